@@ -1,0 +1,10 @@
+"""bvc3d: boundary vector cells and place cells in simulated 3-D worlds.
+
+The compiled core does the work; this package re-exports it with numpy in and numpy out.
+Stages follow the data flow: World -> Sensor scan -> BoundaryVectorLayer -> PlaceCellNetwork
+-> recorded samples -> bvc3d.analysis -> bvc3d.report.
+"""
+from ._core import InputError, Sensor, World, random_walk
+
+__all__ = ["InputError", "Sensor", "World", "random_walk"]
+__version__ = "0.1.0"

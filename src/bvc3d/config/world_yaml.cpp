@@ -1,0 +1,259 @@
+#include "bvc3d/config/world_yaml.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include "bvc3d/core/angles.hpp"
+#include "bvc3d/world/mesh_import.hpp"
+
+namespace bvc3d::config {
+
+namespace {
+
+Vec3 vec3(const YamlView& v) {
+    const auto d = v.as_doubles(3);
+    return Vec3(d[0], d[1], d[2]);
+}
+
+Vec2 vec2(const YamlView& v) {
+    const auto d = v.as_doubles(2);
+    return Vec2(d[0], d[1]);
+}
+
+// rect: [xmin, ymin, xmax, ymax] or polygon: [[x, y], ...]
+Polygon2 region_from_yaml(const YamlView& v) {
+    v.expect_map({"rect", "polygon"});
+    if (v.has("rect") == v.has("polygon")) v.fail("give exactly one of 'rect' or 'polygon'");
+    if (v.has("rect")) {
+        const auto r = v["rect"].as_doubles(4);
+        if (!(r[2] > r[0] && r[3] > r[1])) v["rect"].fail("needs xmin < xmax and ymin < ymax");
+        return Polygon2::rectangle(r[0], r[1], r[2], r[3]);
+    }
+    const auto pv = v["polygon"];
+    Polygon2 poly;
+    for (std::size_t i = 0; i < pv.size(); ++i) poly.points.push_back(vec2(pv.at(i)));
+    if (poly.points.size() < 3 || poly.area() <= 0) pv.fail("needs at least 3 points enclosing a positive area");
+    return poly;
+}
+
+Eigen::Isometry3d pose_from_yaml(const YamlView& v, const std::string& position_key) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    if (v.has(position_key)) pose.translation() = vec3(v[position_key]);
+    if (v.has("rotation_deg")) {  // roll, pitch, yaw about x, y, z (applied in that order)
+        const auto r = v["rotation_deg"].as_doubles(3);
+        pose.linear() = (Eigen::AngleAxisd(deg_to_rad(r[2]), Vec3::UnitZ()) *
+                         Eigen::AngleAxisd(deg_to_rad(r[1]), Vec3::UnitY()) *
+                         Eigen::AngleAxisd(deg_to_rad(r[0]), Vec3::UnitX()))
+                            .toRotationMatrix();
+    } else if (v.has("yaw_deg")) {
+        pose.linear() = Eigen::AngleAxisd(deg_to_rad(v["yaw_deg"].as_double()), Vec3::UnitZ()).toRotationMatrix();
+    }
+    if (v.has("rotation_deg") && v.has("yaw_deg")) v.fail("give 'yaw_deg' or 'rotation_deg', not both");
+    return pose;
+}
+
+CrossArenaParams cross_from_yaml(const YamlView& v) {
+    v.expect_map({"tilt_deg", "lean", "half_width", "height", "wall_length", "wall_thickness", "start_offset"});
+    CrossArenaParams p;
+    p.tilt_deg = v.get("tilt_deg", p.tilt_deg);
+    p.lean = v.get("lean", p.lean);
+    p.half_width = v.get("half_width", p.half_width);
+    p.height = v.get("height", p.height);
+    p.wall_length = v.get("wall_length", p.wall_length);
+    p.wall_thickness = v.get("wall_thickness", p.wall_thickness);
+    p.start_offset = v.get("start_offset", p.start_offset);
+    return p;
+}
+
+void check_mesh(const YamlView& v, const TriangleMesh& m) {
+    if (m.empty()) v.fail("produces no triangles");
+    for (std::size_t t = 0; t < m.size(); ++t) {
+        const auto c = m.corners(t);
+        if (triangle_double_area(c[0], c[1], c[2]) <= 1e-12) v.fail("is degenerate (zero area)");
+    }
+}
+
+// One entry of `objects`: a map with exactly one key naming the primitive.
+void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDescription>& arena) {
+    if (!obj.is_map() || obj.keys().size() != 1)
+        obj.fail("each object is a mapping with one key: cross_arena, box, quad, tilted_wall or mesh");
+    const std::string kind = obj.keys().front();
+    const YamlView v = obj[kind];
+    TriangleMesh part;
+    if (kind == "cross_arena") {
+        CrossArenaParams p = cross_from_yaml(v);
+        try {
+            arena = cross_arena(p);
+        } catch (const InputError& e) {
+            v.fail(e.what());
+        }
+        part = arena->mesh;
+    } else if (kind == "box") {
+        v.expect_map({"center", "size", "yaw_deg", "rotation_deg"});
+        const Vec3 size = vec3(v["size"]);
+        if (!(size.minCoeff() > 0)) v["size"].fail("all three sizes must be > 0");
+        part.append(box_mesh(size), pose_from_yaml(v, "center"));
+    } else if (kind == "quad") {
+        if (v.size() != 4) v.fail("a quad is a list of 4 corners [x, y, z], in order around it");
+        Vec3 c[4];
+        for (int i = 0; i < 4; ++i) c[i] = vec3(v.at(i));
+        part.add_quad(c[0], c[1], c[2], c[3]);
+    } else if (kind == "tilted_wall") {
+        v.expect_map({"center", "length", "thickness", "height", "yaw_deg", "tilt_deg"});
+        TiltedWall t;
+        t.centre = vec2(v["center"]);
+        t.length = v.get("length", t.length);
+        t.thickness = v.get("thickness", t.thickness);
+        t.height = v.get("height", t.height);
+        t.yaw = deg_to_rad(v.get("yaw_deg", 0.0));
+        const double tilt = v.get("tilt_deg", 0.0);
+        require_positive(v, "length", t.length);
+        require_positive(v, "thickness", t.thickness);
+        require_positive(v, "height", t.height);
+        require_range(v, "tilt_deg", tilt, -89.0, 89.0);
+        t.tilt = deg_to_rad(tilt);
+        part = tilted_wall_mesh(t);
+    } else if (kind == "mesh") {
+        v.expect_map({"file", "position", "yaw_deg", "rotation_deg", "scale"});
+        const std::string rel = v["file"].as_string();
+        const std::filesystem::path file = std::filesystem::path(rel).is_absolute()
+                                               ? std::filesystem::path(rel)
+                                               : std::filesystem::path(v.directory()) / rel;
+        TriangleMesh loaded;
+        try {
+            loaded = load_mesh_file(file.string());
+        } catch (const InputError& e) {
+            v["file"].fail(e.what());
+        }
+        const double scale = v.get("scale", 1.0);
+        require_positive(v, "scale", scale);
+        for (auto& p : loaded.vertices) p *= scale;
+        part.append(loaded, pose_from_yaml(v, "position"));
+        if (part.empty()) v.fail("mesh has no triangles");
+        w.mesh.append(part);
+        return;  // assimp already dropped degenerate triangles
+    } else {
+        obj.fail("unknown object kind '" + kind + "' (expected cross_arena, box, quad, tilted_wall or mesh)");
+    }
+    check_mesh(v, part);
+    w.mesh.append(part);
+}
+
+}  // namespace
+
+std::vector<std::string> world_preset_names() { return {"cross", "cross-0", "cross-30", "cross-45", "cross-60"}; }
+
+WorldDescription world_from_yaml(const YamlView& v) {
+    v.expect_map({"name", "objects", "walkable", "start"});
+    WorldDescription w;
+    w.name = v.get("name", std::filesystem::path(v.file()).stem().string());
+    const YamlView objects = v["objects"];
+    if (objects.size() == 0) objects.fail("lists no objects: a world needs geometry");
+    std::optional<WorldDescription> arena;
+    for (std::size_t i = 0; i < objects.size(); ++i) add_object(objects.at(i), w, arena);
+
+    if (v.has("walkable")) {
+        w.walkable = region_from_yaml(v["walkable"]);
+    } else if (arena) {
+        w.walkable = arena->walkable;
+    } else {
+        v.fail_key("walkable", "is required (the floor region the robot may use) unless the world has a cross_arena");
+    }
+    if (v.has("start")) {
+        const YamlView s = v["start"];
+        if (s.has("points")) {
+            s.expect_map({"points"});
+            for (std::size_t i = 0; i < s["points"].size(); ++i) w.start.points.push_back(vec2(s["points"].at(i)));
+            if (w.start.points.empty()) s["points"].fail("must list at least one [x, y] point");
+            for (std::size_t i = 0; i < w.start.points.size(); ++i)
+                if (!w.walkable.contains(w.start.points[i]))
+                    s["points"].at(i).fail("start point lies outside the walkable region");
+        } else {
+            w.start.region = region_from_yaml(s);
+        }
+    } else if (arena && !v.has("walkable")) {
+        w.start = arena->start;
+    } else {
+        w.start.region = w.walkable;
+    }
+    return w;
+}
+
+WorldDescription load_world_file(const std::string& path) { return world_from_yaml(YamlView::load_file(path)); }
+
+WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
+    const auto presets = world_preset_names();
+    if (std::find(presets.begin(), presets.end(), name) != presets.end()) {
+        CrossArenaParams p;
+        p.lean = lean;
+        if (name != "cross") {
+            if (tilt_deg) throw InputError("--tilt only applies to the 'cross' world; '" + name + "' fixes its tilt");
+            p.tilt_deg = std::stod(name.substr(6));
+        } else if (tilt_deg) {
+            p.tilt_deg = *tilt_deg;
+        }
+        return cross_arena(p);
+    }
+    if (tilt_deg) throw InputError("--tilt only applies to the 'cross' world, not to '" + name + "'");
+    std::error_code ec;
+    if (!std::filesystem::exists(name, ec)) {
+        std::string list;
+        for (const auto& p : presets) list += (list.empty() ? "" : ", ") + p;
+        throw InputError("world '" + name + "' is neither a preset (" + list + ") nor an existing YAML file");
+    }
+    return load_world_file(name);
+}
+
+LidarSpec sensor_from_yaml(const YamlView& v) {
+    v.expect_map({"preset", "name", "elevations_deg", "keep_rows", "azimuth_count", "azimuth_offset_deg", "height",
+                  "max_range", "range_noise_sd", "dropout"});
+    const std::string preset = v.get("preset", "");
+    LidarSpec s;
+    if (preset == "horizontal") {
+        s = LidarSpec::horizontal();
+        if (v.has("keep_rows")) v.fail_key("keep_rows", "only applies to the spherical preset");
+    } else if (preset == "spherical") {
+        const std::string rows = v.get("keep_rows", "upper");
+        if (rows != "upper" && rows != "all") v["keep_rows"].fail("must be 'upper' or 'all'");
+        s = LidarSpec::spherical(rows == "upper");
+    } else if (!preset.empty()) {
+        v["preset"].fail("unknown sensor preset '" + preset + "' (expected horizontal or spherical)");
+    } else if (!v.has("elevations_deg")) {
+        v.fail("a custom sensor needs 'elevations_deg' (or a 'preset')");
+    }
+    s.name = v.get("name", preset.empty() ? std::string("custom") : preset);
+    if (v.has("elevations_deg")) {
+        if (v.has("keep_rows")) v.fail_key("keep_rows", "cannot be combined with elevations_deg");
+        const auto e = v["elevations_deg"].as_doubles();
+        if (e.empty()) v["elevations_deg"].fail("must list at least one elevation");
+        s.elevations.clear();
+        for (double d : e) {
+            if (std::abs(d) > 90) v["elevations_deg"].fail("elevations must lie in [-90, 90] degrees");
+            s.elevations.push_back(deg_to_rad(d));
+        }
+    }
+    s.azimuth_count = v.get("azimuth_count", s.azimuth_count);
+    s.azimuth_offset = deg_to_rad(v.get("azimuth_offset_deg", rad_to_deg(s.azimuth_offset)));
+    s.height = v.get("height", s.height);
+    s.max_range = v.get("max_range", s.max_range);
+    s.range_noise_sd = v.get("range_noise_sd", s.range_noise_sd);
+    s.dropout = v.get("dropout", s.dropout);
+    if (s.azimuth_count < 1) v["azimuth_count"].fail("must be >= 1");
+    require_range(v, "height", s.height, 0.0, 1e3);
+    require_positive(v, "max_range", s.max_range);
+    require_range(v, "range_noise_sd", s.range_noise_sd, 0.0, 1e3);
+    require_range(v, "dropout", s.dropout, 0.0, 0.999999);
+    return s;
+}
+
+LidarSpec resolve_sensor(const std::string& name) {
+    if (name == "horizontal") return LidarSpec::horizontal();
+    if (name == "spherical") return LidarSpec::spherical();
+    std::error_code ec;
+    if (!std::filesystem::exists(name, ec))
+        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical' nor an existing YAML file");
+    const YamlView v = YamlView::load_file(name);
+    return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
+}
+
+}  // namespace bvc3d::config

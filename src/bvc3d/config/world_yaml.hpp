@@ -1,0 +1,27 @@
+#pragma once
+// YAML <-> worlds (SPEC §2.2). The schema is documented in docs/worlds.md.
+#include <optional>
+#include <string>
+
+#include "bvc3d/config/yaml_reader.hpp"
+#include "bvc3d/sensor/lidar.hpp"
+#include "bvc3d/world/world.hpp"
+
+namespace bvc3d::config {
+
+// The names `--world` accepts besides a YAML file.
+std::vector<std::string> world_preset_names();
+
+WorldDescription world_from_yaml(const YamlView& v);
+WorldDescription load_world_file(const std::string& path);
+
+// A preset name ("cross", "cross-30", ...) or a YAML file. `tilt_deg` overrides the tilt of the
+// `cross` preset and is an error for anything else.
+WorldDescription resolve_world(const std::string& name_or_file, std::optional<double> tilt_deg = std::nullopt,
+                               const std::string& lean = "+x+y");
+
+// Sensors: "horizontal", "spherical", or a YAML mapping / file describing a beam table.
+LidarSpec sensor_from_yaml(const YamlView& v);
+LidarSpec resolve_sensor(const std::string& name_or_file);
+
+}  // namespace bvc3d::config

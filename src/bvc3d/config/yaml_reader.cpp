@@ -1,0 +1,171 @@
+#include "bvc3d/config/yaml_reader.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace bvc3d::config {
+
+YamlView YamlView::load_file(const std::string& file) {
+    std::ifstream in(file);
+    if (!in) {
+        std::error_code ec;
+        throw ConfigError(file, "", std::filesystem::exists(file, ec) ? "cannot be opened for reading" : "file does not exist");
+    }
+    std::stringstream text;
+    text << in.rdbuf();
+    return load_string(text.str(), file);
+}
+
+YamlView YamlView::load_string(const std::string& text, const std::string& name) {
+    try {
+        YAML::Node n = YAML::Load(text);
+        if (!n.IsDefined() || n.IsNull()) throw ConfigError(name, "", "is empty");
+        return YamlView(n, name);
+    } catch (const YAML::Exception& e) {
+        throw ConfigError(name, "", "malformed YAML at line " + std::to_string(e.mark.line + 1) + ", column " +
+                                        std::to_string(e.mark.column + 1) + ": " + e.msg);
+    }
+}
+
+std::string YamlView::directory() const {
+    const auto parent = std::filesystem::path(file_).parent_path();
+    return parent.empty() ? "." : parent.string();
+}
+
+std::string YamlView::location() const {
+    const auto m = node_.Mark();
+    if (m.line < 0) return "";
+    return " (line " + std::to_string(m.line + 1) + ")";
+}
+
+void YamlView::fail(const std::string& reason) const { throw ConfigError(file_, path_, reason + location()); }
+
+void YamlView::fail_key(const std::string& key, const std::string& reason) const {
+    throw ConfigError(file_, child_path(key), reason + location());
+}
+
+void YamlView::expect_map(std::initializer_list<const char*> allowed) const {
+    expect_map(std::vector<std::string>(allowed.begin(), allowed.end()));
+}
+
+void YamlView::expect_map(const std::vector<std::string>& allowed) const {
+    if (!node_.IsMap()) fail("expected a mapping of keys to values");
+    for (const auto& kv : node_) {
+        const std::string k = kv.first.as<std::string>();
+        bool ok = false;
+        for (const auto& a : allowed) ok = ok || a == k;
+        if (!ok) {
+            std::string list;
+            for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+            YamlView(kv.first, file_, child_path(k)).fail("unknown key (allowed: " + list + ")");
+        }
+    }
+}
+
+YamlView YamlView::operator[](const std::string& key) const {
+    if (!node_.IsMap()) fail("expected a mapping of keys to values");
+    YAML::Node child = node_[key];
+    if (!child.IsDefined()) fail_key(key, "is required but missing");
+    return YamlView(child, file_, child_path(key));
+}
+
+YamlView YamlView::at(std::size_t i) const {
+    if (!node_.IsSequence()) fail("expected a list");
+    return YamlView(node_[i], file_, path_ + "[" + std::to_string(i) + "]");
+}
+
+std::size_t YamlView::size() const {
+    if (!node_.IsSequence()) fail("expected a list");
+    return node_.size();
+}
+
+std::vector<std::string> YamlView::keys() const {
+    if (!node_.IsMap()) fail("expected a mapping of keys to values");
+    std::vector<std::string> out;
+    for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+    return out;
+}
+
+double YamlView::as_double() const {
+    if (!node_.IsScalar()) fail("expected a number");
+    double v;
+    try {
+        v = node_.as<double>();
+    } catch (const YAML::Exception&) {
+        fail("expected a number, got '" + node_.Scalar() + "'");
+    }
+    if (!std::isfinite(v)) fail("expected a finite number, got '" + node_.Scalar() + "'");
+    return v;
+}
+
+long long YamlView::as_int() const {
+    if (!node_.IsScalar()) fail("expected an integer");
+    try {
+        return node_.as<long long>();
+    } catch (const YAML::Exception&) {
+        fail("expected an integer, got '" + node_.Scalar() + "'");
+    }
+}
+
+bool YamlView::as_bool() const {
+    if (!node_.IsScalar()) fail("expected true or false");
+    try {
+        return node_.as<bool>();
+    } catch (const YAML::Exception&) {
+        fail("expected true or false, got '" + node_.Scalar() + "'");
+    }
+}
+
+std::string YamlView::as_string() const {
+    if (!node_.IsScalar()) fail("expected a text value");
+    return node_.Scalar();
+}
+
+std::vector<double> YamlView::as_doubles(std::optional<std::size_t> n) const {
+    if (!node_.IsSequence()) fail(n ? "expected a list of " + std::to_string(*n) + " numbers" : "expected a list of numbers");
+    if (n && node_.size() != *n)
+        fail("expected a list of " + std::to_string(*n) + " numbers, got " + std::to_string(node_.size()));
+    std::vector<double> out;
+    for (std::size_t i = 0; i < node_.size(); ++i) out.push_back(at(i).as_double());
+    return out;
+}
+
+double YamlView::get(const std::string& key, double fallback) const {
+    return has(key) ? (*this)[key].as_double() : fallback;
+}
+
+int YamlView::get(const std::string& key, int fallback) const {
+    if (!has(key)) return fallback;
+    const long long v = (*this)[key].as_int();
+    if (v < INT32_MIN || v > INT32_MAX) (*this)[key].fail("integer out of range");
+    return static_cast<int>(v);
+}
+
+std::string YamlView::get(const std::string& key, const std::string& fallback) const {
+    return has(key) ? (*this)[key].as_string() : fallback;
+}
+
+bool YamlView::get_bool(const std::string& key, bool fallback) const {
+    return has(key) ? (*this)[key].as_bool() : fallback;
+}
+
+namespace {
+[[noreturn]] void fail_at(const YamlView& v, const std::string& key, const std::string& reason) {
+    if (v.has(key)) v[key].fail(reason);
+    v.fail_key(key, reason);
+}
+}  // namespace
+
+void require_positive(const YamlView& v, const std::string& key, double value) {
+    if (!(value > 0)) fail_at(v, key, "must be > 0, got " + std::to_string(value));
+}
+
+void require_range(const YamlView& v, const std::string& key, double value, double lo, double hi) {
+    if (!(value >= lo && value <= hi))
+        fail_at(v, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                            std::to_string(value));
+}
+
+}  // namespace bvc3d::config

@@ -1,0 +1,72 @@
+#pragma once
+// A thin, validating view over yaml-cpp nodes: every error names the file, the key path and the
+// reason, and unknown keys are rejected. All YAML mappings of bvc3d are written with it.
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d::config {
+
+class YamlView {
+public:
+    YamlView(YAML::Node node, std::string file, std::string path = "")
+        : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+    // Parse a file or a string (`name` is what error messages call it).
+    static YamlView load_file(const std::string& file);
+    static YamlView load_string(const std::string& text, const std::string& name);
+
+    const YAML::Node& node() const { return node_; }
+    const std::string& file() const { return file_; }
+    const std::string& path() const { return path_; }
+    std::string directory() const;  // the file's folder, for relative paths inside it
+
+    bool is_map() const { return node_.IsMap(); }
+    bool is_sequence() const { return node_.IsSequence(); }
+    bool is_scalar() const { return node_.IsScalar(); }
+    bool has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
+
+    [[noreturn]] void fail(const std::string& reason) const;
+    [[noreturn]] void fail_key(const std::string& key, const std::string& reason) const;
+
+    // This node must be a map whose keys are all in `allowed`.
+    void expect_map(std::initializer_list<const char*> allowed) const;
+    void expect_map(const std::vector<std::string>& allowed) const;
+
+    YamlView operator[](const std::string& key) const;  // fails if missing
+    YamlView at(std::size_t i) const;
+    std::size_t size() const;  // of a sequence (fails if not one)
+    std::vector<std::string> keys() const;  // of a map, in file order
+
+    double as_double() const;  // finite number
+    long long as_int() const;
+    bool as_bool() const;
+    std::string as_string() const;
+    std::vector<double> as_doubles(std::optional<std::size_t> n = std::nullopt) const;
+
+    // Optional members with a default.
+    double get(const std::string& key, double fallback) const;
+    int get(const std::string& key, int fallback) const;
+    std::string get(const std::string& key, const std::string& fallback) const;
+    std::string get(const std::string& key, const char* fallback) const { return get(key, std::string(fallback)); }
+    bool get_bool(const std::string& key, bool fallback) const;
+
+    std::string child_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+private:
+    std::string location() const;  // " (line L)" when known
+    YAML::Node node_;
+    std::string file_, path_;
+};
+
+// Number checks with the standard message.
+void require_positive(const YamlView& v, const std::string& key, double value);
+void require_range(const YamlView& v, const std::string& key, double value, double lo, double hi);
+
+}  // namespace bvc3d::config

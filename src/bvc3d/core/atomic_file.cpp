@@ -1,0 +1,63 @@
+#include "bvc3d/core/atomic_file.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cstring>
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d {
+
+namespace {
+std::atomic<unsigned> counter{0};
+}
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+    temp_ = target_;
+    temp_ += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    const auto dir = target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
+    ensure_writable_directory(dir);
+}
+
+AtomicFile::~AtomicFile() {
+    if (committed_) return;
+    if (out_.is_open()) out_.close();
+    std::error_code ec;
+    std::filesystem::remove(temp_, ec);
+}
+
+std::ofstream& AtomicFile::stream() {
+    if (!out_.is_open()) {
+        out_.open(temp_, std::ios::out | std::ios::trunc);
+        if (!out_) throw InputError("cannot write '" + target_.string() + "': " + std::strerror(errno));
+    }
+    return out_;
+}
+
+void AtomicFile::commit() {
+    if (out_.is_open()) {
+        out_.flush();
+        if (!out_) throw InputError("error while writing '" + target_.string() + "'");
+        out_.close();
+    }
+    std::error_code ec;
+    std::filesystem::rename(temp_, target_, ec);
+    if (ec) throw InputError("cannot write '" + target_.string() + "': " + ec.message());
+    committed_ = true;
+}
+
+void ensure_writable_directory(const std::filesystem::path& dir) {
+    std::error_code ec;
+    if (std::filesystem::exists(dir, ec)) {
+        if (!std::filesystem::is_directory(dir, ec))
+            throw InputError("output folder '" + dir.string() + "' exists and is not a folder");
+    } else {
+        std::filesystem::create_directories(dir, ec);
+        if (ec) throw InputError("cannot create output folder '" + dir.string() + "': " + ec.message());
+    }
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw InputError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,188 @@
+#include "bvc3d/robot/body_collider.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+// The part of a triangle with z_lo <= z <= z_hi (a convex polygon, possibly empty).
+std::vector<Vec3> clip_to_slab(const std::array<Vec3, 3>& tri, double z_lo, double z_hi) {
+    std::vector<Vec3> poly(tri.begin(), tri.end());
+    auto clip = [&](double z0, double sign) {  // keep sign·(z - z0) >= 0
+        std::vector<Vec3> out;
+        const std::size_t n = poly.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Vec3& a = poly[i];
+            const Vec3& b = poly[(i + 1) % n];
+            const double da = sign * (a.z() - z0), db = sign * (b.z() - z0);
+            if (da >= 0) out.push_back(a);
+            if ((da >= 0) != (db >= 0)) {
+                Vec3 c = a + (da / (da - db)) * (b - a);
+                c.z() = z0;
+                out.push_back(c);
+            }
+        }
+        poly = std::move(out);
+    };
+    clip(z_lo, 1.0);
+    if (!poly.empty()) clip(z_hi, -1.0);
+    return poly;
+}
+
+// Earliest t in [0, max_t] at which the moving point p + t·u comes within distance R of segment
+// ab; max_t if never. If it is already within R, 0 when moving closer, max_t when moving away.
+double contact_time(const Vec2& p, const Vec2& u, double R, const Segment2& s, double max_t) {
+    const Vec2 ab = s.b - s.a;
+    const double len2 = ab.squaredNorm();
+    // Closest point now, to tell "already touching" apart.
+    const double lam0 = len2 > 0 ? std::clamp((p - s.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const Vec2 d0 = p - (s.a + lam0 * ab);
+    if (d0.squaredNorm() < R * R) return d0.dot(u) < 0 ? 0.0 : max_t;
+
+    double best = max_t;
+    // The flat side of the capsule facing p.
+    if (len2 > 0) {
+        const double len = std::sqrt(len2);
+        Vec2 n(-ab.y() / len, ab.x() / len);
+        double s0 = n.dot(p - s.a);
+        if (s0 < 0) {
+            n = -n;
+            s0 = -s0;
+        }
+        const double approach = -n.dot(u);
+        if (approach > 0 && s0 >= R) {
+            const double t = (s0 - R) / approach;
+            const double lam = (p + t * u - s.a).dot(ab) / len2;
+            if (t <= best && lam >= 0.0 && lam <= 1.0) best = t;
+        }
+    }
+    // The round ends: |p + t u - c|^2 = R^2, entering root.
+    for (const Vec2& c : {s.a, s.b}) {
+        const Vec2 w = p - c;
+        const double b = w.dot(u);
+        const double disc = b * b - (w.squaredNorm() - R * R);
+        if (disc < 0) continue;
+        const double t = -b - std::sqrt(disc);
+        if (t >= 0 && t < best) best = t;
+    }
+    return best;
+}
+
+double point_segment_distance(const Vec2& p, const Segment2& s) {
+    const Vec2 ab = s.b - s.a;
+    const double len2 = ab.squaredNorm();
+    const double lam = len2 > 0 ? std::clamp((p - s.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    return (p - (s.a + lam * ab)).norm();
+}
+
+}  // namespace
+
+BodyCollider::BodyCollider(const WorldDescription& world, double radius, double height)
+    : radius_(radius), walkable_(world.walkable) {
+    if (!(radius > 0) || !(height > 0)) throw InputError("robot radius and height must be positive");
+    if (walkable_.points.size() < 3 || walkable_.area() <= 0)
+        throw InputError("world '" + world.name + "': the walkable region needs at least 3 points and a positive area");
+
+    // Triangles touching the slab just above the floor up to the body's top. The tiny lower bound
+    // keeps floor triangles (z = 0) out while walls standing on the floor count from their base.
+    const double z_lo = 1e-9;
+    for (std::size_t t = 0; t < world.mesh.size(); ++t) {
+        const auto poly = clip_to_slab(world.mesh.corners(t), z_lo, height);
+        for (std::size_t i = 0; i < poly.size(); ++i) {
+            const Vec3& a = poly[i];
+            const Vec3& b = poly[(i + 1) % poly.size()];
+            add_segment(a.head<2>(), b.head<2>());
+        }
+    }
+    const auto& w = walkable_.points;
+    for (std::size_t i = 0; i < w.size(); ++i) add_segment(w[i], w[(i + 1) % w.size()]);
+
+    // Grid cells about the size of the body: a move query touches a handful of them.
+    for (const auto& s : segments_) {
+        bounds_.extend(s.a);
+        bounds_.extend(s.b);
+    }
+    cell_ = std::max(4.0 * radius_, 1e-3);
+    nx_ = std::max(1, static_cast<int>(std::ceil(bounds_.sizes().x() / cell_)));
+    ny_ = std::max(1, static_cast<int>(std::ceil(bounds_.sizes().y() / cell_)));
+    while (static_cast<double>(nx_) * ny_ > 4e6) {  // keep the grid's memory bounded
+        cell_ *= 2;
+        nx_ = std::max(1, static_cast<int>(std::ceil(bounds_.sizes().x() / cell_)));
+        ny_ = std::max(1, static_cast<int>(std::ceil(bounds_.sizes().y() / cell_)));
+    }
+    grid_.assign(static_cast<std::size_t>(nx_) * ny_, {});
+    for (std::size_t i = 0; i < segments_.size(); ++i) {
+        Eigen::AlignedBox2d box;
+        box.extend(segments_[i].a);
+        box.extend(segments_[i].b);
+        const int x0 = std::clamp(static_cast<int>((box.min().x() - bounds_.min().x()) / cell_), 0, nx_ - 1);
+        const int x1 = std::clamp(static_cast<int>((box.max().x() - bounds_.min().x()) / cell_), 0, nx_ - 1);
+        const int y0 = std::clamp(static_cast<int>((box.min().y() - bounds_.min().y()) / cell_), 0, ny_ - 1);
+        const int y1 = std::clamp(static_cast<int>((box.max().y() - bounds_.min().y()) / cell_), 0, ny_ - 1);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) grid_[static_cast<std::size_t>(y) * nx_ + x].push_back(static_cast<int>(i));
+    }
+    stamp_.assign(segments_.size(), 0);
+}
+
+void BodyCollider::add_segment(const Vec2& a, const Vec2& b) {
+    if ((a - b).squaredNorm() == 0.0) {
+        segments_.push_back({a, b});  // a point still blocks the body
+        return;
+    }
+    // Projected edges of adjacent triangles repeat: keep one copy of exact repeats.
+    for (std::size_t i = segments_.size(); i-- > 0 && i + 64 > segments_.size();) {
+        const auto& s = segments_[i];
+        if ((s.a == a && s.b == b) || (s.a == b && s.b == a)) return;
+    }
+    segments_.push_back({a, b});
+}
+
+template <class F>
+void BodyCollider::for_segments_near(const Eigen::AlignedBox2d& box, F&& f) const {
+    if (grid_.empty()) return;
+    if (++epoch_ == 0) {
+        std::fill(stamp_.begin(), stamp_.end(), 0u);
+        epoch_ = 1;
+    }
+    const int x0 = std::clamp(static_cast<int>(std::floor((box.min().x() - bounds_.min().x()) / cell_)), 0, nx_ - 1);
+    const int x1 = std::clamp(static_cast<int>(std::floor((box.max().x() - bounds_.min().x()) / cell_)), 0, nx_ - 1);
+    const int y0 = std::clamp(static_cast<int>(std::floor((box.min().y() - bounds_.min().y()) / cell_)), 0, ny_ - 1);
+    const int y1 = std::clamp(static_cast<int>(std::floor((box.max().y() - bounds_.min().y()) / cell_)), 0, ny_ - 1);
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+            for (int i : grid_[static_cast<std::size_t>(y) * nx_ + x])
+                if (stamp_[i] != epoch_) {
+                    stamp_[i] = epoch_;
+                    f(i);
+                }
+}
+
+double BodyCollider::free_distance(const Vec2& p, const Vec2& u, double max_dist) const {
+    Eigen::AlignedBox2d box;
+    box.extend(p);
+    box.extend(p + max_dist * u);
+    box.min().array() -= radius_;
+    box.max().array() += radius_;
+    double t = max_dist;
+    for_segments_near(box, [&](int i) { t = std::min(t, contact_time(p, u, radius_, segments_[i], t)); });
+    return t;
+}
+
+double BodyCollider::clearance(const Vec2& p) const {
+    // Grow the search box until it holds a segment, then check everything that could be closer.
+    double best = std::numeric_limits<double>::infinity();
+    for (double reach = cell_;; reach *= 2) {
+        Eigen::AlignedBox2d box(p - Vec2::Constant(reach), p + Vec2::Constant(reach));
+        for_segments_near(box, [&](int i) { best = std::min(best, point_segment_distance(p, segments_[i])); });
+        if (best <= reach || reach > 2 * (bounds_.sizes().norm() + (p - bounds_.center()).norm())) break;
+    }
+    return best - radius_;
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,52 @@
+#pragma once
+// Exact collision of the robot's body (a vertical cylinder standing on z = 0) with the world.
+//
+// The cylinder, radius R and height H, touches a triangle iff its disc touches the floor-plane
+// projection of the triangle's part with 0 < z <= H. Those projections are convex polygons, so
+// the 3-D test reduces to a disc against 2-D segments (their edges), exactly. Triangles lying at
+// z <= 0 are floor and never collide. The walkable region's boundary also counts as a wall.
+#include <vector>
+
+#include "bvc3d/world/world.hpp"
+
+namespace bvc3d {
+
+struct Segment2 {
+    Vec2 a, b;
+};
+
+class BodyCollider {
+public:
+    BodyCollider(const WorldDescription& world, double radius, double height);
+
+    double radius() const { return radius_; }
+    const std::vector<Segment2>& segments() const { return segments_; }
+
+    // How far the body can move from centre p along the unit direction u, up to max_dist, before
+    // it touches geometry. 0 if it already touches and u points into the contact.
+    double free_distance(const Vec2& p, const Vec2& u, double max_dist) const;
+
+    // Distance from the centre p to the nearest segment, minus the radius (< 0: overlap).
+    double clearance(const Vec2& p) const;
+
+    // Inside the walkable region and not overlapping anything.
+    bool is_free(const Vec2& p) const { return walkable_.contains(p) && clearance(p) >= 0.0; }
+
+private:
+    void add_segment(const Vec2& a, const Vec2& b);
+    template <class F>
+    void for_segments_near(const Eigen::AlignedBox2d& box, F&& f) const;
+
+    double radius_;
+    Polygon2 walkable_;
+    std::vector<Segment2> segments_;
+    // Uniform grid over the segments' bounds: cell -> segment indices.
+    Eigen::AlignedBox2d bounds_;
+    double cell_ = 1.0;
+    int nx_ = 1, ny_ = 1;
+    std::vector<std::vector<int>> grid_;
+    mutable std::vector<unsigned> stamp_;
+    mutable unsigned epoch_ = 0;
+};
+
+}  // namespace bvc3d

@@ -1,0 +1,136 @@
+#include "bvc3d/robot/random_walk.hpp"
+
+#include <cmath>
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d {
+
+void RobotParams::validate() const {
+    auto positive = [](double v, const char* name) {
+        if (!std::isfinite(v) || v <= 0) throw InputError(std::string("robot: ") + name + " must be > 0");
+    };
+    positive(radius, "radius");
+    positive(height, "height");
+    positive(speed, "speed");
+    positive(turn_rate, "turn_rate");
+    positive(model_dt, "model_dt");
+    if (n_walk < 1) throw InputError("robot: n_walk must be >= 1");
+    if (!std::isfinite(turn_sd) || turn_sd < 0) throw InputError("robot: turn_sd must be >= 0");
+    if (!std::isfinite(min_update_move) || min_update_move < 0)
+        throw InputError("robot: min_update_move must be >= 0");
+}
+
+RandomWalk::RandomWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& params, Rng rng,
+                       const Pose& start)
+    : body_(std::move(body)), p_(params), rng_(std::move(rng)) {
+    p_.validate();
+    state_.pose = start;
+    state_.pose.heading = wrap_pi(start.heading);
+}
+
+Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& body, Rng& rng) {
+    Pose pose;
+    if (!world.start.points.empty()) {
+        const auto n = world.start.points.size();
+        const auto i = std::min(n - 1, static_cast<std::size_t>(rng.uniform() * static_cast<double>(n)));
+        pose.x = world.start.points[i].x();
+        pose.y = world.start.points[i].y();
+        if (!body.is_free(world.start.points[i]))
+            throw InputError("world '" + world.name + "': start point (" + std::to_string(pose.x) + ", " +
+                             std::to_string(pose.y) + ") is blocked or outside the walkable region");
+    } else {
+        const auto& region = world.start.region;
+        if (region.points.size() < 3 || region.area() <= 0)
+            throw InputError("world '" + world.name + "': no start points and no start region with positive area");
+        const auto box = region.bounds();
+        bool found = false;
+        for (int attempt = 0; attempt < 100000 && !found; ++attempt) {
+            const Vec2 p(rng.uniform(box.min().x(), box.max().x()), rng.uniform(box.min().y(), box.max().y()));
+            if (region.contains(p) && body.is_free(p)) {
+                pose.x = p.x();
+                pose.y = p.y();
+                found = true;
+            }
+        }
+        if (!found)
+            throw InputError("world '" + world.name + "': the start region has no place where the robot fits");
+    }
+    pose.heading = rng.uniform(-pi, pi);
+    return pose;
+}
+
+void RandomWalk::turn_to(double heading) {
+    heading = wrap_pi(heading);
+    state_.t += std::abs(wrap_pi(heading - state_.pose.heading)) / p_.turn_rate;
+    state_.pose.heading = heading;
+}
+
+void RandomWalk::bump() {
+    const double h = rng_.uniform(-pi, pi);
+    if (log_) log_->push_back({TurnEvent::Kind::bump, h});
+    turn_to(h);
+    state_.steps_since_turn = 0;
+    state_.bump_pending = false;
+}
+
+std::optional<WalkStep> RandomWalk::next(double t_end) {
+    const double step_len = p_.speed * p_.model_dt;
+    while (state_.t < t_end) {
+        if (state_.bump_pending) {
+            bump();
+            continue;
+        }
+        if (state_.steps_since_turn >= p_.n_walk) {
+            const double d = rng_.normal(0.0, p_.turn_sd);
+            if (log_) log_->push_back({TurnEvent::Kind::gaussian, d});
+            turn_to(state_.pose.heading + d);
+            state_.steps_since_turn = 0;
+            continue;
+        }
+        Pose& q = state_.pose;
+        const Vec2 u(std::cos(q.heading), std::sin(q.heading));
+        const double free = body_->free_distance(Vec2(q.x, q.y), u, step_len);
+        if (free >= step_len) {
+            q.x += step_len * u.x();
+            q.y += step_len * u.y();
+            state_.t += p_.model_dt;
+            ++state_.steps_since_turn;
+            return WalkStep{state_.t, q.x, q.y, q.heading, false};
+        }
+        // Bumper: stop at contact (a nanometre short of it), then turn to a uniform heading.
+        const double moved = std::max(0.0, free - 1e-9);
+        q.x += moved * u.x();
+        q.y += moved * u.y();
+        state_.t += moved / p_.speed;
+        state_.bump_pending = true;
+        if (moved > p_.min_update_move) return WalkStep{state_.t, q.x, q.y, q.heading, true};
+    }
+    return std::nullopt;
+}
+
+WalkState RandomWalk::state() const {
+    WalkState s = state_;
+    s.rng_state = rng_.state();
+    return s;
+}
+
+void RandomWalk::restore(const WalkState& s) {
+    state_ = s;
+    rng_.set_state(s.rng_state);
+}
+
+std::vector<WalkStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params) {
+    if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0");
+    params.validate();
+    auto body = std::make_shared<const BodyCollider>(world.description(), params.radius, params.height);
+    Rng rng(seed, Stream::walk);
+    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    RandomWalk walk(body, params, std::move(rng), start);
+    std::vector<WalkStep> steps;
+    steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
+    while (auto s = walk.next(hours * 3600.0)) steps.push_back(*s);
+    return steps;
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,75 @@
+#pragma once
+// Sensor stage: range scanners on the robot.
+// Takes: a World and the robot's pose. Gives: the hits as (range, allocentric azimuth,
+// elevation) relative to the sensor (SPEC §1, §3); beams with no hit within max_range are dropped.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bvc3d/world/world.hpp"
+
+namespace bvc3d {
+
+struct Pose {
+    double x = 0.0, y = 0.0, heading = 0.0;
+};
+
+// One return. Laid out as three doubles so a scan is an (N, 3) array for numpy.
+struct LidarReturn {
+    double range;      // m
+    double azimuth;    // allocentric, radians in (-pi, pi], 0 = +x (east)
+    double elevation;  // radians, positive up
+};
+using Scan = std::vector<LidarReturn>;
+
+// A beam table: every elevation (row, top first) × azimuth_count columns at robot-frame azimuth
+// azimuth_offset + j·2π/azimuth_count. Beam index = row·azimuth_count + column.
+struct LidarSpec {
+    std::string name = "custom";
+    std::vector<double> elevations{0.0};  // radians
+    int azimuth_count = 720;
+    double azimuth_offset = 0.0;  // radians
+    double height = 0.08;         // m above the floor
+    double max_range = 20.0;      // m
+    double range_noise_sd = 0.0;  // m, Gaussian noise added to each range
+    double dropout = 0.0;         // probability that a beam returns nothing
+
+    // The paper's 2-D scanner: 720 beams, 0.5° apart, at 0.08 m.
+    static LidarSpec horizontal();
+    // The paper's 3-D scanner: the 90 × 180 range image at 0.18 m; `upper_only` keeps rows 0-44.
+    static LidarSpec spherical(bool upper_only = true);
+
+    std::size_t beam_count() const { return elevations.size() * static_cast<std::size_t>(azimuth_count); }
+    void validate() const;  // throws InputError naming the bad field
+};
+
+// Seeds the optional range noise and dropout. The noise of beam b in scan s depends only on
+// (seed, s, b), so casting a subset of beams never changes the other beams' noise.
+struct NoiseKey {
+    std::uint64_t seed = 0;
+    std::uint64_t scan_index = 0;
+};
+
+class Lidar {
+public:
+    explicit Lidar(LidarSpec spec);
+    const LidarSpec& spec() const { return spec_; }
+
+    // Cast the beams from `pose` and append the hits to `out` (which is cleared first).
+    // `rows`, if not empty, flags which rows to cast (one flag per elevation).
+    void scan(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise = {},
+              const std::vector<char>& rows = {}) const;
+    Scan scan(const World& world, const Pose& pose, const NoiseKey& noise = {}) const {
+        Scan s;
+        scan(world, pose, s, noise);
+        return s;
+    }
+
+private:
+    LidarSpec spec_;
+    std::vector<double> cos_el_, sin_el_, column_azimuth_;
+    mutable std::vector<Vec3> dirs_;  // scratch
+    mutable std::vector<double> ranges_, azimuths_;
+};
+
+}  // namespace bvc3d

@@ -1,0 +1,35 @@
+#pragma once
+// Ray queries against a triangle mesh, through Embree 3.
+// Embree finds the triangle a ray hits (in float); the distance is then recomputed in double
+// against that triangle's plane, so ranges are exact to ~1e-12 m rather than float's ~1e-6 m.
+#include <limits>
+#include <span>
+
+#include "bvc3d/world/mesh.hpp"
+
+namespace bvc3d {
+
+class RayCaster {
+public:
+    explicit RayCaster(const TriangleMesh& mesh);
+    ~RayCaster();
+    RayCaster(const RayCaster&) = delete;
+    RayCaster& operator=(const RayCaster&) = delete;
+
+    static constexpr double no_hit = std::numeric_limits<double>::infinity();
+
+    // Distance along the unit direction `dir` to the first surface within max_range, or no_hit.
+    double cast(const Vec3& origin, const Vec3& dir, double max_range) const;
+
+    // Same for many unit directions from one origin (uses Embree ray packets).
+    void cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range, std::span<double> ranges) const;
+
+private:
+    double refine(unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const;
+
+    struct Impl;
+    Impl* impl_;
+    std::vector<Vec3> plane_point_, plane_normal_;  // per triangle, double precision
+};
+
+}  // namespace bvc3d

@@ -1,0 +1,70 @@
+#include "bvc3d/world/world.hpp"
+
+#include <cmath>
+
+#include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/world/ray_caster.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+void require(bool ok, const std::string& what) {
+    if (!ok) throw InputError("cross arena: " + what);
+}
+
+// Signs of the corner named by `lean`, e.g. "+x-y" -> (+1, -1).
+std::pair<double, double> lean_signs(const std::string& lean) {
+    if (lean == "+x+y") return {1.0, 1.0};
+    if (lean == "+x-y") return {1.0, -1.0};
+    if (lean == "-x+y") return {-1.0, 1.0};
+    if (lean == "-x-y") return {-1.0, -1.0};
+    throw InputError("cross arena: lean '" + lean + "' is not one of +x+y, +x-y, -x+y, -x-y");
+}
+
+}  // namespace
+
+WorldDescription cross_arena(const CrossArenaParams& p) {
+    const auto [sx, sy] = lean_signs(p.lean);
+    require(std::isfinite(p.tilt_deg) && p.tilt_deg >= 0.0 && p.tilt_deg < 90.0,
+            "tilt_deg must be in [0, 90), got " + std::to_string(p.tilt_deg));
+    require(p.half_width > 0 && p.height > 0 && p.wall_thickness > 0 && p.wall_length > 0,
+            "sizes must be positive");
+    require(p.wall_length < 2.0 * p.half_width, "wall_length must be shorter than the arena");
+    const double alpha = deg_to_rad(p.tilt_deg);
+    const double reach = p.height * std::tan(alpha) + 0.5 * p.wall_thickness / std::cos(alpha);
+    require(reach < p.half_width, "tilt_deg " + std::to_string(p.tilt_deg) +
+                                      " makes the central walls' tops pass through the outer walls");
+    require(std::abs(p.start_offset) < p.half_width, "start_offset must lie inside the arena");
+
+    WorldDescription w;
+    w.name = "cross-" + std::to_string(static_cast<int>(std::lround(p.tilt_deg)));
+    const double a = p.half_width, h = p.height;
+    auto& m = w.mesh;
+    m.add_quad(Vec3(-a, -a, 0), Vec3(a, -a, 0), Vec3(a, a, 0), Vec3(-a, a, 0));  // floor
+    m.add_quad(Vec3(-a, -a, h), Vec3(-a, a, h), Vec3(a, a, h), Vec3(a, -a, h));  // ceiling
+    m.add_quad(Vec3(-a, -a, 0), Vec3(-a, a, 0), Vec3(-a, a, h), Vec3(-a, -a, h));  // x = -a
+    m.add_quad(Vec3(a, -a, 0), Vec3(a, -a, h), Vec3(a, a, h), Vec3(a, a, 0));      // x = +a
+    m.add_quad(Vec3(-a, -a, 0), Vec3(-a, -a, h), Vec3(a, -a, h), Vec3(a, -a, 0));  // y = -a
+    m.add_quad(Vec3(-a, a, 0), Vec3(a, a, 0), Vec3(a, a, h), Vec3(-a, a, h));      // y = +a
+
+    // Wall A runs along x and leans toward sy·y; wall B runs along y and leans toward sx·x.
+    // For yaw = 90° the left normal is -x, hence the sign flip on B's tilt.
+    TiltedWall wall{.centre = Vec2(0, 0), .length = p.wall_length, .thickness = p.wall_thickness,
+                    .height = h, .yaw = 0.0, .tilt = sy * alpha};
+    m.append(tilted_wall_mesh(wall));
+    wall.yaw = pi / 2;
+    wall.tilt = -sx * alpha;
+    m.append(tilted_wall_mesh(wall));
+
+    w.walkable = Polygon2::rectangle(-a, -a, a, a);
+    const double o = p.start_offset;
+    w.start.points = {Vec2(o, o), Vec2(-o, o), Vec2(-o, -o), Vec2(o, -o)};
+    return w;
+}
+
+World::World(WorldDescription description)
+    : desc_(std::move(description)), caster_(std::make_shared<RayCaster>(desc_.mesh)) {}
+
+}  // namespace bvc3d

@@ -1,0 +1,56 @@
+#pragma once
+// World stage: the static 3-D geometry the robot moves through and its sensors see.
+// Takes: a WorldDescription (triangles + floor regions), built in code, from YAML or meshes.
+// Gives: ray casts (RayCaster, through Embree) and the geometry for body collision.
+#include <memory>
+#include <string>
+
+#include "bvc3d/world/mesh.hpp"
+
+namespace bvc3d {
+
+class RayCaster;
+
+// Where a walk may start: one of `points` (uniformly), or else a uniform point of `region`.
+struct StartRegion {
+    std::vector<Vec2> points;
+    Polygon2 region;
+};
+
+struct WorldDescription {
+    std::string name;
+    TriangleMesh mesh;
+    Polygon2 walkable;  // the robot's body stays inside this floor polygon
+    StartRegion start;
+};
+
+// The paper's arena (SPEC §2.1).
+struct CrossArenaParams {
+    double tilt_deg = 0.0;
+    std::string lean = "+x+y";  // the corner the central walls lean toward
+    double half_width = 5.0;
+    double height = 2.5;
+    double wall_length = 7.0;
+    double wall_thickness = 0.3;
+    double start_offset = 4.0;  // start corners at (±offset, ±offset)
+};
+
+// Checks the parameters (throws InputError naming the parameter) and builds the arena.
+WorldDescription cross_arena(const CrossArenaParams& p);
+
+class World {
+public:
+    explicit World(WorldDescription description);
+    static World cross(const CrossArenaParams& p = {}) { return World(cross_arena(p)); }
+
+    const WorldDescription& description() const { return desc_; }
+    const std::string& name() const { return desc_.name; }
+    const TriangleMesh& mesh() const { return desc_.mesh; }
+    const RayCaster& rays() const { return *caster_; }
+
+private:
+    WorldDescription desc_;
+    std::shared_ptr<const RayCaster> caster_;  // immutable after construction: shared by copies
+};
+
+}  // namespace bvc3d

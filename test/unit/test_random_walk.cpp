@@ -1,0 +1,239 @@
+// The robot's random walk (SPEC §4): stays in the arena, never overlaps a wall, turns as specified,
+// covers the floor, and is deterministic by seed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "bvc3d/core/angles.hpp"
+#include "bvc3d/robot/random_walk.hpp"
+
+using namespace bvc3d;
+
+namespace {
+
+constexpr double R = 0.25;
+
+// Independent oracle: the central walls' footprints over the body's height z in [0, 0.1] are the
+// rectangles |x| <= 3.5, y in [-h, h + 0.1·tan a] (wall A, leaning +y) and the same with x, y swapped.
+double distance_to_rect(double x, double y, double x0, double x1, double y0, double y1) {
+    const double dx = std::max({x0 - x, 0.0, x - x1});
+    const double dy = std::max({y0 - y, 0.0, y - y1});
+    return std::hypot(dx, dy);
+}
+
+// Distance from the body's centre to the nearest geometry minus the radius (negative: overlap).
+double oracle_clearance(double x, double y, double tilt_deg) {
+    const double a = deg_to_rad(tilt_deg), h = 0.15 / std::cos(a), reach = h + 0.1 * std::tan(a);
+    double d = std::min({5 - x, 5 + x, 5 - y, 5 + y});
+    d = std::min(d, distance_to_rect(x, y, -3.5, 3.5, -h, reach));
+    d = std::min(d, distance_to_rect(x, y, -h, reach, -3.5, 3.5));
+    return d - R;
+}
+
+double normal_cdf(double x, double sd) { return 0.5 * std::erfc(-x / (sd * std::sqrt(2.0))); }
+
+// Kolmogorov-Smirnov statistic of a sample against a continuous CDF.
+template <class Cdf>
+double ks_statistic(std::vector<double> xs, Cdf cdf) {
+    std::sort(xs.begin(), xs.end());
+    const double n = static_cast<double>(xs.size());
+    double d = 0;
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+        const double f = cdf(xs[i]);
+        d = std::max({d, (i + 1) / n - f, f - i / n});
+    }
+    return d;
+}
+double ks_critical_1pct(std::size_t n) { return 1.628 / std::sqrt(static_cast<double>(n)); }
+
+class PaperWorldWalk : public ::testing::TestWithParam<double> {};
+
+}  // namespace
+
+TEST_P(PaperWorldWalk, TwentyFourHoursNeverLeaveNorOverlap) {
+    const double tilt = GetParam();
+    const World world = World::cross({.tilt_deg = tilt});
+    const auto steps = random_walk(world, 24.0, 11);
+    ASSERT_GT(steps.size(), 200000u);
+    double worst = INFINITY;
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        const auto& s = steps[i];
+        ASSERT_LE(std::max(std::abs(s.x), std::abs(s.y)), 5.0 - R + 1e-9) << "left the arena at step " << i;
+        worst = std::min(worst, oracle_clearance(s.x, s.y, tilt));
+        // Along the straight path from the previous step (a step moves at most 0.144 m).
+        if (i > 0 && steps[i - 1].heading == s.heading)
+            for (int k = 1; k < 15; ++k) {
+                const double f = k / 15.0;
+                worst = std::min(worst, oracle_clearance(steps[i - 1].x + f * (s.x - steps[i - 1].x),
+                                                         steps[i - 1].y + f * (s.y - steps[i - 1].y), tilt));
+            }
+    }
+    EXPECT_GE(worst, -1e-3) << "the body overlapped a wall by " << -worst << " m";
+    EXPECT_LT(worst, 1e-6) << "bumps should bring the body into contact";
+    EXPECT_NEAR(steps.back().t, 24 * 3600.0, 1.0);
+}
+
+TEST_P(PaperWorldWalk, FourHoursCoverEveryReachableHalfMetreCell) {
+    const double tilt = GetParam();
+    const World world = World::cross({.tilt_deg = tilt});
+    const auto steps = random_walk(world, 4.0, 5);
+    // 30-50 thousand samples per 4-hour phase (SPEC §7).
+    EXPECT_GT(steps.size(), 30000u);
+    EXPECT_LT(steps.size(), 50000u);
+    std::set<std::pair<int, int>> visited;
+    for (const auto& s : steps) visited.insert({static_cast<int>(std::floor(s.x / 0.5)), static_cast<int>(std::floor(s.y / 0.5))});
+    // A cell is reachable if the body fits somewhere in it with 2 cm to spare (a sliver thinner than
+    // that is visited only by grazing contacts, which a finite walk need not make).
+    int reachable = 0;
+    for (int cx = -10; cx < 10; ++cx)
+        for (int cy = -10; cy < 10; ++cy) {
+            bool fits = false;
+            for (int i = 0; i <= 50 && !fits; ++i)
+                for (int j = 0; j <= 50 && !fits; ++j)
+                    fits = oracle_clearance(0.5 * cx + 0.01 * i, 0.5 * cy + 0.01 * j, tilt) >= 0.02;
+            if (!fits) continue;
+            ++reachable;
+            EXPECT_TRUE(visited.count({cx, cy})) << "cell [" << 0.5 * cx << ", " << 0.5 * cy << "] never visited";
+        }
+    EXPECT_GT(reachable, 300);
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperTilts, PaperWorldWalk, ::testing::Values(0.0, 30.0, 45.0, 60.0));
+
+TEST(RandomWalk, TurnsFollowTheirDistributions) {
+    const World world = World::cross({.tilt_deg = 45});
+    auto body = std::make_shared<const BodyCollider>(world.description(), R, 0.1);
+    Rng rng(2024, Stream::walk);
+    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    RandomWalk walk(body, RobotParams{}, rng, start);
+    std::vector<TurnEvent> log;
+    walk.log_turns(&log);
+    std::vector<WalkStep> steps;
+    while (auto s = walk.next(8 * 3600.0)) steps.push_back(*s);
+
+    // Realised turns after tau_w uninterrupted steps, read off the trajectory: N(0, (pi/6)^2).
+    std::vector<double> gaussian_turns;
+    for (std::size_t i = 0; i + 1 < steps.size(); ++i)
+        if (!steps[i].bumped && steps[i + 1].heading != steps[i].heading)
+            gaussian_turns.push_back(wrap_pi(steps[i + 1].heading - steps[i].heading));
+    ASSERT_GT(gaussian_turns.size(), 5000u);
+    const double d_gauss = ks_statistic(gaussian_turns, [](double x) { return normal_cdf(x, pi / 6); });
+    EXPECT_LT(d_gauss, ks_critical_1pct(gaussian_turns.size()));
+
+    // Headings drawn after bumps (including redraws when blocked at once): uniform on [-pi, pi).
+    std::vector<double> bump_headings;
+    for (const auto& e : log)
+        if (e.kind == TurnEvent::Kind::bump) bump_headings.push_back(e.drawn);
+    ASSERT_GT(bump_headings.size(), 1000u);
+    const double d_unif = ks_statistic(bump_headings, [](double x) { return (x + pi) / two_pi; });
+    EXPECT_LT(d_unif, ks_critical_1pct(bump_headings.size()));
+    // ... and a bumped step is followed by the heading the last bump drew.
+    std::size_t checked = 0;
+    for (std::size_t i = 0; i + 1 < steps.size(); ++i)
+        if (steps[i].bumped) ++checked;
+    EXPECT_GT(checked, 1000u);
+}
+
+TEST(RandomWalk, SimulatedTimeCountsMotionAndTurns) {
+    const World world = World::cross({.tilt_deg = 30});
+    const auto steps = random_walk(world, 2.0, 3);
+    RobotParams p;
+    std::size_t turned = 0, mismatched = 0;
+    int since_turn = 0;  // uninterrupted model steps since the last turn or bump
+    for (std::size_t i = 0; i + 1 < steps.size(); ++i) {
+        const auto &a = steps[i], &b = steps[i + 1];
+        since_turn = a.bumped ? 0 : since_turn + 1;
+        if (a.bumped || b.bumped) continue;
+        const bool turn = a.heading != b.heading;
+        const double expect = p.model_dt + std::abs(wrap_pi(b.heading - a.heading)) / p.turn_rate;
+        // A turn comes exactly after n_walk uninterrupted steps, and its duration is |angle| / 2.1 rad/s.
+        // (A turn that runs into a wall at once adds an unrecorded bump in between: rare.)
+        if (std::abs((b.t - a.t) - expect) > 1e-9 || turn != (since_turn == p.n_walk)) {
+            ++mismatched;
+        } else {
+            turned += turn;
+            EXPECT_NEAR(std::hypot(b.x - a.x, b.y - a.y), 0.144, 1e-12);
+        }
+        if (turn) since_turn = 0;
+    }
+    EXPECT_LT(mismatched, steps.size() / 500);
+    EXPECT_GT(turned, 1000u);
+    // A step cut short by a bump takes the time of the distance it moved.
+    std::size_t bumps = 0;
+    for (std::size_t i = 0; i + 1 < steps.size(); ++i) {
+        const auto &a = steps[i], &b = steps[i + 1];
+        if (!b.bumped || a.bumped || a.heading != b.heading) continue;
+        ++bumps;
+        const double moved = std::hypot(b.x - a.x, b.y - a.y);
+        EXPECT_GT(moved, 1e-3);
+        EXPECT_LT(moved, 0.144);
+        EXPECT_NEAR(b.t - a.t, moved / p.speed, 1e-9);
+    }
+    EXPECT_GT(bumps, 100u);
+}
+
+TEST(RandomWalk, StartsAtARandomCornerWithARandomHeading) {
+    const World world = World::cross();
+    std::set<std::pair<int, int>> corners;
+    for (std::uint64_t seed = 0; seed < 40; ++seed) {
+        const auto s = random_walk(world, 0.001, seed);
+        ASSERT_FALSE(s.empty());
+        corners.insert({s[0].x > 0 ? 1 : -1, s[0].y > 0 ? 1 : -1});
+        EXPECT_LT(std::hypot(std::abs(s[0].x) - 4.0, std::abs(s[0].y) - 4.0), 0.15);
+    }
+    EXPECT_EQ(corners.size(), 4u);
+}
+
+TEST(RandomWalk, SameSeedSameTrajectoryDifferentSeedDifferent) {
+    const World world = World::cross({.tilt_deg = 60});
+    const auto a = random_walk(world, 0.5, 42), b = random_walk(world, 0.5, 42), c = random_walk(world, 0.5, 43);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        ASSERT_EQ(a[i].t, b[i].t);
+        ASSERT_EQ(a[i].x, b[i].x);
+        ASSERT_EQ(a[i].y, b[i].y);
+        ASSERT_EQ(a[i].heading, b[i].heading);
+        ASSERT_EQ(a[i].bumped, b[i].bumped);
+    }
+    EXPECT_TRUE(a.size() != c.size() || a[5].x != c[5].x);
+}
+
+TEST(RandomWalk, ResumesExactlyFromItsState) {
+    const World world = World::cross({.tilt_deg = 45});
+    auto body = std::make_shared<const BodyCollider>(world.description(), R, 0.1);
+    Rng rng(9, Stream::walk);
+    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    RandomWalk full(body, RobotParams{}, rng, start), part(body, RobotParams{}, rng, start);
+    std::vector<WalkStep> a, b;
+    while (auto s = full.next(1800)) a.push_back(*s);
+    while (auto s = part.next(900)) b.push_back(*s);
+    const WalkState saved = part.state();
+    RandomWalk resumed(body, RobotParams{}, Rng(0, Stream::walk), Pose{});
+    resumed.restore(saved);
+    while (auto s = resumed.next(1800)) b.push_back(*s);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i].x, b[i].x) << i;
+}
+
+TEST(BodyCollider, ExactContactDistances) {
+    WorldDescription w;
+    w.name = "post";
+    w.mesh = box_mesh(Vec3(1.0, 1.0, 2.0));  // a 1 m post from z = -1 to 1, so 0 < z <= 0.1 is inside it
+    w.walkable = Polygon2::rectangle(-5, -5, 5, 5);
+    const BodyCollider body(w, R, 0.1);
+    // Head-on into the face x = -0.5 from x = -2: contact when the centre reaches -0.75.
+    EXPECT_NEAR(body.free_distance(Vec2(-2, 0), Vec2(1, 0), 5.0), 1.25, 1e-12);
+    // Grazing the corner (-0.5, 0.5) from y = 0.6: contact where |c - corner| = R.
+    const double dy = 0.1;
+    EXPECT_NEAR(body.free_distance(Vec2(-2, 0.5 + dy), Vec2(1, 0), 5.0), 1.5 - std::sqrt(R * R - dy * dy), 1e-12);
+    // Passing clear of it, and the walkable boundary stopping the body.
+    EXPECT_NEAR(body.free_distance(Vec2(-2, 0.8), Vec2(1, 0), 10.0), 7.0 - R, 1e-12);
+    EXPECT_NEAR(body.clearance(Vec2(-2, 0)), 1.5 - R, 1e-12);
+    EXPECT_TRUE(body.is_free(Vec2(-2, 0)));
+    EXPECT_FALSE(body.is_free(Vec2(-0.6, 0)));
+    // Touching and moving into the contact: blocked; moving away: free.
+    EXPECT_EQ(body.free_distance(Vec2(-0.75 + 1e-12, 0), Vec2(1, 0), 1.0), 0.0);
+    EXPECT_EQ(body.free_distance(Vec2(-0.75 + 1e-12, 0), Vec2(-1, 0), 1.0), 1.0);
+}
