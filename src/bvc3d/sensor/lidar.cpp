@@ -48,8 +48,11 @@ Lidar::Lidar(LidarSpec spec) : spec_(std::move(spec)) {
         cos_el_.push_back(std::cos(e));
         sin_el_.push_back(std::sin(e));
     }
-    for (int j = 0; j < spec_.azimuth_count; ++j)
+    for (int j = 0; j < spec_.azimuth_count; ++j) {
         column_azimuth_.push_back(spec_.azimuth_offset + j * two_pi / spec_.azimuth_count);
+        column_cos_.push_back(std::cos(column_azimuth_.back()));
+        column_sin_.push_back(std::sin(column_azimuth_.back()));
+    }
 }
 
 void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise,
@@ -60,14 +63,21 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
     const Vec3 origin(pose.x, pose.y, spec_.height);
     const bool noisy = spec_.range_noise_sd > 0 || spec_.dropout > 0;
 
+    // Allocentric azimuths (exact, SPEC §1) and the horizontal unit vectors of the columns: the
+    // robot-frame table rotated by the heading, which saves a sin and cos per beam.
     azimuths_.resize(n_cols);
-    for (std::size_t j = 0; j < n_cols; ++j) azimuths_[j] = wrap_pi(pose.heading + column_azimuth_[j]);
+    horizontal_.resize(n_cols);
+    const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);
+    for (std::size_t j = 0; j < n_cols; ++j) {
+        azimuths_[j] = wrap_pi(pose.heading + column_azimuth_[j]);
+        horizontal_[j] = Vec2(ch * column_cos_[j] - sh * column_sin_[j], sh * column_cos_[j] + ch * column_sin_[j]);
+    }
+    dirs_.resize(n_cols);
+    ranges_.resize(n_cols);
     for (std::size_t i = 0; i < n_rows; ++i) {
         if (!rows.empty() && !rows[i]) continue;
-        dirs_.resize(n_cols);
-        ranges_.resize(n_cols);
         for (std::size_t j = 0; j < n_cols; ++j)
-            dirs_[j] = Vec3(cos_el_[i] * std::cos(azimuths_[j]), cos_el_[i] * std::sin(azimuths_[j]), sin_el_[i]);
+            dirs_[j] = Vec3(cos_el_[i] * horizontal_[j].x(), cos_el_[i] * horizontal_[j].y(), sin_el_[i]);
         world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
         for (std::size_t j = 0; j < n_cols; ++j) {
             double r = ranges_[j];

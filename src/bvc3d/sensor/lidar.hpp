@@ -67,8 +67,10 @@ public:
 
 private:
     LidarSpec spec_;
-    std::vector<double> cos_el_, sin_el_, column_azimuth_;
-    mutable std::vector<Vec3> dirs_;  // scratch
+    std::vector<double> cos_el_, sin_el_, column_azimuth_, column_cos_, column_sin_;
+    // Scratch space reused between scans: a Lidar is not shared between threads.
+    mutable std::vector<Vec3> dirs_;
+    mutable std::vector<Vec2> horizontal_;
     mutable std::vector<double> ranges_, azimuths_;
 };
 

@@ -13,6 +13,7 @@ namespace bvc3d {
 struct RayCaster::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
+    int packet = 4;  // widest ray packet the CPU runs natively: 4, 8 or 16
 };
 
 namespace {
@@ -54,6 +55,8 @@ RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(new Impl) {
     rtcReleaseGeometry(geom);
     rtcCommitScene(impl_->scene);
     check_device(impl_->device, "scene build");
+    if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) impl_->packet = 16;
+    else if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) impl_->packet = 8;
 
     plane_point_.reserve(mesh.size());
     plane_normal_.reserve(mesh.size());
@@ -84,35 +87,66 @@ double RayCaster::cast(const Vec3& origin, const Vec3& dir, double max_range) co
     return r;
 }
 
+namespace {
+
+// One packet of up to N rays from a common origin, through rtcIntersect{4,8,16}.
+template <int N, class RayHitN, class Intersect>
+void cast_packet(RTCScene scene, RTCIntersectContext* ctx, Intersect intersect, const Vec3& origin,
+                 const Vec3* dirs, std::size_t count, float tfar, unsigned* prim, float* t) {
+    alignas(64) RayHitN rh;
+    alignas(64) int valid[N];
+    for (int k = 0; k < N; ++k) {
+        const bool on = static_cast<std::size_t>(k) < count;
+        valid[k] = on ? -1 : 0;
+        const Vec3& d = dirs[on ? k : 0];
+        rh.ray.org_x[k] = static_cast<float>(origin.x());
+        rh.ray.org_y[k] = static_cast<float>(origin.y());
+        rh.ray.org_z[k] = static_cast<float>(origin.z());
+        rh.ray.dir_x[k] = static_cast<float>(d.x());
+        rh.ray.dir_y[k] = static_cast<float>(d.y());
+        rh.ray.dir_z[k] = static_cast<float>(d.z());
+        rh.ray.tnear[k] = 0.0f;
+        rh.ray.tfar[k] = tfar;
+        rh.ray.time[k] = 0.0f;
+        rh.ray.mask[k] = 0xFFFFFFFFu;
+        rh.ray.id[k] = static_cast<unsigned>(k);
+        rh.ray.flags[k] = 0;
+        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    intersect(valid, scene, ctx, &rh);
+    for (std::size_t k = 0; k < count; ++k) {
+        prim[k] = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : rh.hit.primID[k];
+        t[k] = rh.ray.tfar[k];
+    }
+}
+
+}  // namespace
+
 void RayCaster::cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range,
                      std::span<double> ranges) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // every ray shares the origin
     // Embree's far limit is float: widen it by a hair so the exact double test below decides.
     const float tfar = static_cast<float>(max_range) * (1.0f + 1e-6f);
-    for (std::size_t i = 0; i < dirs.size(); ++i) {
-        RTCRayHit rh;
-        rh.ray.org_x = static_cast<float>(origin.x());
-        rh.ray.org_y = static_cast<float>(origin.y());
-        rh.ray.org_z = static_cast<float>(origin.z());
-        rh.ray.dir_x = static_cast<float>(dirs[i].x());
-        rh.ray.dir_y = static_cast<float>(dirs[i].y());
-        rh.ray.dir_z = static_cast<float>(dirs[i].z());
-        rh.ray.tnear = 0.0f;
-        rh.ray.tfar = tfar;
-        rh.ray.time = 0.0f;
-        rh.ray.mask = 0xFFFFFFFFu;
-        rh.ray.id = 0;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(impl_->scene, &ctx, &rh);
-        double r = no_hit;
-        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-            r = refine(rh.hit.primID, origin, dirs[i], rh.ray.tfar);
-            if (r > max_range) r = no_hit;
+    unsigned prim[16];
+    float t[16];
+    for (std::size_t i = 0; i < dirs.size(); i += impl_->packet) {
+        const std::size_t n = std::min<std::size_t>(impl_->packet, dirs.size() - i);
+        switch (impl_->packet) {
+            case 16: cast_packet<16, RTCRayHit16>(impl_->scene, &ctx, rtcIntersect16, origin, &dirs[i], n, tfar, prim, t); break;
+            case 8: cast_packet<8, RTCRayHit8>(impl_->scene, &ctx, rtcIntersect8, origin, &dirs[i], n, tfar, prim, t); break;
+            default: cast_packet<4, RTCRayHit4>(impl_->scene, &ctx, rtcIntersect4, origin, &dirs[i], n, tfar, prim, t); break;
         }
-        ranges[i] = r;
+        for (std::size_t k = 0; k < n; ++k) {
+            double r = no_hit;
+            if (prim[k] != RTC_INVALID_GEOMETRY_ID) {
+                r = refine(prim[k], origin, dirs[i + k], t[k]);
+                if (r > max_range) r = no_hit;
+            }
+            ranges[i + k] = r;
+        }
     }
 }
 
