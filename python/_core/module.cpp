@@ -8,5 +8,6 @@ PYBIND11_MODULE(_core, m) {
     m.doc() = "bvc3d compiled core (use the `bvc3d` package)";
     pybind11::register_exception<bvc3d::InputError>(m, "InputError", PyExc_ValueError);
     bvc3d::py::bind_simulator(m);
+    bvc3d::py::bind_model(m);
     bvc3d::py::bind_analysis(m);
 }

@@ -4,7 +4,9 @@ The compiled core does the work; this package re-exports it with numpy in and nu
 Stages follow the data flow: World -> Sensor scan -> BoundaryVectorLayer -> PlaceCellNetwork
 -> recorded samples -> bvc3d.analysis -> bvc3d.report.
 """
-from ._core import InputError, Sensor, World, random_walk
+from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Sensor, World, model_presets, model_sensor,
+                    random_walk)
 
-__all__ = ["InputError", "Sensor", "World", "random_walk"]
+__all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Sensor", "World", "model_presets",
+           "model_sensor", "random_walk"]
 __version__ = "0.1.0"

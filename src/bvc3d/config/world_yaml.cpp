@@ -205,8 +205,11 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
 }
 
 LidarSpec sensor_from_yaml(const YamlView& v) {
-    v.expect_map({"preset", "name", "elevations_deg", "keep_rows", "azimuth_count", "azimuth_offset_deg", "height",
-                  "max_range", "range_noise_sd", "dropout"});
+    v.expect_map({"preset", "name", "elevations", "elevations_deg", "keep_rows", "azimuth_count", "azimuth_offset",
+                  "azimuth_offset_deg", "height", "max_range", "range_noise_sd", "dropout"});
+    if (v.has("elevations") && v.has("elevations_deg")) v.fail("give 'elevations' (rad) or 'elevations_deg', not both");
+    if (v.has("azimuth_offset") && v.has("azimuth_offset_deg"))
+        v.fail("give 'azimuth_offset' (rad) or 'azimuth_offset_deg', not both");
     const std::string preset = v.get("preset", "");
     LidarSpec s;
     if (preset == "horizontal") {
@@ -218,22 +221,25 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
         s = LidarSpec::spherical(rows == "upper");
     } else if (!preset.empty()) {
         v["preset"].fail("unknown sensor preset '" + preset + "' (expected horizontal or spherical)");
-    } else if (!v.has("elevations_deg")) {
+    } else if (!v.has("elevations_deg") && !v.has("elevations")) {
         v.fail("a custom sensor needs 'elevations_deg' (or a 'preset')");
     }
     s.name = v.get("name", preset.empty() ? std::string("custom") : preset);
-    if (v.has("elevations_deg")) {
-        if (v.has("keep_rows")) v.fail_key("keep_rows", "cannot be combined with elevations_deg");
-        const auto e = v["elevations_deg"].as_doubles();
-        if (e.empty()) v["elevations_deg"].fail("must list at least one elevation");
+    for (const char* key : {"elevations_deg", "elevations"}) {
+        if (!v.has(key)) continue;
+        if (v.has("keep_rows")) v.fail_key("keep_rows", std::string("cannot be combined with ") + key);
+        const bool degrees = std::string(key) == "elevations_deg";
+        const auto e = v[key].as_doubles();
+        if (e.empty()) v[key].fail("must list at least one elevation");
         s.elevations.clear();
         for (double d : e) {
-            if (std::abs(d) > 90) v["elevations_deg"].fail("elevations must lie in [-90, 90] degrees");
-            s.elevations.push_back(deg_to_rad(d));
+            if (std::abs(degrees ? d : rad_to_deg(d)) > 90) v[key].fail("elevations must lie within ±90°");
+            s.elevations.push_back(degrees ? deg_to_rad(d) : d);
         }
     }
     s.azimuth_count = v.get("azimuth_count", s.azimuth_count);
-    s.azimuth_offset = deg_to_rad(v.get("azimuth_offset_deg", rad_to_deg(s.azimuth_offset)));
+    if (v.has("azimuth_offset_deg")) s.azimuth_offset = deg_to_rad(v["azimuth_offset_deg"].as_double());
+    s.azimuth_offset = v.get("azimuth_offset", s.azimuth_offset);
     s.height = v.get("height", s.height);
     s.max_range = v.get("max_range", s.max_range);
     s.range_noise_sd = v.get("range_noise_sd", s.range_noise_sd);

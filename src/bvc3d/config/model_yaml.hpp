@@ -1,0 +1,16 @@
+#pragma once
+// YAML <-> models (sensor + BVC layer + place cells). Schema in docs/model.md.
+#include <string>
+
+#include "bvc3d/config/yaml_reader.hpp"
+#include "bvc3d/experiment/model_spec.hpp"
+
+namespace bvc3d::config {
+
+ModelSpec model_from_yaml(const YamlView& v);
+// A preset name or a model YAML file.
+ModelSpec resolve_model(const std::string& name_or_file);
+// The YAML text that model_from_yaml reads back to the same model (stored in trial files).
+std::string model_to_yaml(const ModelSpec& m);
+
+}  // namespace bvc3d::config

@@ -1,0 +1,116 @@
+#include "bvc3d/place/place_cell_network.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/random.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+// Σ a[i]·b[i] over n (a multiple of 8) in a fixed order: 8 running lanes, then a fixed tree.
+float dot8(const float* a, const float* b, std::size_t n) {
+    float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (std::size_t i = 0; i < n; i += 8)
+        for (int t = 0; t < 8; ++t) acc[t] += a[i + t] * b[i + t];
+    return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+}
+
+float sum8(const float* a, std::size_t n) {
+    float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (std::size_t i = 0; i < n; i += 8)
+        for (int t = 0; t < 8; ++t) acc[t] += a[i + t];
+    return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+}
+
+}  // namespace
+
+void PlaceParams::validate() const {
+    auto fail = [](const std::string& what) { throw InputError("place cells: " + what); };
+    if (n_place < 1) fail("n_place must be >= 1");
+    if (!(p_connect >= 0 && p_connect <= 1)) fail("p_connect must be in [0, 1]");
+    if (!(std::isfinite(dt_over_tau) && dt_over_tau > 0 && dt_over_tau <= 1)) fail("dt_over_tau must be in (0, 1]");
+    if (!(std::isfinite(gamma_pb) && std::isfinite(gamma_pp))) fail("gamma_pb and gamma_pp must be finite");
+    if (!(std::isfinite(gain) && gain > 0)) fail("gain must be > 0");
+    if (!(std::isfinite(eta) && eta >= 0)) fail("eta must be >= 0");
+    if (!(std::isfinite(alpha_pb) && alpha_pb > 0)) fail("alpha_pb must be > 0");
+}
+
+PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::uint64_t seed)
+    : n_bvc_(n_bvc), p_(params) {
+    p_.validate();
+    if (n_bvc < 1) throw InputError("place cells: need at least one BVC input");
+    stride_ = (static_cast<std::size_t>(n_bvc) + 7) / 8 * 8;
+    w_.assign(static_cast<std::size_t>(p_.n_place) * stride_, 0.0f);
+    Rng rng(seed, Stream::weights);
+    for (int i = 0; i < p_.n_place; ++i)
+        for (int j = 0; j < n_bvc; ++j) row(i)[j] = rng.bernoulli(p_.p_connect) ? 1.0f : 0.0f;
+    s_.assign(p_.n_place, 0.0f);
+    v_.assign(p_.n_place, 0.0f);
+    vb_.assign(stride_, 0.0f);
+}
+
+std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates, bool learn) {
+    if (bvc_rates.size() != static_cast<std::size_t>(n_bvc_))
+        throw InputError("place cells: expected " + std::to_string(n_bvc_) + " BVC rates, got " +
+                         std::to_string(bvc_rates.size()));
+    for (int j = 0; j < n_bvc_; ++j) {
+        if (!std::isfinite(bvc_rates[j])) throw InputError("place cells: BVC rate " + std::to_string(j) + " is not finite");
+        vb_[j] = static_cast<float>(bvc_rates[j]);
+    }
+    const float k = static_cast<float>(p_.dt_over_tau);
+    // Inhibition uses the BVC total and the place cells' previous rates.
+    const float inhibition = static_cast<float>(p_.gamma_pb) * sum8(vb_.data(), stride_) +
+                             static_cast<float>(p_.gamma_pp) * [&] {
+                                 float s = 0;
+                                 for (float v : v_) s += v;
+                                 return s;
+                             }();
+    const float gain = static_cast<float>(p_.gain);
+    for (int i = 0; i < p_.n_place; ++i) {
+        const float drive = dot8(row(i), vb_.data(), stride_);
+        s_[i] = s_[i] + k * (-s_[i] + drive - inhibition);
+        v_[i] = std::tanh(gain * std::max(s_[i], 0.0f));
+    }
+    if (learn && p_.eta > 0) {
+        // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
+        const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
+        for (int i = 0; i < p_.n_place; ++i) {
+            const float vi = v_[i];
+            if (vi == 0.0f) continue;
+            const float a = eta * vi, c = vi * inv_alpha;
+            float* w = row(i);
+            for (int j = 0; j < n_bvc_; ++j) w[j] = w[j] + a * (vb_[j] - c * w[j]);
+        }
+    }
+    return v_;
+}
+
+std::vector<float> PlaceCellNetwork::weights() const {
+    std::vector<float> out(static_cast<std::size_t>(p_.n_place) * n_bvc_);
+    for (int i = 0; i < p_.n_place; ++i) std::copy(row(i), row(i) + n_bvc_, out.data() + static_cast<std::size_t>(i) * n_bvc_);
+    return out;
+}
+
+void PlaceCellNetwork::set_weights(std::span<const float> w) {
+    if (w.size() != static_cast<std::size_t>(p_.n_place) * n_bvc_)
+        throw InputError("place cells: weights must be " + std::to_string(p_.n_place) + " x " + std::to_string(n_bvc_));
+    for (float x : w)
+        if (!std::isfinite(x)) throw InputError("place cells: weights must be finite");
+    for (int i = 0; i < p_.n_place; ++i) std::copy(w.data() + static_cast<std::size_t>(i) * n_bvc_, w.data() + static_cast<std::size_t>(i + 1) * n_bvc_, row(i));
+}
+
+void PlaceCellNetwork::reset() {
+    std::fill(s_.begin(), s_.end(), 0.0f);
+    std::fill(v_.begin(), v_.end(), 0.0f);
+}
+
+void PlaceCellNetwork::set_state(std::span<const float> membrane, std::span<const float> rates) {
+    if (membrane.size() != s_.size() || rates.size() != v_.size()) throw InputError("place cells: state has the wrong size");
+    std::copy(membrane.begin(), membrane.end(), s_.begin());
+    std::copy(rates.begin(), rates.end(), v_.begin());
+}
+
+}  // namespace bvc3d

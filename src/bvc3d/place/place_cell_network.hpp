@@ -1,0 +1,58 @@
+#pragma once
+// Place-cell stage (SPEC §6): a rate network driven by BVCs, learning with Oja's rule.
+// Takes: BVC rates, one vector per model step. Gives: place-cell rates.
+//
+// Single precision (weights, membrane, rates): the recorded rates are float32 anyway, and sums run
+// in a fixed order of 8 interleaved partial sums, so results are bit-identical whatever the
+// vector width the compiler picks.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace bvc3d {
+
+struct PlaceParams {
+    int n_place = 250;
+    double p_connect = 0.25;    // initial weights are Bernoulli(p_connect)
+    double dt_over_tau = 0.5;   // Δt/τ_p
+    double gamma_pb = 0.3;      // feedforward inhibition
+    double gamma_pp = 0.5;      // recurrent inhibition
+    double gain = 1.0;          // g in v = tanh(g·[s]+)
+    double eta = 0.096;         // learning rate Δt/τ_W
+    double alpha_pb = 0.70710678118654752;  // √0.5
+    void validate() const;
+};
+
+class PlaceCellNetwork {
+public:
+    // Initial weights drawn from the trial's `weights` stream (bvc3d::Stream::weights) of `seed`.
+    PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::uint64_t seed);
+
+    int n_bvc() const { return n_bvc_; }
+    int n_place() const { return p_.n_place; }
+    const PlaceParams& params() const { return p_; }
+
+    // One Euler step of the membrane, new rates, and (if learn) one Oja update. Returns the rates.
+    std::span<const float> step(std::span<const double> bvc_rates, bool learn);
+
+    std::span<const float> rates() const { return v_; }
+    std::span<const float> membrane() const { return s_; }
+    // Row-major n_place × n_bvc weights.
+    std::vector<float> weights() const;
+    void set_weights(std::span<const float> w);
+    // Membrane and rates back to zero; weights kept.
+    void reset();
+    // Restore the dynamic state (checkpoints).
+    void set_state(std::span<const float> membrane, std::span<const float> rates);
+
+private:
+    float* row(int i) { return w_.data() + static_cast<std::size_t>(i) * stride_; }
+    const float* row(int i) const { return w_.data() + static_cast<std::size_t>(i) * stride_; }
+
+    int n_bvc_;
+    std::size_t stride_;  // n_bvc rounded up to a multiple of 8; padding stays 0
+    PlaceParams p_;
+    std::vector<float> w_, s_, v_, vb_;
+};
+
+}  // namespace bvc3d

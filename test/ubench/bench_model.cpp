@@ -1,0 +1,104 @@
+// Model stage: one model step (BVC layer + place cells, learning on) per preset on real scans,
+// beside the dense reference (every return x every cell, as a numpy implementation computes it).
+#include <benchmark/benchmark.h>
+
+#include "../support/bvc_reference.hpp"
+#include "bvc3d/experiment/model_spec.hpp"
+#include "bvc3d/robot/random_walk.hpp"
+
+using namespace bvc3d;
+
+namespace {
+
+struct Inputs {
+    ModelSpec model;
+    std::vector<Scan> scans;
+};
+
+// Scans along a real walk in the 45° arena.
+Inputs inputs(const std::string& preset) {
+    Inputs in{model_preset(preset), {}};
+    const World world = World::cross({.tilt_deg = 45});
+    const Lidar lidar(in.model.sensor);
+    const auto walk = random_walk(world, 0.05, 1);
+    for (std::size_t i = 0; i < walk.size(); i += walk.size() / 16)
+        in.scans.push_back(lidar.scan(world, Pose{walk[i].x, walk[i].y, walk[i].heading}));
+    return in;
+}
+
+void BM_ModelStep(benchmark::State& state, std::string preset) {
+    const Inputs in = inputs(preset);
+    const BoundaryVectorLayer layer(in.model.bvc);
+    PlaceCellNetwork net(in.model.bvc.n_cells(), in.model.place, 1);
+    std::vector<double> rates(layer.n_cells());
+    std::size_t i = 0;
+    for (auto _ : state) {
+        layer.rates(in.scans[i++ % in.scans.size()], rates);
+        benchmark::DoNotOptimize(net.step(rates, true).data());
+    }
+}
+
+void BM_BvcOnly(benchmark::State& state, std::string preset) {
+    const Inputs in = inputs(preset);
+    const BoundaryVectorLayer layer(in.model.bvc);
+    std::vector<double> rates(layer.n_cells());
+    std::size_t i = 0;
+    for (auto _ : state) {
+        layer.rates(in.scans[i++ % in.scans.size()], rates);
+        benchmark::DoNotOptimize(rates.data());
+    }
+}
+
+void BM_PlaceCellsOnly(benchmark::State& state) {
+    const Inputs in = inputs("3d-0.2");
+    const BoundaryVectorLayer layer(in.model.bvc);
+    PlaceCellNetwork net(in.model.bvc.n_cells(), in.model.place, 1);
+    std::vector<std::vector<double>> rates(in.scans.size(), std::vector<double>(layer.n_cells()));
+    for (std::size_t k = 0; k < in.scans.size(); ++k) layer.rates(in.scans[k], rates[k]);
+    std::size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(net.step(rates[i++ % rates.size()], state.range(0) != 0).data());
+}
+
+// The dense baseline: the literal equations for the BVCs, a double-precision matrix-vector
+// product and rank-1 update for the place cells.
+void BM_DenseReferenceStep(benchmark::State& state, std::string preset) {
+    const Inputs in = inputs(preset);
+    const int nb = in.model.bvc.n_cells(), np = in.model.place.n_place;
+    std::vector<double> W(static_cast<std::size_t>(np) * nb, 0.25), s(np, 0.0), v(np, 0.0);
+    const auto& p = in.model.place;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        const auto vb = reference::bvc_rates(in.model.bvc, in.scans[i++ % in.scans.size()]);
+        double sum_b = 0, sum_p = 0;
+        for (double x : vb) sum_b += x;
+        for (double x : v) sum_p += x;
+        for (int a = 0; a < np; ++a) {
+            double drive = 0;
+            for (int b = 0; b < nb; ++b) drive += W[static_cast<std::size_t>(a) * nb + b] * vb[b];
+            s[a] += p.dt_over_tau * (-s[a] + drive - p.gamma_pb * sum_b - p.gamma_pp * sum_p);
+        }
+        for (int a = 0; a < np; ++a) v[a] = std::tanh(p.gain * std::max(s[a], 0.0));
+        for (int a = 0; a < np; ++a)
+            for (int b = 0; b < nb; ++b) {
+                double& w = W[static_cast<std::size_t>(a) * nb + b];
+                w += p.eta * v[a] * (vb[b] - v[a] * w / p.alpha_pb);
+            }
+        benchmark::DoNotOptimize(v.data());
+    }
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_ModelStep, 2d, std::string("2d"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_1, std::string("3d-0.1"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_2, std::string("3d-0.2"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ModelStep, 3d_3l, std::string("3d-3l"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ModelStep, 2d_8beam, std::string("2d-8beam"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_BvcOnly, 2d, std::string("2d"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_BvcOnly, 3d_3l, std::string("3d-3l"))->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PlaceCellsOnly)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_DenseReferenceStep, 2d, std::string("2d"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DenseReferenceStep, 3d_0_1, std::string("3d-0.1"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DenseReferenceStep, 3d_0_2, std::string("3d-0.2"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DenseReferenceStep, 3d_3l, std::string("3d-3l"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DenseReferenceStep, 2d_8beam, std::string("2d-8beam"))->Unit(benchmark::kMillisecond);

@@ -1,0 +1,247 @@
+// Boundary vector cells (SPEC §5) against the literal equations.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "../support/bvc_reference.hpp"
+#include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/experiment/model_spec.hpp"
+#include "bvc3d/robot/random_walk.hpp"
+
+using namespace bvc3d;
+
+namespace {
+
+// |fast - reference| <= 1e-6 of the step's largest reference rate, for every cell (SPEC §5).
+void expect_matches_reference(const BvcParams& p, const Scan& returns, const std::string& what) {
+    const BoundaryVectorLayer layer(p);
+    std::vector<double> fast(layer.n_cells());
+    layer.rates(returns, fast);
+    const auto ref = reference::bvc_rates(p, returns);
+    ASSERT_EQ(fast.size(), ref.size());
+    double largest = 0, worst = 0;
+    for (double v : ref) largest = std::max(largest, v);
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+        ASSERT_TRUE(std::isfinite(fast[i]));
+        worst = std::max(worst, std::abs(fast[i] - ref[i]));
+    }
+    EXPECT_LE(worst, 1e-6 * largest) << what << ": worst error " << worst << " vs largest rate " << largest;
+}
+
+Scan random_returns(std::mt19937_64& gen, int n, double phi_lo, double phi_hi) {
+    std::uniform_real_distribution<double> range(0.0, 18.0), az(-M_PI, M_PI), el(phi_lo, phi_hi);
+    Scan s;
+    for (int i = 0; i < n; ++i) s.push_back({range(gen), az(gen), el(gen)});
+    return s;
+}
+
+std::vector<BvcParams> all_configs() {
+    std::vector<BvcParams> configs;
+    for (const auto& name : model_preset_names()) configs.push_back(model_preset(name).bvc);
+    BvcParams odd;
+    odd.elevations = {-0.3, 0.0, 0.05, 0.4, 1.2};  // many layers, some below the horizon
+    odd.n_dir = 3;
+    odd.n_per_axis = 17;
+    odd.sigma_phi = 0.05;
+    configs.push_back(odd);
+    BvcParams wide;  // angular window wider than the circle; single distance cell
+    wide.n_dir = 1;
+    wide.n_per_axis = 1;
+    wide.sigma_theta = 1.57;
+    configs.push_back(wide);
+    BvcParams coarse;  // cells further apart than sigma_r: the direct (non-recurrence) path
+    coarse.elevations = {0.1};
+    coarse.n_dir = 16;
+    coarse.n_per_axis = 5;
+    coarse.sigma_r = 0.3;
+    configs.push_back(coarse);
+    return configs;
+}
+
+}  // namespace
+
+TEST(BoundaryVectorLayer, MatchesTheEquationsOnRandomReturns) {
+    std::mt19937_64 gen(7);
+    for (const auto& p : all_configs()) {
+        for (int trial = 0; trial < 3; ++trial) {
+            Scan s = random_returns(gen, 400, -0.5, 0.6);
+            // Awkward cases: azimuth exactly ±π, elevations outside every layer, range 0 and beyond max.
+            s.push_back({3.0, M_PI, 0.0});
+            s.push_back({3.0, -M_PI, 0.1});
+            s.push_back({0.0, 0.5, 0.2});
+            s.push_back({25.0, 0.0, 0.0});
+            s.push_back({4.0, 1.0, 1.5});
+            expect_matches_reference(p, s, "random returns, " + std::to_string(p.n_dir) + " dirs");
+        }
+        // Only a few returns, all at one elevation that matches no layer: sums are tiny but still exact.
+        Scan sparse = {{2.0, 0.3, 0.7}, {5.0, -2.0, 0.7}};
+        expect_matches_reference(p, sparse, "sparse returns");
+    }
+}
+
+TEST(BoundaryVectorLayer, MatchesTheEquationsOnRealScansOfEveryPaperWorld) {
+    for (double tilt : {0.0, 30.0, 45.0, 60.0}) {
+        const World world = World::cross({.tilt_deg = tilt});
+        const auto walk = random_walk(world, 0.05, 3);
+        for (const auto& name : model_preset_names()) {
+            const ModelSpec m = model_preset(name);
+            const Lidar lidar(m.sensor);
+            for (std::size_t i : {walk.size() / 3, walk.size() - 1}) {
+                const Scan scan = lidar.scan(world, Pose{walk[i].x, walk[i].y, walk[i].heading});
+                expect_matches_reference(m.bvc, scan, name + " in cross-" + std::to_string(int(tilt)));
+            }
+        }
+    }
+}
+
+TEST(BoundaryVectorLayer, PrunedScanningGivesTheSameRates) {
+    const World world = World::cross({.tilt_deg = 45});
+    for (const char* name : {"3d-0.1", "3d-0.2", "3d-3l"}) {
+        const ModelSpec m = model_preset(name);
+        const BoundaryVectorLayer layer(m.bvc);
+        const Lidar lidar(m.sensor);
+        const auto rows = layer.rows_needed(m.sensor);
+        int cast = 0;
+        for (char r : rows) cast += r;
+        EXPECT_LT(cast, 10) << name << " should need only the rows near its layers";
+        for (const Pose pose : {Pose{4, 4, 0.2}, Pose{0.7, -0.9, -1}}) {
+            Scan full, pruned;
+            lidar.scan(world, pose, full);
+            lidar.scan(world, pose, pruned, {}, rows);
+            std::vector<double> a(layer.n_cells()), b(layer.n_cells());
+            layer.rates(full, a);
+            ASSERT_TRUE(layer.rates_pruned(pruned, m.sensor.beam_count(), b));
+            const auto ref = reference::bvc_rates(m.bvc, full);
+            for (std::size_t i = 0; i < a.size(); ++i) {
+                EXPECT_NEAR(a[i], ref[i], 0.5e-6);
+                EXPECT_NEAR(b[i], ref[i], 0.5e-6);
+            }
+        }
+    }
+}
+
+TEST(BoundaryVectorLayer, CellOrderAndPreferredValues) {
+    // One return straight east at 6.1 m, elevation 0.2: the peak is layer 0.2, direction 0, d_m ≈ 6.1.
+    BvcParams p = model_preset("3d-0.2").bvc;
+    const BoundaryVectorLayer layer(p);
+    std::vector<double> v(layer.n_cells());
+    layer.rates(Scan{{6.1, 0.0, 0.2}}, v);
+    const auto peak = std::max_element(v.begin(), v.end()) - v.begin();
+    const int M = p.n_per_axis, K = p.n_dir;
+    EXPECT_EQ(peak / (K * M), 1);        // layer index of psi = 0.2
+    EXPECT_EQ((peak / M) % K, 0);        // direction east
+    EXPECT_NEAR((peak % M) * p.spacing(), 6.1, p.spacing() / 2);
+    // A return to the north-west lands in direction 3 (135°).
+    layer.rates(Scan{{3.0, 3 * M_PI / 4, 0.0}}, v);
+    const auto nw = std::max_element(v.begin(), v.end()) - v.begin();
+    EXPECT_EQ(nw / (K * M), 0);
+    EXPECT_EQ((nw / M) % K, 3);
+}
+
+TEST(BoundaryVectorLayer, ElevationFactorSelectsTheLayer) {
+    const BvcParams p = model_preset("3d-0.2").bvc;
+    const BoundaryVectorLayer layer(p);
+    std::vector<double> raw(layer.n_cells());
+    layer.raw(Scan{{4.0, 0.0, 0.2}}, raw);
+    const std::size_t per_layer = p.n_dir * p.n_per_axis;
+    const double low = *std::max_element(raw.begin(), raw.begin() + per_layer);
+    const double high = *std::max_element(raw.begin() + per_layer, raw.end());
+    EXPECT_GT(high, 0.0);
+    EXPECT_LT(low, 1e-80 * high);  // 0.2 rad = 20 sigma_phi from the 0-rad layer
+    // The 2-D model ignores elevation entirely.
+    const BoundaryVectorLayer flat(model_preset("2d").bvc);
+    std::vector<double> a(flat.n_cells()), b(flat.n_cells());
+    flat.raw(Scan{{4.0, 0.0, 0.2}}, a);
+    flat.raw(Scan{{4.0, 0.0, 0.0}}, b);
+    EXPECT_EQ(a, b);
+}
+
+TEST(BoundaryVectorLayer, NormalisationModes) {
+    const World world = World::cross({.tilt_deg = 30});
+    const ModelSpec m = model_preset("3d-3l");
+    const Scan scan = Lidar(m.sensor).scan(world, Pose{1, 1, 0});
+    const BoundaryVectorLayer layer(m.bvc);
+    std::vector<double> v(layer.n_cells()), raw(layer.n_cells());
+    layer.rates(scan, v);
+    layer.raw(scan, raw);
+    EXPECT_EQ(*std::max_element(v.begin(), v.end()), 0.5);  // exactly
+    EXPECT_GE(*std::min_element(v.begin(), v.end()), 0.0);
+    const double mx = *std::max_element(raw.begin(), raw.end());
+    for (std::size_t i = 0; i < v.size(); ++i) EXPECT_DOUBLE_EQ(v[i], raw[i] / (2 * mx));
+    // All-zero input: an empty scan, or returns beyond every window.
+    layer.rates(Scan{}, v);
+    for (double x : v) EXPECT_EQ(x, 0.0);
+    layer.rates(Scan{{100.0, 0.0, 0.0}}, v);
+    for (double x : v) EXPECT_EQ(x, 0.0);
+    // none and fixed.
+    BvcParams p = m.bvc;
+    p.normalization = BvcNormalization::none;
+    BoundaryVectorLayer(p).rates(scan, v);
+    for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], raw[i]);
+    p.normalization = BvcNormalization::fixed;
+    p.norm_constant = 40.0;
+    BoundaryVectorLayer(p).rates(scan, v);
+    for (std::size_t i = 0; i < v.size(); ++i) EXPECT_DOUBLE_EQ(v[i], raw[i] / 40.0);
+}
+
+TEST(BoundaryVectorLayer, InputHygiene) {
+    const BoundaryVectorLayer layer(model_preset("3d-0.1").bvc);
+    std::vector<double> a(layer.n_cells()), b(layer.n_cells());
+    // NaN and +inf ranges are "no return": skipped, never NaN rates.
+    layer.rates(Scan{{3.0, 0.2, 0.0}, {NAN, 0.1, 0.0}, {INFINITY, 1.0, 0.1}}, a);
+    layer.rates(Scan{{3.0, 0.2, 0.0}}, b);
+    EXPECT_EQ(a, b);
+    layer.rates(Scan{{NAN, 0.1, 0.0}}, a);
+    for (double x : a) EXPECT_EQ(x, 0.0);
+    // Negative or -inf ranges and non-finite angles are errors that name the return.
+    try {
+        layer.rates(Scan{{3.0, 0.2, 0.0}, {-1.0, 0.0, 0.0}}, a);
+        ADD_FAILURE();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("return 1: negative range"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(layer.rates(Scan{{-INFINITY, 0.0, 0.0}}, a), InputError);
+    EXPECT_THROW(layer.rates(Scan{{1.0, NAN, 0.0}}, a), InputError);
+    EXPECT_THROW(layer.rates(Scan{{1.0, 0.0, INFINITY}}, a), InputError);
+    std::vector<double> small(3);
+    EXPECT_THROW(layer.rates(Scan{}, small), InputError);
+}
+
+TEST(BoundaryVectorLayer, RejectsImpossibleParameters) {
+    auto bad = [](auto edit) {
+        BvcParams p;
+        edit(p);
+        EXPECT_THROW(BoundaryVectorLayer{p}, InputError);
+    };
+    bad([](BvcParams& p) { p.n_dir = 0; });
+    bad([](BvcParams& p) { p.n_per_axis = 0; });
+    bad([](BvcParams& p) { p.sigma_r = 0; });
+    bad([](BvcParams& p) { p.sigma_phi = -1; });
+    bad([](BvcParams& p) { p.max_dist = NAN; });
+    bad([](BvcParams& p) { p.elevations = {0.1, 3.0}; });
+    bad([](BvcParams& p) {
+        p.normalization = BvcNormalization::fixed;
+        p.norm_constant = 0;
+    });
+    bad([](BvcParams& p) {
+        p.reading = BvcReading::nearest_beam;
+        p.elevations = {0.0};
+    });
+}
+
+TEST(ModelPresets, TableOne) {
+    for (const auto& name : {"2d", "3d-0.1", "3d-0.2", "3d-3l", "2d-8beam"}) {
+        const ModelSpec m = model_preset(name);
+        EXPECT_EQ(m.bvc.n_cells(), 960) << name;
+        EXPECT_EQ(m.place.n_place, 250);
+        EXPECT_EQ(m.bvc.n_dir, 8);
+        EXPECT_EQ(m.bvc.max_dist, std::string(name) == "2d-8beam" ? 11.9 : 12.0);
+    }
+    EXPECT_EQ(model_preset("2d").sensor.name, "horizontal");
+    EXPECT_EQ(model_preset("3d-3l").sensor.name, "spherical");
+    EXPECT_EQ(model_preset("3d-3l").bvc.elevations, (std::vector<double>{0.0, 0.1, 0.2}));
+    EXPECT_NEAR(model_preset("2d-8beam").bvc.spacing(), 0.1, 1e-15);
+    EXPECT_THROW(model_preset("4d"), InputError);
+}

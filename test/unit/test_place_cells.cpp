@@ -1,0 +1,140 @@
+// The place-cell network (SPEC §6): dynamics, Oja learning, determinism.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/place/place_cell_network.hpp"
+
+using namespace bvc3d;
+
+namespace {
+PlaceCellNetwork tiny_network() {
+    PlaceParams p;
+    p.n_place = 2;
+    PlaceCellNetwork net(3, p, 0);
+    net.set_weights(std::vector<float>{1, 0, 1, 0, 1, 0.5f});
+    return net;
+}
+}  // namespace
+
+TEST(PlaceCellNetwork, HandComputedTwoSteps) {
+    // W = [[1, 0, 1], [0, 1, 0.5]], v_b = [0.5, 0.2, 0.1]: W·v_b = [0.6, 0.25], Σv_b = 0.8.
+    // Step 1: s = 0.5·(W·v_b - 0.3·0.8 - 0.5·0) = [0.18, 0.005], v = tanh(s) = [0.178081, 0.0049999583].
+    // Step 2: Σv = 0.183081; s0 = 0.18 + 0.5·(-0.18 + 0.6 - 0.24 - 0.0915404) = 0.2242298,
+    //         s1 = 0.005 + 0.5·(-0.005 + 0.25 - 0.24 - 0.0915404) = -0.0382702, v = [0.2205459, 0].
+    auto net = tiny_network();
+    const std::vector<double> vb{0.5, 0.2, 0.1};
+    auto v = net.step(vb, false);
+    EXPECT_NEAR(net.membrane()[0], 0.18, 1e-6);
+    EXPECT_NEAR(net.membrane()[1], 0.005, 1e-6);
+    EXPECT_NEAR(v[0], 0.17808087, 1e-6);
+    EXPECT_NEAR(v[1], 0.00499996, 1e-6);
+    v = net.step(vb, false);
+    EXPECT_NEAR(net.membrane()[0], 0.22422979, 1e-6);
+    EXPECT_NEAR(net.membrane()[1], -0.03827021, 1e-6);
+    EXPECT_NEAR(v[0], 0.22054585, 1e-6);
+    EXPECT_EQ(v[1], 0.0f);  // rectified
+}
+
+TEST(PlaceCellNetwork, HandComputedOjaUpdate) {
+    // After step 1 (v = [0.178081, 0.0049999583]) with learning on, eta = 0.096, alpha = √0.5:
+    // W_ij += eta·v_i·(v_b,j - v_i·W_ij/alpha), e.g. W_00 = 1 + 0.0170958·(0.5 - 0.251844) = 1.0042424.
+    auto net = tiny_network();
+    net.step(std::vector<double>{0.5, 0.2, 0.1}, true);
+    const auto w = net.weights();
+    const double expected[6] = {1.00424241, 3.41915267e-03, 9.97404104e-01, 2.39998000e-04, 1.00009261, 5.00046303e-01};
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(w[i], expected[i], 2e-7) << i;
+}
+
+TEST(PlaceCellNetwork, LearningOffLeavesWeightsUntouched) {
+    PlaceCellNetwork net(960, PlaceParams{}, 5);
+    const auto before = net.weights();
+    std::mt19937_64 gen(1);
+    std::uniform_real_distribution<double> u(0, 0.5);
+    std::vector<double> vb(960);
+    int active = 0;
+    for (int t = 0; t < 200; ++t) {
+        for (auto& x : vb) x = u(gen) * (u(gen) < 0.05);
+        for (float r : net.step(vb, false)) active += r > 0;
+    }
+    EXPECT_GT(active, 0);
+    EXPECT_EQ(net.weights(), before);
+}
+
+TEST(PlaceCellNetwork, WeightsStayBoundedOverALongRandomStream) {
+    PlaceCellNetwork net(960, PlaceParams{}, 9);
+    std::mt19937_64 gen(2);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<double> vb(960);
+    float max_w = 0;
+    int active_steps = 0;
+    for (int t = 0; t < 20000; ++t) {
+        // Sparse, bump-like BVC activity in [0, 0.5], as normalised layers give.
+        const int centre = static_cast<int>(u(gen) * 960);
+        for (int j = 0; j < 960; ++j) {
+            const int d = std::min(std::abs(j - centre), 960 - std::abs(j - centre));
+            vb[j] = 0.5 * std::exp(-0.5 * d * d / 100.0) * (0.5 + 0.5 * u(gen));
+        }
+        bool any = false;
+        for (float r : net.step(vb, true)) any = any || r > 0;
+        active_steps += any;
+    }
+    for (float w : net.weights()) {
+        ASSERT_TRUE(std::isfinite(w));
+        max_w = std::max(max_w, std::abs(w));
+    }
+    EXPECT_GT(active_steps, 1000);
+    // Oja's rule keeps |W_i| near alpha·|v_b|/v_i-scale: nothing runs away.
+    EXPECT_LT(max_w, 5.0f);
+}
+
+TEST(PlaceCellNetwork, InitialWeightsAreSeededBernoulli) {
+    const PlaceCellNetwork a(960, PlaceParams{}, 3), b(960, PlaceParams{}, 3), c(960, PlaceParams{}, 4);
+    EXPECT_EQ(a.weights(), b.weights());
+    EXPECT_NE(a.weights(), c.weights());
+    double ones = 0;
+    for (float w : a.weights()) {
+        ASSERT_TRUE(w == 0.0f || w == 1.0f);
+        ones += w;
+    }
+    EXPECT_NEAR(ones / (250.0 * 960.0), 0.25, 0.005);
+    for (float v : a.rates()) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(PlaceCellNetwork, SameInputsSameSeedBitIdentical) {
+    PlaceCellNetwork a(960, PlaceParams{}, 11), b(960, PlaceParams{}, 11);
+    std::mt19937_64 gen(3);
+    std::uniform_real_distribution<double> u(0, 0.5);
+    std::vector<double> vb(960);
+    for (int t = 0; t < 500; ++t) {
+        for (auto& x : vb) x = u(gen) * (u(gen) < 0.1);
+        const auto ra = a.step(vb, true);
+        const auto rb = b.step(vb, true);
+        ASSERT_TRUE(std::equal(ra.begin(), ra.end(), rb.begin()));
+    }
+    EXPECT_EQ(a.weights(), b.weights());
+}
+
+TEST(PlaceCellNetwork, ResetAndWeightsRoundTrip) {
+    PlaceCellNetwork net(960, PlaceParams{}, 1);
+    std::vector<double> vb(960, 0.0);
+    for (int j = 0; j < 100; ++j) vb[j] = 0.5;
+    net.step(vb, true);
+    auto w = net.weights();
+    w[7] = 0.123f;
+    net.set_weights(w);
+    EXPECT_EQ(net.weights(), w);
+    net.reset();
+    for (float s : net.membrane()) EXPECT_EQ(s, 0.0f);
+    for (float v : net.rates()) EXPECT_EQ(v, 0.0f);
+    EXPECT_EQ(net.weights(), w);
+    EXPECT_THROW(net.set_weights(std::vector<float>(10)), InputError);
+    EXPECT_THROW(net.step(std::vector<double>(959), true), InputError);
+    vb[3] = NAN;
+    EXPECT_THROW(net.step(vb, true), InputError);
+    PlaceParams bad;
+    bad.n_place = 0;
+    EXPECT_THROW(PlaceCellNetwork(960, bad, 0), InputError);
+}
