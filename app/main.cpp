@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "bvc3d 0.1.0");
     bvc3d::cli::add_simulator_commands(app);
     bvc3d::cli::add_model_commands(app);
+    bvc3d::cli::add_experiment_commands(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -1,0 +1,312 @@
+// bvc3d run / paper / analyze: trials, the paper's experiment, and analysis of trial files.
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/trial_yaml.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/experiment/experiment.hpp"
+#include "bvc3d/experiment/trial_runner.hpp"
+#include "bvc3d/report/summary.hpp"
+#include "cli_common.hpp"
+
+namespace bvc3d::cli {
+
+namespace {
+
+// Ctrl-C asks running trials to checkpoint and stop; a second Ctrl-C ends the program at once.
+std::atomic<bool> g_stop{false};
+extern "C" void on_sigint(int) {
+    g_stop.store(true);
+    std::signal(SIGINT, SIG_DFL);
+}
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string item; std::getline(ss, item, ',');)
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+double parse_double(const std::string& s, const std::string& what) {
+    try {
+        std::size_t used = 0;
+        const double v = std::stod(s, &used);
+        if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument(s);
+        return v;
+    } catch (const std::exception&) {
+        throw InputError(what + ": '" + s + "' is not a number");
+    }
+}
+
+// Runs the report module: /usr/bin/python3 -m bvc3d.report DIR.
+int run_report(const std::filesystem::path& dir) {
+    const char* py_env = std::getenv("BVC3D_PYTHON");
+    const std::string python = py_env ? py_env : BVC3D_PYTHON;
+    const char* path_env = std::getenv("BVC3D_PYTHONPATH");
+    std::string pythonpath = path_env ? path_env : BVC3D_PYTHON_DIR;
+    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing) pythonpath += std::string(":") + existing;
+    const std::string cmd = "PYTHONPATH='" + pythonpath + "' '" + python + "' -m bvc3d.report '" + dir.string() + "'";
+    return std::system(cmd.c_str());
+}
+
+struct Interrupt {
+    Interrupt() { std::signal(SIGINT, on_sigint); }
+    ~Interrupt() { std::signal(SIGINT, SIG_DFL); }
+};
+
+[[noreturn]] void exit_interrupted() {
+    std::cerr << "\nbvc3d: interrupted; finished trials are kept. Run the same command again to resume.\n";
+    std::exit(130);
+}
+
+// Summary files and figures for a folder of trial files.
+void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report) {
+    const auto trials = read_summaries(files);
+    const auto rows = summarize(trials);
+    write_trials_csv(out / "trials.csv", trials);
+    write_summary_csv(out / "summary.csv", rows);
+    write_summary_markdown(out / "summary.md", rows);
+    if (report && run_report(out) != 0)
+        throw InputError("the report (figures) failed; the trial files and summary are in '" + out.string() +
+                         "'; rerun with: python3 -m bvc3d.report " + out.string());
+}
+
+void add_run(CLI::App& app) {
+    auto* cmd = app.add_subcommand("run", "Run one trial (SPEC §7) and write its HDF5 file");
+    struct Options {
+        std::string config, world, lean, model, protocol, extent, out;
+        std::optional<double> tilt, explore_hours, sample_hours, hours;
+        std::optional<std::uint64_t> seed;
+        bool record_bvc = false;
+        double checkpoint_minutes = 10;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--config", o->config, "Trial YAML file (docs/experiments.md); flags below override it");
+    cmd->add_option("--world", o->world, "World preset or YAML file (default cross)");
+    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
+    cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward (default +x+y)");
+    cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
+    cmd->add_option("--seed", o->seed, "Random seed (default 0)");
+    cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
+    cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
+    cmd->add_option("--sample-hours", o->sample_hours, "Simulated hours of sampling (recorded)");
+    cmd->add_option("--hours", o->hours, "Shorten both phases to this many simulated hours");
+    cmd->add_flag("--record-bvc", o->record_bvc, "Also record the BVC rates");
+    cmd->add_option("--extent", o->extent, "Rate-map grid over the 'data' (default) or the 'arena'");
+    cmd->add_option("--out", o->out, "Trial file to write (default results/<trial name>.h5)");
+    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
+                    "Checkpoint every this many simulated minutes (0: only on Ctrl-C)")
+        ->capture_default_str();
+    cmd->footer("Ctrl-C checkpoints and stops; running the same command again resumes and gives the same file.");
+    cmd->callback([o] {
+        TrialConfig t = o->config.empty() ? TrialConfig{} : config::load_trial_file(o->config);
+        if (o->config.empty()) t.model = model_preset("3d-0.2");
+        if (!o->world.empty()) t.world = WorldSpec{o->world, std::nullopt, "+x+y"};
+        if (o->tilt) t.world.tilt_deg = o->tilt;
+        if (!o->lean.empty()) t.world.lean = o->lean;
+        if (!o->model.empty()) t.model = config::resolve_model(o->model);
+        if (o->seed) t.seed = *o->seed;
+        if (!o->protocol.empty()) t.protocol.kind = parse_protocol(o->protocol);
+        if (o->hours) t.protocol.explore_hours = t.protocol.sample_hours = *o->hours;
+        if (o->explore_hours) t.protocol.explore_hours = *o->explore_hours;
+        if (o->sample_hours) t.protocol.sample_hours = *o->sample_hours;
+        if (o->record_bvc) t.protocol.record_bvc = true;
+        if (!o->extent.empty()) {
+            if (o->extent != "data" && o->extent != "arena") throw InputError("--extent must be 'data' or 'arena'");
+            t.arena_extent = o->extent == "arena";
+        }
+        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+        t.protocol.validate();
+        const WorldDescription world = t.world.resolve();
+        const std::filesystem::path out = o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
+                                                         : std::filesystem::path(o->out);
+        ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
+        if (trial_file_fingerprint(out) == t.fingerprint()) {
+            std::cerr << "bvc3d: " << out.string() << " is complete with this configuration; nothing to do\n";
+            return;
+        }
+        const bool tty = ::isatty(STDERR_FILENO);
+        const double total = 3600 * (t.protocol.kind == Protocol::Kind::online ? t.protocol.sample_hours
+                                                                                 : t.protocol.explore_hours + t.protocol.sample_hours);
+        Interrupt guard;
+        RunControl control;
+        control.stop = &g_stop;
+        control.checkpoint = out.string() + ".ckpt";
+        control.checkpoint_minutes = o->checkpoint_minutes;
+        const auto start = std::chrono::steady_clock::now();
+        if (tty)
+            control.progress = [&](double s) {
+                const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                std::fprintf(stderr, "\r  %.2f/%.2f simulated hours  ~%.0f s left   ", s / 3600, total / 3600,
+                             s > 0 ? wall * (total - s) / s : 0.0);
+            };
+        GroupResult result;
+        try {
+            result = run_trial_group({t}, control);
+        } catch (const Interrupted&) {
+            exit_interrupted();
+        }
+        const auto metrics = analyze(t, world, result.x, result.y, result.models[0].rates, result.models[0].n_place);
+        write_trial_file(out, t, result, 0, metrics);
+        std::filesystem::remove(control.checkpoint);
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (tty) std::fprintf(stderr, "\n");
+        std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), result.t.size(),
+                    (result.stats.explore_steps + result.stats.sample_steps) / wall);
+        for (const auto& [name, v] : scalar_metrics(metrics)) std::printf("  %-16s %g\n", name.c_str(), v);
+    });
+}
+
+void add_paper(CLI::App& app) {
+    auto* cmd = app.add_subcommand("paper", "Run the paper's experiment: models x tilted worlds x seeds, summary, figures");
+    struct Options {
+        std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol;
+        int seeds = 1, jobs = 0;
+        std::optional<double> hours;
+        double checkpoint_minutes = 0;
+        bool no_report = false, arena_extent = false;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
+    cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
+    cmd->add_option("--hours", o->hours, "Shorten both phases to H simulated hours (default: the paper's 4 + 4)");
+    cmd->add_option("--jobs", o->jobs, "Trials in parallel (default: every core)");
+    cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
+    cmd->add_option("--tilts", o->tilts, "Comma-separated tilts of the cross arena, degrees")->capture_default_str();
+    cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
+    cmd->add_flag("--arena-extent", o->arena_extent, "Bin rate maps over the arena instead of each trajectory");
+    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
+                    "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
+    cmd->add_flag("--no-report", o->no_report, "Skip the figures (trial files and summary only)");
+    cmd->footer(
+        "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and (via python3 -m bvc3d.report)\n"
+        "figures and report.md. Completed trials are skipped on a rerun; Ctrl-C stops cleanly and can be resumed.");
+    cmd->callback([o] {
+        if (o->seeds < 1) throw InputError("--seeds must be >= 1");
+        if (o->jobs < 0) throw InputError("--jobs must be >= 0");
+        if (o->hours && !(*o->hours > 0)) throw InputError("--hours must be a positive number of hours");
+        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+        std::vector<ModelSpec> models;
+        for (const auto& m : split(o->models)) models.push_back(config::resolve_model(m));
+        if (models.empty()) throw InputError("--models lists no model");
+        std::vector<double> tilts;
+        for (const auto& t : split(o->tilts)) tilts.push_back(parse_double(t, "--tilts"));
+        if (tilts.empty()) throw InputError("--tilts lists no tilt");
+        std::vector<TrialConfig> trials;
+        for (int seed = 0; seed < o->seeds; ++seed)
+            for (double tilt : tilts)
+                for (const auto& m : models) {
+                    TrialConfig t;
+                    t.world = WorldSpec{"cross", tilt, "+x+y"};
+                    t.model = m;
+                    t.seed = static_cast<std::uint64_t>(seed);
+                    if (!o->protocol.empty()) t.protocol.kind = parse_protocol(o->protocol);
+                    if (o->hours) t.protocol.explore_hours = t.protocol.sample_hours = *o->hours;
+                    t.arena_extent = o->arena_extent;
+                    trials.push_back(t);
+                }
+        ExperimentOptions opts;
+        opts.out_dir = o->out;
+        opts.jobs = o->jobs;
+        opts.progress = ::isatty(STDERR_FILENO);
+        opts.checkpoint_minutes = o->checkpoint_minutes;
+        opts.stop = &g_stop;
+        Interrupt guard;
+        ExperimentOutcome outcome;
+        try {
+            outcome = run_experiment(trials, opts);
+        } catch (const Interrupted&) {
+            exit_interrupted();
+        }
+        std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", trials.size(), o->out.c_str(),
+                    outcome.ran, outcome.skipped, outcome.wall_seconds);
+        if (outcome.steps > 0) std::printf(", %.0f walk steps/s", outcome.steps / outcome.wall_seconds);
+        std::printf("\n");
+        summarise(o->out, outcome.files, !o->no_report);
+        std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
+    });
+}
+
+void add_analyze(CLI::App& app) {
+    auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files (SPEC §8), optionally with other parameters");
+    struct Options {
+        std::vector<std::string> files;
+        analysis::AnalysisParams params;
+        std::string extent, cells;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("files", o->files, "Trial files (.h5)")->required();
+    cmd->add_option("--gridsize", o->params.gridsize, "Hexagons across x")->capture_default_str();
+    cmd->add_option("--quantile", o->params.quantile, "Rate-map threshold quantile")->capture_default_str();
+    cmd->add_option("--eps", o->params.dbscan.eps, "DBSCAN radius, m")->capture_default_str();
+    cmd->add_option("--min-samples", o->params.dbscan.min_samples, "DBSCAN min_samples")->capture_default_str();
+    cmd->add_option("--d-th", o->params.d_th, "SAI exclusion distance, m")->capture_default_str();
+    cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX (default: the trajectory's)");
+    cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
+    cmd->callback([o] {
+        if (!o->extent.empty()) {
+            const auto parts = split(o->extent);
+            if (parts.size() != 4) throw InputError("--extent expects XMIN,XMAX,YMIN,YMAX");
+            o->params.extent = analysis::Extent{parse_double(parts[0], "--extent"), parse_double(parts[1], "--extent"),
+                                                parse_double(parts[2], "--extent"), parse_double(parts[3], "--extent")};
+        }
+        o->params.validate();
+        std::printf("%-40s", "trial");
+        for (const auto& n : scalar_metric_names()) std::printf(" %15s", n.c_str());
+        std::printf("\n");
+        for (std::size_t i = 0; i < o->files.size(); ++i) {
+            const auto d = read_trial_samples(o->files[i]);
+            const auto m = analysis::analyze_trial<float>(d.x, d.y, d.rates, o->params);
+            std::printf("%-40s", d.name.c_str());
+            for (const auto& [name, v] : scalar_metrics(m)) std::printf(" %15.6g", v);
+            std::printf("\n");
+            if (i == 0 && !o->cells.empty()) {
+                AtomicFile f(o->cells);
+                f.stream() << "cell,modality,peak_rate,mean_rate,field_area,spatial_info\n";
+                for (std::size_t c = 0; c < m.modality.size(); ++c)
+                    f.stream() << c << ',' << m.modality[c] << ',' << num(m.cells.peak_rate[c]) << ','
+                               << num(m.cells.mean_rate[c]) << ',' << num(m.cells.field_area[c]) << ','
+                               << num(m.cells.spatial_info[c]) << '\n';
+                f.commit();
+            }
+        }
+    });
+}
+
+void add_summarize(CLI::App& app) {
+    auto* cmd = app.add_subcommand("summarize", "Write trials.csv, summary.csv/.md and the figures for a folder of trial files");
+    auto dir = std::make_shared<std::string>();
+    auto no_report = std::make_shared<bool>(false);
+    cmd->add_option("folder", *dir, "Folder of trial files")->required();
+    cmd->add_flag("--no-report", *no_report, "Skip the figures");
+    cmd->callback([dir, no_report] {
+        std::vector<std::filesystem::path> files;
+        std::error_code ec;
+        if (!std::filesystem::is_directory(*dir, ec)) throw InputError("'" + *dir + "' is not a folder");
+        for (const auto& e : std::filesystem::directory_iterator(*dir))
+            if (e.path().extension() == ".h5" && trial_file_fingerprint(e.path())) files.push_back(e.path());
+        if (files.empty()) throw InputError("'" + *dir + "' holds no complete trial files");
+        std::sort(files.begin(), files.end());
+        summarise(*dir, files, !*no_report);
+        std::printf("%zu trials summarised in %s/summary.md\n", files.size(), dir->c_str());
+    });
+}
+
+}  // namespace
+
+void add_experiment_commands(CLI::App& app) {
+    add_run(app);
+    add_paper(app);
+    add_analyze(app);
+    add_summarize(app);
+}
+
+}  // namespace bvc3d::cli

@@ -1,0 +1,217 @@
+#include "bvc3d/recorder/hdf5_io.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d::h5 {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& what) { throw InputError("HDF5: " + what); }
+
+hid_t check(hid_t id, const std::string& what) {
+    if (id < 0) fail(what);
+    return id;
+}
+
+void check(herr_t e, const std::string& what) {
+    if (e < 0) fail(what);
+}
+
+// Quiet HDF5's own error printing once; our exceptions say what failed.
+void silence() {
+    static std::once_flag once;
+    std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+}
+
+template <class T>
+void write_any(hid_t loc, const std::string& name, const std::vector<T>& v, std::vector<std::size_t> shape,
+               hid_t mem_type, bool compress) {
+    auto lock = hdf5_lock();
+    std::size_t n = 1;
+    for (auto d : shape) n *= d;
+    if (n != v.size()) throw std::logic_error("HDF5 write: shape does not match data for " + name);
+    std::vector<hsize_t> hd(shape.begin(), shape.end());
+    Handle space(check(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), "dataspace " + name), H5Sclose);
+    Handle dcpl(check(H5Pcreate(H5P_DATASET_CREATE), "plist"), H5Pclose);
+    check(H5Pset_obj_track_times(dcpl, false), "track times");
+    if (compress && n > 0) {
+        std::vector<hsize_t> chunk = hd;
+        // About 1 MB chunks of whole rows.
+        const hsize_t row = hd.size() > 1 ? std::max<hsize_t>(hd[1], 1) : 1;
+        chunk[0] = std::max<hsize_t>(1, std::min<hsize_t>(hd[0], (1u << 20) / (sizeof(T) * row)));
+        check(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), "chunk " + name);
+        check(H5Pset_shuffle(dcpl), "shuffle");
+        check(H5Pset_deflate(dcpl, 1), "deflate");
+    }
+    Handle ds(check(H5Dcreate2(loc, name.c_str(), mem_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), "create " + name),
+              H5Dclose);
+    if (n > 0) check(H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), "write " + name);
+}
+
+template <class T>
+std::vector<T> read_any(hid_t loc, const std::string& name, hid_t mem_type) {
+    auto lock = hdf5_lock();
+    Handle ds(check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), "no dataset '" + name + "'"), H5Dclose);
+    Handle space(check(H5Dget_space(ds), "space " + name), H5Sclose);
+    const hssize_t n = H5Sget_simple_extent_npoints(space);
+    std::vector<T> out(static_cast<std::size_t>(std::max<hssize_t>(n, 0)));
+    if (n > 0) check(H5Dread(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), "read " + name);
+    return out;
+}
+
+Handle attr_for_write(hid_t obj, const std::string& name, hid_t type, hid_t space) {
+    if (H5Aexists(obj, name.c_str()) > 0) check(H5Adelete(obj, name.c_str()), "delete attribute " + name);
+    return Handle(check(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), "attribute " + name), H5Aclose);
+}
+
+}  // namespace
+
+std::unique_lock<std::recursive_mutex> hdf5_lock() {
+    static std::recursive_mutex m;
+    silence();
+    return std::unique_lock<std::recursive_mutex>(m);
+}
+
+Handle& Handle::operator=(Handle&& o) noexcept {
+    if (this != &o) {
+        reset();
+        id_ = o.id_;
+        close_ = o.close_;
+        o.id_ = -1;
+    }
+    return *this;
+}
+
+void Handle::reset() {
+    if (id_ >= 0 && close_) {
+        auto lock = hdf5_lock();
+        close_(id_);
+    }
+    id_ = -1;
+}
+
+Handle create_file(const std::string& path) {
+    auto lock = hdf5_lock();
+    Handle fcpl(check(H5Pcreate(H5P_FILE_CREATE), "plist"), H5Pclose);
+    check(H5Pset_obj_track_times(fcpl, false), "track times");
+    return Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT), "cannot create '" + path + "'"), H5Fclose);
+}
+
+Handle open_file(const std::string& path) {
+    auto lock = hdf5_lock();
+    return Handle(check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "cannot open '" + path + "' as an HDF5 file"),
+                  H5Fclose);
+}
+
+Handle create_group(hid_t loc, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle gcpl(check(H5Pcreate(H5P_GROUP_CREATE), "plist"), H5Pclose);
+    check(H5Pset_obj_track_times(gcpl, false), "track times");
+    return Handle(check(H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, gcpl, H5P_DEFAULT), "group " + name), H5Gclose);
+}
+
+Handle open_group(hid_t loc, const std::string& name) {
+    auto lock = hdf5_lock();
+    return Handle(check(H5Gopen2(loc, name.c_str(), H5P_DEFAULT), "no group '" + name + "'"), H5Gclose);
+}
+
+bool exists(hid_t loc, const std::string& name) {
+    auto lock = hdf5_lock();
+    return H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0;
+}
+
+void write_attr(hid_t obj, const std::string& name, const std::string& value) {
+    auto lock = hdf5_lock();
+    Handle type(check(H5Tcopy(H5T_C_S1), "type"), H5Tclose);
+    check(H5Tset_size(type, std::max<std::size_t>(value.size(), 1)), "type size");
+    check(H5Tset_cset(type, H5T_CSET_UTF8), "cset");
+    Handle space(check(H5Screate(H5S_SCALAR), "space"), H5Sclose);
+    Handle a = attr_for_write(obj, name, type, space);
+    const std::string padded = value.empty() ? std::string(1, '\0') : value;
+    check(H5Awrite(a, type, padded.data()), "write attribute " + name);
+}
+
+void write_attr(hid_t obj, const std::string& name, double value) {
+    auto lock = hdf5_lock();
+    Handle space(check(H5Screate(H5S_SCALAR), "space"), H5Sclose);
+    Handle a = attr_for_write(obj, name, H5T_IEEE_F64LE, space);
+    check(H5Awrite(a, H5T_NATIVE_DOUBLE, &value), "write attribute " + name);
+}
+
+void write_attr(hid_t obj, const std::string& name, std::int64_t value) {
+    auto lock = hdf5_lock();
+    Handle space(check(H5Screate(H5S_SCALAR), "space"), H5Sclose);
+    Handle a = attr_for_write(obj, name, H5T_STD_I64LE, space);
+    check(H5Awrite(a, H5T_NATIVE_INT64, &value), "write attribute " + name);
+}
+
+std::string read_attr_string(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
+    Handle type(check(H5Aget_type(a), "type"), H5Tclose);
+    if (H5Tget_class(type) != H5T_STRING) fail("attribute '" + name + "' is not text");
+    if (H5Tis_variable_str(type) > 0) {
+        char* s = nullptr;
+        Handle mem(check(H5Tcopy(H5T_C_S1), "type"), H5Tclose);
+        check(H5Tset_size(mem, H5T_VARIABLE), "size");
+        check(H5Aread(a, mem, &s), "read attribute " + name);
+        std::string out = s ? s : "";
+        Handle space(check(H5Aget_space(a), "space"), H5Sclose);
+        H5Dvlen_reclaim(mem, space, H5P_DEFAULT, &s);
+        return out;
+    }
+    std::string out(H5Tget_size(type), '\0');
+    check(H5Aread(a, type, out.data()), "read attribute " + name);
+    const auto end = out.find('\0');
+    if (end != std::string::npos) out.resize(end);
+    return out;
+}
+
+double read_attr_double(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
+    double v = 0;
+    check(H5Aread(a, H5T_NATIVE_DOUBLE, &v), "read attribute " + name);
+    return v;
+}
+
+std::int64_t read_attr_int(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
+    std::int64_t v = 0;
+    check(H5Aread(a, H5T_NATIVE_INT64, &v), "read attribute " + name);
+    return v;
+}
+
+void write(hid_t loc, const std::string& name, const std::vector<double>& v, std::vector<std::size_t> d, bool c) {
+    write_any(loc, name, v, std::move(d), H5T_NATIVE_DOUBLE, c);
+}
+void write(hid_t loc, const std::string& name, const std::vector<float>& v, std::vector<std::size_t> d, bool c) {
+    write_any(loc, name, v, std::move(d), H5T_NATIVE_FLOAT, c);
+}
+void write(hid_t loc, const std::string& name, const std::vector<std::int64_t>& v, std::vector<std::size_t> d, bool c) {
+    write_any(loc, name, v, std::move(d), H5T_NATIVE_INT64, c);
+}
+void write(hid_t loc, const std::string& name, const std::vector<std::uint8_t>& v, std::vector<std::size_t> d, bool c) {
+    write_any(loc, name, v, std::move(d), H5T_NATIVE_UINT8, c);
+}
+
+std::vector<std::size_t> dims(hid_t loc, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle ds(check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), "no dataset '" + name + "'"), H5Dclose);
+    Handle space(check(H5Dget_space(ds), "space"), H5Sclose);
+    const int nd = H5Sget_simple_extent_ndims(space);
+    std::vector<hsize_t> d(std::max(nd, 0));
+    H5Sget_simple_extent_dims(space, d.data(), nullptr);
+    return std::vector<std::size_t>(d.begin(), d.end());
+}
+
+std::vector<double> read_doubles(hid_t loc, const std::string& n) { return read_any<double>(loc, n, H5T_NATIVE_DOUBLE); }
+std::vector<float> read_floats(hid_t loc, const std::string& n) { return read_any<float>(loc, n, H5T_NATIVE_FLOAT); }
+std::vector<std::int64_t> read_ints(hid_t loc, const std::string& n) { return read_any<std::int64_t>(loc, n, H5T_NATIVE_INT64); }
+std::vector<std::uint8_t> read_bytes(hid_t loc, const std::string& n) { return read_any<std::uint8_t>(loc, n, H5T_NATIVE_UINT8); }
+
+}  // namespace bvc3d::h5

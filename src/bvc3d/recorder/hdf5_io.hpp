@@ -1,0 +1,60 @@
+#pragma once
+// A small RAII layer over the HDF5 C API: just what trial and checkpoint files need.
+// Debian's HDF5 is not built thread-safe, so every call made through this layer holds one
+// process-wide lock (hdf5_lock); files written the same way are byte-identical (no timestamps).
+#include <hdf5.h>
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace bvc3d::h5 {
+
+std::unique_lock<std::recursive_mutex> hdf5_lock();
+
+class Handle {
+public:
+    Handle() = default;
+    Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+    Handle(Handle&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
+    Handle& operator=(Handle&& o) noexcept;
+    Handle(const Handle&) = delete;
+    Handle& operator=(const Handle&) = delete;
+    ~Handle() { reset(); }
+    void reset();  // close now
+    hid_t id() const { return id_; }
+    operator hid_t() const { return id_; }
+
+private:
+    hid_t id_ = -1;
+    herr_t (*close_)(hid_t) = nullptr;
+};
+
+Handle create_file(const std::string& path);  // truncates
+Handle open_file(const std::string& path);    // read-only
+Handle create_group(hid_t loc, const std::string& name);
+Handle open_group(hid_t loc, const std::string& name);
+bool exists(hid_t loc, const std::string& name);
+
+void write_attr(hid_t obj, const std::string& name, const std::string& value);
+void write_attr(hid_t obj, const std::string& name, double value);
+void write_attr(hid_t obj, const std::string& name, std::int64_t value);
+std::string read_attr_string(hid_t obj, const std::string& name);
+double read_attr_double(hid_t obj, const std::string& name);
+std::int64_t read_attr_int(hid_t obj, const std::string& name);
+
+// Row-major datasets of 1 or 2 dimensions; chunked and compressed when `compress` (for h5py users
+// this is transparent).
+void write(hid_t loc, const std::string& name, const std::vector<double>& v, std::vector<std::size_t> dims, bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<float>& v, std::vector<std::size_t> dims, bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<std::int64_t>& v, std::vector<std::size_t> dims, bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<std::uint8_t>& v, std::vector<std::size_t> dims, bool compress = true);
+
+std::vector<std::size_t> dims(hid_t loc, const std::string& name);
+std::vector<double> read_doubles(hid_t loc, const std::string& name);
+std::vector<float> read_floats(hid_t loc, const std::string& name);
+std::vector<std::int64_t> read_ints(hid_t loc, const std::string& name);
+std::vector<std::uint8_t> read_bytes(hid_t loc, const std::string& name);
+
+}  // namespace bvc3d::h5

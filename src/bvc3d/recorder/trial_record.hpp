@@ -1,0 +1,39 @@
+#pragma once
+// Recorder stage: what a trial records (SPEC §7, §9), in memory. trial_file.hpp writes it to HDF5.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bvc3d/robot/random_walk.hpp"
+
+namespace bvc3d {
+
+struct ModelRecord {
+    std::vector<float> rates;    // samples × n_place, row-major
+    std::vector<float> bvc;      // samples × n_bvc, if the protocol records them
+    std::vector<float> weights;  // n_place × n_bvc
+    int n_place = 0, n_bvc = 0;
+};
+
+struct WalkStats {
+    std::int64_t explore_steps = 0, sample_steps = 0, bumps = 0, full_scan_fallbacks = 0;
+    double end_time = 0;  // simulated seconds at the end of the walk
+};
+
+// A group of models on one walk: the samples' positions are shared, the records are per model.
+struct GroupResult {
+    std::vector<double> t, x, y, heading;  // one per recorded sample
+    std::vector<ModelRecord> models;       // in the order of the group's trials
+    WalkStats stats;
+};
+
+// Everything needed to continue a group exactly where it stopped.
+struct GroupCheckpoint {
+    std::string fingerprint;  // of the group's configuration
+    WalkState walk;
+    std::int64_t step_index = 0;
+    GroupResult partial;  // samples so far; per model the current weights
+    std::vector<std::vector<float>> membrane, place_rates;  // per model
+};
+
+}  // namespace bvc3d

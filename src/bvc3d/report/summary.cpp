@@ -1,0 +1,130 @@
+#include "bvc3d/report/summary.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "bvc3d/core/atomic_file.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+std::string num(double v) {
+    if (std::isnan(v)) return "nan";
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
+}
+
+std::string fixed(double v, int digits) {
+    if (std::isnan(v)) return "–";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    return buf;
+}
+
+// Human headings and precision for the Markdown table.
+struct Column {
+    const char* metric;
+    const char* heading;
+    int digits;
+};
+const Column markdown_columns[] = {{"frac_active", "MI>0 fraction", 3},   {"mean_mi_active", "mean MI (MI>0)", 2},
+                                   {"frac_multimodal", "MI>1 fraction", 3}, {"msai", "MSAI", 4},
+                                   {"decode_median_m", "decoding median (m)", 2}, {"decode_mean_m", "decoding mean (m)", 2}};
+
+}  // namespace
+
+std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files) {
+    std::vector<TrialSummaryRow> rows;
+    for (const auto& f : files) rows.push_back(read_trial_summary(f));
+    return rows;
+}
+
+std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials) {
+    std::vector<SummaryRow> rows;
+    std::map<std::pair<std::string, std::string>, std::vector<const TrialSummaryRow*>> by_condition;
+    for (const auto& t : trials) {
+        auto& members = by_condition[{t.model, t.world}];
+        if (members.empty()) {
+            SummaryRow r;
+            r.model = t.model;
+            r.world = t.world;
+            r.tilt_deg = t.tilt_deg;
+            rows.push_back(r);
+        }
+        members.push_back(&t);
+    }
+    for (auto& r : rows) {
+        const auto& members = by_condition[{r.model, r.world}];
+        r.n_seeds = static_cast<int>(members.size());
+        for (std::size_t m = 0; m < members.front()->metrics.size(); ++m) {
+            double sum = 0, sum2 = 0;
+            for (const auto* t : members) sum += t->metrics[m].second;
+            const double mean = sum / r.n_seeds;
+            for (const auto* t : members) sum2 += (t->metrics[m].second - mean) * (t->metrics[m].second - mean);
+            r.metric_names.push_back(members.front()->metrics[m].first);
+            r.mean.push_back(mean);
+            r.sd.push_back(r.n_seeds > 1 ? std::sqrt(sum2 / (r.n_seeds - 1)) : NAN);
+        }
+    }
+    return rows;
+}
+
+void write_summary_csv(const std::filesystem::path& path, const std::vector<SummaryRow>& rows) {
+    AtomicFile f(path);
+    auto& os = f.stream();
+    os << "model,world,tilt_deg,n_seeds";
+    if (!rows.empty())
+        for (const auto& m : rows.front().metric_names) os << ',' << m << "_mean," << m << "_sd";
+    os << '\n';
+    for (const auto& r : rows) {
+        os << r.model << ',' << r.world << ',' << num(r.tilt_deg) << ',' << r.n_seeds;
+        for (std::size_t m = 0; m < r.mean.size(); ++m) os << ',' << num(r.mean[m]) << ',' << num(r.sd[m]);
+        os << '\n';
+    }
+    f.commit();
+}
+
+void write_summary_markdown(const std::filesystem::path& path, const std::vector<SummaryRow>& rows) {
+    AtomicFile f(path);
+    auto& os = f.stream();
+    os << "| model | world | seeds |";
+    for (const auto& c : markdown_columns) os << ' ' << c.heading << " |";
+    os << "\n|---|---|---|";
+    for (std::size_t i = 0; i < std::size(markdown_columns); ++i) os << "---|";
+    os << '\n';
+    for (const auto& r : rows) {
+        os << "| " << r.model << " | " << r.world << " | " << r.n_seeds << " |";
+        for (const auto& c : markdown_columns) {
+            const auto it = std::find(r.metric_names.begin(), r.metric_names.end(), c.metric);
+            const std::size_t m = static_cast<std::size_t>(it - r.metric_names.begin());
+            os << ' ' << fixed(r.mean[m], c.digits);
+            if (r.n_seeds > 1) os << " ± " << fixed(r.sd[m], c.digits);
+            os << " |";
+        }
+        os << '\n';
+    }
+    os << "\nMean over seeds ± sample standard deviation. MI: modality index (DBSCAN clusters per place cell);\n"
+          "MSAI: mean spatial aliasing index; decoding: position error of the cosine-nearest rate-map bin.\n";
+    f.commit();
+}
+
+void write_trials_csv(const std::filesystem::path& path, const std::vector<TrialSummaryRow>& trials) {
+    AtomicFile f(path);
+    auto& os = f.stream();
+    os << "name,model,world,tilt_deg,seed";
+    if (!trials.empty())
+        for (const auto& [name, v] : trials.front().metrics) os << ',' << name;
+    os << '\n';
+    for (const auto& t : trials) {
+        os << t.name << ',' << t.model << ',' << t.world << ',' << num(t.tilt_deg) << ',' << t.seed;
+        for (const auto& [name, v] : t.metrics) os << ',' << num(v);
+        os << '\n';
+    }
+    f.commit();
+}
+
+}  // namespace bvc3d

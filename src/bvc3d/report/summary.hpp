@@ -1,0 +1,31 @@
+#pragma once
+// Report stage (C++ side): the experiment summary (SPEC §9), one row per condition with every
+// metric's mean ± sd over seeds, as CSV and as a Markdown table. Figures are drawn by the Python
+// module bvc3d.report, which reads these files and the trial files.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bvc3d/recorder/trial_file.hpp"
+
+namespace bvc3d {
+
+struct SummaryRow {
+    std::string model, world;
+    double tilt_deg = NAN;
+    int n_seeds = 0;
+    std::vector<std::string> metric_names;
+    std::vector<double> mean, sd;  // sd over seeds (n - 1); NaN for one seed
+};
+
+// Rows in the order conditions first appear in `trials`.
+std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials);
+std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files);
+
+// Written atomically. The CSV has columns model, world, tilt_deg, n_seeds, <metric>_mean, <metric>_sd.
+void write_summary_csv(const std::filesystem::path& path, const std::vector<SummaryRow>& rows);
+void write_summary_markdown(const std::filesystem::path& path, const std::vector<SummaryRow>& rows);
+// One row per trial: name, model, world, tilt_deg, seed, <metric>...
+void write_trials_csv(const std::filesystem::path& path, const std::vector<TrialSummaryRow>& trials);
+
+}  // namespace bvc3d
