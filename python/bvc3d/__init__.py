@@ -5,6 +5,7 @@ Stages follow the data flow: World -> Sensor scan -> BoundaryVectorLayer -> Plac
 -> recorded samples -> bvc3d.analysis -> bvc3d.report.
 """
 from ._core import InputError, Sensor, World, random_walk
+from . import analysis
 
 __all__ = ["InputError", "Sensor", "World", "random_walk"]
 __version__ = "0.1.0"
