@@ -414,9 +414,12 @@ def dense_decoder(x, y, rates, gridsize=50):
     return np.median(err), err.mean(), ok.sum(), (~ok).sum()
 
 
-def test_decoding_matches_a_dense_numpy_decoder():
+@pytest.mark.parametrize("floor", [0.05, 0.0])  # sparse rates, and dense ones (the blocked-product path)
+def test_decoding_matches_a_dense_numpy_decoder(floor):
     x, y = walk(30, 1.0, 6)
-    rates = place_population(x, y, 80, np.random.default_rng(6), sigma=0.7)
+    rates = place_population(x, y, 80, np.random.default_rng(6), sigma=0.7, floor=floor)
+    if floor == 0:
+        rates += np.float32(1e-3) * np.random.default_rng(7).random(rates.shape, dtype=np.float32)
     rates[len(x) // 2 + 5] = 0  # a silent sample is not decoded
     d = A.decoding_error(x, y, rates)
     med, mean, n_ok, n_bad = dense_decoder(x, y, rates)
