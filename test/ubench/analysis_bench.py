@@ -2,12 +2,13 @@
 numpy / scikit-learn computation of the same metric, and check that they agree.
 
     PYTHONPATH=build/python /usr/bin/python3 test/ubench/analysis_bench.py [--samples 50000]
-        [--cells 250] [--repeats 3] [--seed 1]
+        [--cells 250] [--repeats 3] [--seed 1] [--dense]
 
 Input: a random walk in the 45° cross arena (SPEC §4) cut to --samples steps, and --cells sparse
 place-field-like rates (1-3 Gaussian fields per cell, sigma 0.6 m, values below 0.05 set to 0,
 10 % silent cells), float32 as a trial records them. Times are the median of --repeats runs
-(references slower than 5 s run once).
+(references slower than 5 s run once). --dense replaces the rates by uniform random ones, all
+non-zero: the worst case for the sparse code paths (every cell active in every bin).
 """
 import argparse
 import math
@@ -32,11 +33,13 @@ def timed(fn, repeats):
     return statistics.median(times), out
 
 
-def trial_input(n_samples, n_cells, seed):
+def trial_input(n_samples, n_cells, seed, dense=False):
     w = bvc3d.random_walk(bvc3d.World.cross(45), n_samples * 0.3 / 3600 * 1.3 + 0.1, seed)
     x, y = w["x"][:n_samples], w["y"][:n_samples]
     assert len(x) == n_samples, "walk too short"
     rng = np.random.default_rng(seed)
+    if dense:
+        return x, y, rng.random((n_samples, n_cells), dtype=np.float32)
     rates = np.zeros((n_samples, n_cells), dtype=np.float32)
     for c in range(n_cells):
         if rng.random() < 0.1:
@@ -161,9 +164,10 @@ def main():
     ap.add_argument("--cells", type=int, default=250)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--dense", action="store_true", help="dense random rates (worst case)")
     args = ap.parse_args()
 
-    x, y, rates = trial_input(args.samples, args.cells, args.seed)
+    x, y, rates = trial_input(args.samples, args.cells, args.seed, args.dense)
     rates64 = rates.astype(np.float64)
     active = (rates > 0).mean()
     print(f"input: {len(x)} samples x {rates.shape[1]} cells (float32), {100 * active:.1f} % non-zero rates")
