@@ -10,6 +10,7 @@
 
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
+#include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"

@@ -1,8 +1,238 @@
-// Analysis functions (filled in by the analysis stage).
+// Analysis functions (bvc3d._core.analysis): numpy in, C++ (bvc3d::analysis), numpy out.
+// Argument checking and documentation live in python/bvc3d/analysis.py.
+#include <array>
+#include <optional>
+#include <span>
+#include <string>
+
 #include "bindings.hpp"
+#include "bvc3d/analysis/trial_metrics.hpp"
+#include "bvc3d/core/error.hpp"
 
 namespace bvc3d::py {
 
-void bind_analysis(pyb::module_& m) { (void)m; }
+namespace {
+
+namespace an = bvc3d::analysis;
+template <class T>
+using Array = pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast>;
+using MaybeExtent = std::optional<std::array<double, 4>>;
+
+std::optional<an::Extent> extent_of(const MaybeExtent& e) {
+    if (!e) return std::nullopt;
+    return an::Extent{(*e)[0], (*e)[1], (*e)[2], (*e)[3]};
+}
+
+std::span<const double> span1d(const ArrayD& a, const char* name) {
+    if (a.ndim() != 1) throw InputError(std::string(name) + " must be 1-D, got " + std::to_string(a.ndim()) + " dimensions");
+    return {a.data(), static_cast<std::size_t>(a.shape(0))};
+}
+
+template <class T>
+Eigen::Map<const an::RowMatrixX<T>> matrix(const Array<T>& a, const char* name) {
+    if (a.ndim() != 2) throw InputError(std::string(name) + " must be 2-D, got " + std::to_string(a.ndim()) + " dimensions");
+    return {a.data(), a.shape(0), a.shape(1)};
+}
+
+Eigen::Map<const an::Centers> centers_of(const ArrayD& a) {
+    if (a.ndim() != 2 || a.shape(1) != 2) throw InputError("centers/points must be an (N, 2) array");
+    return {a.data(), a.shape(0), 2};
+}
+
+pyb::array_t<double> numpy_of(const an::RowMatrixXd& m) { return to_numpy(m.data(), {m.rows(), m.cols()}); }
+pyb::array_t<double> numpy_of(const an::Centers& c) { return to_numpy(c.data(), {c.rows(), pyb::ssize_t{2}}); }
+template <class T>
+pyb::array_t<T> numpy_of(const std::vector<T>& v) { return to_numpy(v.data(), {static_cast<pyb::ssize_t>(v.size())}); }
+
+pyb::dict decoding_dict(const an::DecodingResult& d) {
+    pyb::dict r;
+    r["median_m"] = d.median_m;
+    r["mean_m"] = d.mean_m;
+    r["n_decoded"] = d.n_decoded;
+    r["n_undecoded"] = d.n_undecoded;
+    return r;
+}
+
+pyb::dict summary_dict(const an::ModalitySummary& s) {
+    pyb::dict r;
+    r["frac_active"] = s.frac_active;
+    r["mean_mi_active"] = s.mean_mi_active;
+    r["frac_multimodal"] = s.frac_multimodal;
+    return r;
+}
+
+pyb::dict stats_dict(const an::CellStats& s) {
+    pyb::dict r;
+    r["peak_rate"] = numpy_of(s.peak_rate);
+    r["mean_rate"] = numpy_of(s.mean_rate);
+    r["field_area_m2"] = numpy_of(s.field_area);
+    r["spatial_info"] = numpy_of(s.spatial_info);
+    r["spatial_info_per_rate"] = numpy_of(s.spatial_info_per_rate);
+    return r;
+}
+
+// Functions over per-sample values exist for float32 (taken as is) and float64 (anything else).
+template <class T>
+void bind_sample_functions(pyb::module_& a) {
+    auto values_arg = [](const char* name) {
+        auto arg = pyb::arg(name);
+        if constexpr (std::is_same_v<T, float>) arg.noconvert();
+        return arg;
+    };
+    a.def(
+        "hexbin",
+        [](const ArrayD& x, const ArrayD& y, const Array<T>& values, int gridsize, const MaybeExtent& extent) {
+            const auto xs = span1d(x, "x"), ys = span1d(y, "y");
+            const auto v = matrix<T>(values, "values");
+            an::HexBins bins;
+            an::RowMatrixXd means;
+            {
+                pyb::gil_scoped_release release;
+                bins = an::hexbin(xs, ys, gridsize, extent_of(extent));
+                means = an::bin_means<T>(bins, v);
+            }
+            return pyb::make_tuple(numpy_of(bins.centers), numpy_of(means), numpy_of(bins.counts));
+        },
+        pyb::arg("x"), pyb::arg("y"), values_arg("values"), pyb::arg("gridsize"), pyb::arg("extent"));
+    a.def(
+        "rate_maps",
+        [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile,
+           const MaybeExtent& extent) {
+            const auto xs = span1d(x, "x"), ys = span1d(y, "y");
+            const auto r = matrix<T>(rates, "rates");
+            an::RateMaps m;
+            {
+                pyb::gil_scoped_release release;
+                m = an::rate_maps<T>(xs, ys, r, {gridsize, quantile, extent_of(extent)});
+            }
+            return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean), numpy_of(m.bins.counts));
+        },
+        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
+        pyb::arg("extent"));
+    a.def(
+        "decoding_error",
+        [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, const MaybeExtent& extent) {
+            const auto xs = span1d(x, "x"), ys = span1d(y, "y");
+            const auto r = matrix<T>(rates, "rates");
+            an::DecodingResult d;
+            {
+                pyb::gil_scoped_release release;
+                d = an::decoding_error<T>(xs, ys, r, {gridsize, extent_of(extent)});
+            }
+            return decoding_dict(d);
+        },
+        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("extent"));
+    a.def(
+        "cell_stats",
+        [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile,
+           const MaybeExtent& extent) {
+            const auto xs = span1d(x, "x"), ys = span1d(y, "y");
+            const auto r = matrix<T>(rates, "rates");
+            an::CellStats s;
+            {
+                pyb::gil_scoped_release release;
+                s = an::cell_stats(an::rate_maps<T>(xs, ys, r, {gridsize, quantile, extent_of(extent)}));
+            }
+            return stats_dict(s);
+        },
+        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
+        pyb::arg("extent"));
+    a.def(
+        "analyze",
+        [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile, double eps,
+           int min_samples, double d_th, const MaybeExtent& extent) {
+            const auto xs = span1d(x, "x"), ys = span1d(y, "y");
+            const auto r = matrix<T>(rates, "rates");
+            an::TrialMetrics m;
+            {
+                pyb::gil_scoped_release release;
+                m = an::analyze_trial<T>(xs, ys, r, {gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent)});
+            }
+            pyb::dict d;
+            d["centers"] = numpy_of(m.maps.bins.centers);
+            d["counts"] = numpy_of(m.maps.bins.counts);
+            d["mean_maps"] = numpy_of(m.maps.mean);
+            d["maps"] = numpy_of(m.maps.map);
+            d["bin_area_m2"] = m.maps.bins.grid.bin_area();
+            d["modality"] = numpy_of(m.modality);
+            d["modality_summary"] = summary_dict(m.modality_summary);
+            d["sai"] = to_numpy(m.aliasing.sai.data(), {m.aliasing.sai.size()});
+            d["msai"] = m.aliasing.msai;
+            d["decoding"] = decoding_dict(m.decoding);
+            d["cells"] = stats_dict(m.cells);
+            return d;
+        },
+        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
+        pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"));
+}
+
+}  // namespace
+
+void bind_analysis(pyb::module_& m) {
+    auto a = m.def_submodule("analysis", "Analysis stage (use bvc3d.analysis)");
+    bind_sample_functions<float>(a);  // first: taken only for float32 input, without conversion
+    bind_sample_functions<double>(a);
+
+    a.def(
+        "dbscan_cluster_count",
+        [](const ArrayD& points, double eps, int min_samples) {
+            const auto p = centers_of(points);
+            pyb::gil_scoped_release release;
+            return an::dbscan_cluster_count(p, {eps, min_samples});
+        },
+        pyb::arg("points"), pyb::arg("eps"), pyb::arg("min_samples"));
+    a.def(
+        "radius_neighbors",
+        [](const ArrayD& points, double eps) {
+            const auto p = centers_of(points);
+            an::Neighborhoods nb;
+            {
+                pyb::gil_scoped_release release;
+                nb = an::sklearn_radius_neighbors(p, eps);
+            }
+            return pyb::make_tuple(numpy_of(nb.offsets), numpy_of(nb.indices));
+        },
+        pyb::arg("points"), pyb::arg("eps"));
+    a.def(
+        "modality",
+        [](const ArrayD& centers, const ArrayD& maps, double eps, int min_samples) {
+            const auto c = centers_of(centers);
+            const auto mp = matrix<double>(maps, "maps");
+            std::vector<int> mi;
+            {
+                pyb::gil_scoped_release release;
+                mi = an::modality(c, mp, {eps, min_samples});
+            }
+            return numpy_of(mi);
+        },
+        pyb::arg("centers"), pyb::arg("maps"), pyb::arg("eps"), pyb::arg("min_samples"));
+    a.def(
+        "modality_summary",
+        [](const pyb::array_t<int, pyb::array::c_style | pyb::array::forcecast>& counts) {
+            if (counts.ndim() != 1) throw InputError("counts must be 1-D");
+            return summary_dict(an::summarize_modality({counts.data(), static_cast<std::size_t>(counts.shape(0))}));
+        },
+        pyb::arg("counts"));
+    a.def(
+        "percentile",
+        [](const ArrayD& values, double percent) {
+            std::vector<double> v(values.data(), values.data() + values.size());
+            return an::percentile_linear(v, percent);
+        },
+        pyb::arg("values"), pyb::arg("percent"), "numpy.percentile(values, percent), linear (for tests)");
+    a.def(
+        "aliasing",
+        [](const ArrayD& centers, const ArrayD& maps, double d_th) {
+            const auto c = centers_of(centers);
+            const auto mp = matrix<double>(maps, "maps");
+            an::AliasingResult r;
+            {
+                pyb::gil_scoped_release release;
+                r = an::spatial_aliasing(c, mp, d_th);
+            }
+            return pyb::make_tuple(to_numpy(r.sai.data(), {r.sai.size()}), r.msai);
+        },
+        pyb::arg("centers"), pyb::arg("maps"), pyb::arg("d_th"));
+}
 
 }  // namespace bvc3d::py

@@ -6,7 +6,8 @@ Stages follow the data flow: World -> Sensor scan -> BoundaryVectorLayer -> Plac
 """
 from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Sensor, World, model_presets, model_sensor,
                     random_walk)
+from . import analysis
 
-__all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Sensor", "World", "model_presets",
+__all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Sensor", "World", "analysis", "model_presets",
            "model_sensor", "random_walk"]
 __version__ = "0.1.0"

@@ -1,0 +1,243 @@
+"""Analysis of recorded samples (SPEC §8): rate maps, modality index, spatial aliasing,
+localisation error and per-cell statistics. numpy in, numpy out; the work is done in C++.
+
+Conventions (docs/analysis.md has the details):
+
+* Bins are exactly matplotlib 3.6.3's ``Axes.hexbin(x, y, C, gridsize, extent,
+  reduce_C_function=numpy.mean)`` bins: same extent rule (data min/max made nonsingular, x padded
+  by 1e-9 of its range), same two lattices and tie-breaking, same bin order, only visited bins.
+* Values may be float32 (read as is) or float64 (anything else is converted); means are summed in
+  float64 either way.
+* The modality index is scikit-learn 1.2.1's ``DBSCAN(eps, min_samples).fit(points)`` cluster
+  count, reproduced down to points at exactly ``eps``.
+* Every function raises ValueError on bad input (mismatched lengths, non-finite coordinates or
+  values, gridsize < 2, quantile outside [0, 1], eps <= 0, ...).
+"""
+import numbers
+
+import numpy as np
+
+from ._core import analysis as _an
+
+__all__ = [
+    "hexbin",
+    "rate_maps",
+    "modality",
+    "modality_summary",
+    "dbscan_cluster_count",
+    "aliasing",
+    "decoding_error",
+    "cell_stats",
+    "analyze",
+]
+
+
+def _positions(x, y):
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    if x.ndim != 1 or y.ndim != 1:
+        raise ValueError(f"x and y must be 1-D arrays, got shapes {x.shape} and {y.shape}")
+    if x.shape != y.shape:
+        raise ValueError(f"x and y must have the same length, got {len(x)} and {len(y)}")
+    return x, y
+
+
+def _samples(values, n, name):
+    """(n,) or (n, C) float32/float64 C-contiguous; returns (array 2-D, was_1d)."""
+    v = np.asarray(values)
+    v = np.ascontiguousarray(v, dtype=np.float32 if v.dtype == np.float32 else np.float64)
+    if v.ndim not in (1, 2):
+        raise ValueError(f"{name} must be (n,) or (n, n_cells), got shape {v.shape}")
+    if v.shape[0] != n:
+        raise ValueError(f"{name} must have one row per sample: {v.shape[0]} rows for {n} samples")
+    return (v.reshape(n, 1), True) if v.ndim == 1 else (v, False)
+
+
+def _gridsize(gridsize):
+    if isinstance(gridsize, bool) or not isinstance(gridsize, numbers.Integral):
+        raise ValueError(f"gridsize must be an integer, got {gridsize!r}")
+    if gridsize < 2:
+        raise ValueError(f"gridsize must be >= 2 (matplotlib's grid has int(gridsize / sqrt(3)) rows), got {gridsize}")
+    return int(gridsize)
+
+
+def _extent(extent):
+    if extent is None:
+        return None
+    e = np.asarray(extent, dtype=np.float64).ravel()
+    if e.shape != (4,):
+        raise ValueError(f"extent must be (xmin, xmax, ymin, ymax), got {extent!r}")
+    return tuple(float(v) for v in e)
+
+
+def _quantile(q):
+    q = float(q)
+    if not 0.0 <= q <= 1.0:
+        raise ValueError(f"quantile must lie in [0, 1], got {q}")
+    return q
+
+
+def _dbscan_params(eps, min_samples):
+    eps = float(eps)
+    if not eps > 0 or not np.isfinite(eps):
+        raise ValueError(f"eps must be a positive number, got {eps}")
+    if isinstance(min_samples, bool) or not isinstance(min_samples, numbers.Integral) or min_samples < 1:
+        raise ValueError(f"min_samples must be an integer >= 1, got {min_samples!r}")
+    return eps, int(min_samples)
+
+
+def _d_th(d_th):
+    d_th = float(d_th)
+    if not d_th >= 0 or not np.isfinite(d_th):
+        raise ValueError(f"d_th must be a finite distance >= 0, got {d_th}")
+    return d_th
+
+
+def _centers_maps(centers, maps):
+    c = np.ascontiguousarray(centers, dtype=np.float64)
+    if c.ndim != 2 or c.shape[1] != 2:
+        raise ValueError(f"centers must be an (N, 2) array, got shape {c.shape}")
+    m = np.ascontiguousarray(maps, dtype=np.float64)
+    was_1d = m.ndim == 1
+    if was_1d:
+        m = m.reshape(-1, 1)
+    if m.ndim != 2 or m.shape[0] != c.shape[0]:
+        raise ValueError(f"maps must be (N,) or (N, n_cells) with N = {c.shape[0]} bins, got shape {np.shape(maps)}")
+    return c, m, was_1d
+
+
+def hexbin(x, y, values, gridsize=50, extent=None):
+    """Mean of ``values`` per hexagonal bin, exactly as matplotlib's hexbin computes it.
+
+    Parameters: x, y (n,) positions; values (n,) or (n, C) (float32 or float64), all columns
+    binned in one pass; gridsize hexagons across x; extent (xmin, xmax, ymin, ymax) or None for the
+    data's own min/max.
+
+    Returns ``(centers (B, 2), means (B,) or (B, C), counts (B,))`` over the B visited bins in
+    matplotlib's order: ``centers`` equals ``PolyCollection.get_offsets()`` and each column of
+    ``means`` equals ``get_array()`` of ``ax.hexbin(x, y, C=column, gridsize=gridsize,
+    extent=extent, reduce_C_function=numpy.mean)``. Points whose bin falls outside an explicit
+    extent are dropped, as matplotlib drops them.
+    """
+    x, y = _positions(x, y)
+    v, was_1d = _samples(values, len(x), "values")
+    centers, means, counts = _an.hexbin(x, y, v, _gridsize(gridsize), _extent(extent))
+    return centers, (means[:, 0] if was_1d else means), counts
+
+
+def rate_maps(x, y, rates, gridsize=50, quantile=0.1, extent=None):
+    """Thresholded, normalised rate maps (SPEC §8).
+
+    Per cell (column of ``rates``): the mean rate per visited bin (``hexbin``), then values below
+    ``numpy.percentile(cell_map, 100 * quantile)`` (linear) set to 0, then the map divided by its
+    maximum. A cell whose maximum is <= 0 (silent) gets an all-zero map (never NaN).
+
+    Returns ``(centers (B, 2), maps (B, n_cells))`` (``maps`` is (B,) for 1-D ``rates``).
+    """
+    x, y = _positions(x, y)
+    r, was_1d = _samples(rates, len(x), "rates")
+    centers, maps, _, _ = _an.rate_maps(x, y, r, _gridsize(gridsize), _quantile(quantile), _extent(extent))
+    return centers, (maps[:, 0] if was_1d else maps)
+
+
+def dbscan_cluster_count(points, eps=1.0, min_samples=20):
+    """Number of clusters ``sklearn.cluster.DBSCAN(eps, min_samples).fit(points)`` finds
+    (labels >= 0), for (N, 2) points; identical to scikit-learn 1.2.1 for any input, including
+    points at exactly ``eps`` from each other. 0 for no points."""
+    p = np.ascontiguousarray(points, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise ValueError(f"points must be an (N, 2) array, got shape {p.shape}")
+    eps, min_samples = _dbscan_params(eps, min_samples)
+    return int(_an.dbscan_cluster_count(p, eps, min_samples))
+
+
+def modality(centers, maps, eps=1.0, min_samples=20):
+    """Modality index per cell: the DBSCAN cluster count (``dbscan_cluster_count``) over the
+    centres of the bins where the cell's map is > 0, in bin order.
+
+    Returns an int array (n_cells,) (an int for 1-D ``maps``).
+    """
+    c, m, was_1d = _centers_maps(centers, maps)
+    eps, min_samples = _dbscan_params(eps, min_samples)
+    mi = np.asarray(_an.modality(c, m, eps, min_samples), dtype=np.int64)
+    return int(mi[0]) if was_1d else mi
+
+
+def modality_summary(counts):
+    """The paper's three figures from per-cell modality indices: ``frac_active`` (fraction of all
+    cells with MI > 0), ``mean_mi_active`` (mean MI over cells with MI > 0, NaN if none),
+    ``frac_multimodal`` (fraction of all cells with MI > 1). NaN everywhere for no cells."""
+    counts = np.asarray(counts)
+    if counts.ndim != 1:
+        raise ValueError(f"counts must be 1-D, got shape {counts.shape}")
+    if counts.size and not np.issubdtype(counts.dtype, np.integer):
+        raise ValueError(f"counts must be integers, got dtype {counts.dtype}")
+    return dict(_an.modality_summary(counts.astype(np.int64, copy=False)))
+
+
+def aliasing(centers, maps, d_th=2.0):
+    """Spatial aliasing (SPEC §8).
+
+    ``SAI_i = (1/N) * sum over j != i with |c_i - c_j| > d_th of cos(a_i, a_j)`` where a_i is row i
+    of ``maps`` (the population vector of bin i), cos = 0 when either vector is zero and N is the
+    number of bins; distances are ``sqrt(dx**2 + dy**2)``. Returns ``(sai (B,), msai)``, msai = mean
+    SAI (NaN for no bins).
+    """
+    c, m, _ = _centers_maps(centers, maps)
+    sai, msai = _an.aliasing(c, m, _d_th(d_th))
+    return sai, float(msai)
+
+
+def decoding_error(x, y, rates, gridsize=50, extent=None):
+    """Localisation error of a population-vector decoder (SPEC §8).
+
+    Templates: the mean rate of every cell in every bin visited by the first half of the samples
+    (raw means on the trial's grid, whose extent comes from all samples unless given). Each
+    sample of the second half is decoded to the bin whose template is most cosine-similar to the
+    sample's rates (ties: first bin in matplotlib's order); its error is the distance from its true
+    position to that bin's centre. Samples with no positive similarity to any template (e.g. all
+    cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of the
+    statistics.
+
+    Returns a dict: ``median_m``, ``mean_m`` (NaN if nothing was decoded), ``n_decoded``,
+    ``n_undecoded``.
+    """
+    x, y = _positions(x, y)
+    r, _ = _samples(rates, len(x), "rates")
+    return dict(_an.decoding_error(x, y, r, _gridsize(gridsize), _extent(extent)))
+
+
+def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
+    """Per-cell statistics from the rate maps, as a dict of (n_cells,) arrays:
+
+    * ``peak_rate``: maximum of the cell's mean-rate map;
+    * ``mean_rate``: occupancy-weighted mean rate, sum_b p_b * rate_b with p_b = count_b / n;
+    * ``field_area_m2``: number of bins whose normalised map (``rate_maps``) is > 0.5 times the
+      area of one hexagon (sx * sy / 2);
+    * ``spatial_info``: Skaggs information sum_b p_b rate_b log2(rate_b / mean_rate) in bits per
+      sample (bins with rate <= 0 add nothing; 0 for a silent cell);
+    * ``spatial_info_per_rate``: the same divided by mean_rate (Skaggs' bits per spike; NaN for a
+      silent cell).
+    """
+    x, y = _positions(x, y)
+    r, _ = _samples(rates, len(x), "rates")
+    return {k: np.asarray(v) for k, v in
+            _an.cell_stats(x, y, r, _gridsize(gridsize), _quantile(quantile), _extent(extent)).items()}
+
+
+def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_th=2.0, extent=None):
+    """Every metric of one trial in one call (the C++ entry point the experiment uses).
+
+    Returns a dict: ``centers``, ``counts``, ``mean_maps``, ``maps``, ``bin_area_m2``,
+    ``modality``, ``modality_summary`` (dict), ``sai``, ``msai``, ``decoding`` (dict as
+    ``decoding_error``; same grid as the maps), ``cells`` (dict as ``cell_stats``).
+    """
+    x, y = _positions(x, y)
+    r, _ = _samples(rates, len(x), "rates")
+    eps, min_samples = _dbscan_params(eps, min_samples)
+    out = dict(_an.analyze(x, y, r, _gridsize(gridsize), _quantile(quantile), eps, min_samples, _d_th(d_th),
+                           _extent(extent)))
+    out["decoding"] = dict(out["decoding"])
+    out["modality_summary"] = dict(out["modality_summary"])
+    out["cells"] = dict(out["cells"])
+    return out

@@ -1,0 +1,70 @@
+#pragma once
+// Hexagonal binning exactly as matplotlib 3.6.3's Axes.hexbin(x, y, C, gridsize, extent,
+// reduce_C_function=numpy.mean) does it (SPEC §8), for many value columns in one pass.
+// Takes: sample positions (x, y) and values (one row per sample). Gives: the visited bins in
+// matplotlib's order, their centres, sample counts and per-column means.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "bvc3d/analysis/types.hpp"
+
+namespace bvc3d::analysis {
+
+// matplotlib.transforms.nonsingular(vmin, vmax, expander, tiny=1e-15, increasing=True).
+std::array<double, 2> nonsingular(double vmin, double vmax, double expander);
+
+// Two interleaved rectangular lattices of hexagon centres. Lattice 1 has (nx+1)·(ny+1) centres at
+// (i·sx + xmin, j·sy + ymin); lattice 2 has nx·ny centres offset by half a step in x and y.
+// A flat bin index runs over lattice 1 (i·(ny+1) + j) and then lattice 2 (offset + i·ny + j):
+// matplotlib's order of bins.
+struct HexGrid {
+    int nx = 0, ny = 0;         // nx = gridsize, ny = int(gridsize / sqrt(3))
+    double xmin = 0, ymin = 0;  // lower-left lattice point (xmin includes matplotlib's padding)
+    double sx = 0, sy = 0;      // lattice steps: hexagons are sx wide, rows sy apart
+
+    // The grid matplotlib builds: extent = the data's min/max made nonsingular (expander 0.1)
+    // unless given; then x (only x) is padded by 1e-9 of its range; sx = width/nx, sy = height/ny.
+    // gridsize must be >= 2 (below that matplotlib's grid has no rows).
+    static HexGrid fit(std::span<const double> x, std::span<const double> y, int gridsize,
+                       const std::optional<Extent>& extent = {});
+
+    int size() const { return (nx + 1) * (ny + 1) + nx * ny; }
+    int lattice1_size() const { return (nx + 1) * (ny + 1); }
+    // Flat index of the bin holding (x, y), -1 if that bin lies outside the grid (matplotlib drops
+    // such points). Nearest centre in the metric dx² + 3·dy² of lattice units; a tie goes to lattice 2.
+    int bin_of(double x, double y) const;
+    std::array<double, 2> center(int bin) const;
+    // Area of one hexagon, m² when x, y are in metres: the two lattices tile each sx × sy cell twice.
+    double bin_area() const { return 0.5 * sx * sy; }
+};
+
+// Samples assigned to the visited bins of a grid.
+struct HexBins {
+    HexGrid grid;
+    std::vector<int> bins;              // flat grid index of each visited bin, ascending
+    Centers centers;                    // centre of each visited bin
+    std::vector<std::int64_t> counts;   // samples in each visited bin
+    std::vector<int> sample_bin;        // per sample: row in `bins`, or -1 outside the grid
+    int size() const { return static_cast<int>(bins.size()); }
+};
+
+// Coordinates must have equal lengths and be finite (InputError otherwise).
+HexBins bin_samples(const HexGrid& grid, std::span<const double> x, std::span<const double> y);
+HexBins hexbin(std::span<const double> x, std::span<const double> y, int gridsize = 50,
+               const std::optional<Extent>& extent = {});
+
+// Per visited bin, the mean of each column of `values` (one row per sample, finite) over the
+// bin's samples: numpy.mean for every column at once, summed in double.
+template <class T>
+RowMatrixXd bin_means(const HexBins& bins, const Eigen::Ref<const RowMatrixX<T>>& values);
+
+// Throws InputError unless x and y have equal lengths and finite entries.
+void check_positions(std::span<const double> x, std::span<const double> y);
+// Throws InputError unless `values` has `n` rows and only finite entries.
+template <class T>
+void check_values(const Eigen::Ref<const RowMatrixX<T>>& values, std::size_t n, const char* what);
+
+}  // namespace bvc3d::analysis
