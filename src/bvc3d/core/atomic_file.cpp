@@ -53,6 +53,14 @@ void ensure_writable_directory(const std::filesystem::path& dir) {
         if (!std::filesystem::is_directory(dir, ec))
             throw InputError("output folder '" + dir.string() + "' exists and is not a folder");
     } else {
+        // Name the ancestor that is in the way, if one is a file.
+        for (auto p = dir.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
+            if (std::filesystem::exists(p, ec)) {
+                if (!std::filesystem::is_directory(p, ec))
+                    throw InputError("cannot create output folder '" + dir.string() + "': '" + p.string() +
+                                     "' is not a folder");
+                break;
+            }
         std::filesystem::create_directories(dir, ec);
         if (ec) throw InputError("cannot create output folder '" + dir.string() + "': " + ec.message());
     }

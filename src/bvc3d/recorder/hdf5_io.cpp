@@ -20,11 +20,8 @@ void check(herr_t e, const std::string& what) {
     if (e < 0) fail(what);
 }
 
-// Quiet HDF5's own error printing once; our exceptions say what failed.
-void silence() {
-    static std::once_flag once;
-    std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
-}
+// Quiet HDF5's own error printing (per thread in thread-safe builds); our exceptions say what failed.
+void silence() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
 template <class T>
 void write_any(hid_t loc, const std::string& name, const std::vector<T>& v, std::vector<std::size_t> shape,
@@ -125,13 +122,14 @@ bool exists(hid_t loc, const std::string& name) {
 
 void write_attr(hid_t obj, const std::string& name, const std::string& value) {
     auto lock = hdf5_lock();
+    // Variable-length UTF-8: h5py reads it as a Python str.
     Handle type(check(H5Tcopy(H5T_C_S1), "type"), H5Tclose);
-    check(H5Tset_size(type, std::max<std::size_t>(value.size(), 1)), "type size");
+    check(H5Tset_size(type, H5T_VARIABLE), "type size");
     check(H5Tset_cset(type, H5T_CSET_UTF8), "cset");
     Handle space(check(H5Screate(H5S_SCALAR), "space"), H5Sclose);
     Handle a = attr_for_write(obj, name, type, space);
-    const std::string padded = value.empty() ? std::string(1, '\0') : value;
-    check(H5Awrite(a, type, padded.data()), "write attribute " + name);
+    const char* text = value.c_str();
+    check(H5Awrite(a, type, &text), "write attribute " + name);
 }
 
 void write_attr(hid_t obj, const std::string& name, double value) {
@@ -157,6 +155,7 @@ std::string read_attr_string(hid_t obj, const std::string& name) {
         char* s = nullptr;
         Handle mem(check(H5Tcopy(H5T_C_S1), "type"), H5Tclose);
         check(H5Tset_size(mem, H5T_VARIABLE), "size");
+        check(H5Tset_cset(mem, H5Tget_cset(type)), "cset");
         check(H5Aread(a, mem, &s), "read attribute " + name);
         std::string out = s ? s : "";
         Handle space(check(H5Aget_space(a), "space"), H5Sclose);
