@@ -38,6 +38,26 @@ void BM_ModelStep(benchmark::State& state, std::string preset) {
     }
 }
 
+// What a trial does per model step: cast the rows the model needs, BVC rates, place cells learning.
+void BM_FullStep(benchmark::State& state, std::string preset) {
+    const ModelSpec model = model_preset(preset);
+    const World world = World::cross({.tilt_deg = 45});
+    const Lidar lidar(model.sensor);
+    const BoundaryVectorLayer layer(model.bvc);
+    const auto plan = layer.plan(model.sensor);
+    PlaceCellNetwork net(model.bvc.n_cells(), model.place, 1);
+    const auto walk = random_walk(world, 0.1, 1);
+    std::vector<double> rates(layer.n_cells());
+    Scan scan;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        const auto& s = walk[i++ % walk.size()];
+        lidar.scan(world, Pose{s.x, s.y, s.heading}, scan, {}, plan.rows);
+        if (!layer.rates_pruned(scan, plan, rates)) state.SkipWithError("pruning bound failed");
+        benchmark::DoNotOptimize(net.step(rates, true).data());
+    }
+}
+
 void BM_BvcOnly(benchmark::State& state, std::string preset) {
     const Inputs in = inputs(preset);
     const BoundaryVectorLayer layer(in.model.bvc);
@@ -94,6 +114,11 @@ BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_1, std::string("3d-0.1"))->Unit(benchmark::
 BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_2, std::string("3d-0.2"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 3d_3l, std::string("3d-3l"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 2d_8beam, std::string("2d-8beam"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FullStep, 2d, std::string("2d"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FullStep, 3d_0_1, std::string("3d-0.1"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FullStep, 3d_0_2, std::string("3d-0.2"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FullStep, 3d_3l, std::string("3d-3l"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FullStep, 2d_8beam, std::string("2d-8beam"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_BvcOnly, 2d, std::string("2d"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_BvcOnly, 3d_3l, std::string("3d-3l"))->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PlaceCellsOnly)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "bvc3d/bvc/bvc_kernels.hpp"
 #include "bvc3d/core/angles.hpp"
@@ -11,13 +12,18 @@ namespace bvc3d {
 
 namespace {
 
-// A factor exp(-x²/2σ²) below this (relative to its peak) is treated as zero. Each pruned term is
-// then below tiny × (product of the peaks), and raw_pruned checks that their sum cannot reach
-// 1e-7 of the step's largest sum (SPEC §5 asks for 1e-6 of the largest rate).
-constexpr double tiny = 1e-13;
+// A factor exp(-x²/2σ²) below tiny_* (relative to its peak) is treated as zero. raw_pruned bounds
+// what that drops with the step's own weight sums and checks that it cannot reach 1e-7 of the
+// step's largest sum (SPEC §5 asks for 1e-6 of the largest rate); otherwise the full sum is used.
+// Elevation has two tiers: a (return, layer) below tiny_row is not summed but its exact weight
+// enters the bound; below tiny_phi it is not even evaluated and a worst case enters the bound.
+constexpr double tiny_r = 1e-9;
+constexpr double tiny_theta = 1e-10;
+constexpr double tiny_row = 1e-8;
+constexpr double tiny_phi = 1e-13;
 constexpr double pruned_tolerance = 1e-7;
 
-double window(double sigma) { return sigma * std::sqrt(2.0 * std::log(1.0 / tiny)); }
+double window(double sigma, double tiny) { return sigma * std::sqrt(2.0 * std::log(1.0 / tiny)); }
 double gauss_norm(double sigma) { return 1.0 / std::sqrt(two_pi * sigma * sigma); }
 
 }  // namespace
@@ -68,17 +74,30 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     c_r_ = gauss_norm(p_.sigma_r);
     c_theta_ = gauss_norm(p_.sigma_theta);
     c_phi_ = gauss_norm(p_.sigma_phi);
-    cut_r_ = window(p_.sigma_r);
-    cut_theta_ = window(p_.sigma_theta);
-    cut_phi_ = window(p_.sigma_phi);
+    cut_r_ = window(p_.sigma_r, tiny_r);
+    cut_theta_ = window(p_.sigma_theta, tiny_theta);
+    cut_phi_ = window(p_.sigma_phi, tiny_phi);
+    cut_row_ = window(p_.sigma_phi, tiny_row);
     const double d = p_.spacing();
     // Padded with zeros to a multiple of 8 for the vector kernel.
     const int padded = (p_.n_per_axis + 7) / 8 * 8;
     dist_decay_.assign(padded, 0.0);
     for (int n = 0; n < p_.n_per_axis; ++n) dist_decay_[n] = std::exp(-0.5 * (n * d) * (n * d) / (p_.sigma_r * p_.sigma_r));
     profile_.assign(padded, 0.0);
-    weights_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
-    rows_.assign(weights_.size(), nullptr);
+    row_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
+    rows_.assign(row_weight_.size(), nullptr);
+    elev_.assign(p_.n_layers(), 0.0);
+    dropped_e_.assign(p_.n_layers(), 0.0);
+    kept_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
+    layer_weight_.assign(p_.n_layers(), 0.0);
+    far_weight_.assign(p_.n_layers(), 0.0);
+    dropped_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
+    axis_stride_ = padded + 8;
+    padded_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir * axis_stride_, 0.0);
+    cache_key_.assign(cache_slots, NAN);
+    cache_count_.assign(cache_slots, 0);
+    cache_dir_.assign(cache_slots * p_.n_dir, 0);
+    cache_weight_.assign(cache_slots * p_.n_dir, 0.0);
 }
 
 void BoundaryVectorLayer::check_return(const LidarReturn& r, std::size_t index) {
@@ -95,77 +114,97 @@ namespace {
 bool is_no_return(const LidarReturn& r) { return std::isnan(r.range) || r.range == INFINITY; }
 }  // namespace
 
-bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, std::size_t n_bound,
-                                     std::span<double> out) const {
-    std::fill(out.begin(), out.end(), 0.0);
-    const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis;
+bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan,
+                                     std::span<double> result) const {
+    // Sums go to a buffer whose axes are padded by one 8-lane block, so the vector kernel never
+    // needs a scalar tail; they are copied to `result` at the end.
+    const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis, stride = axis_stride_;
+    std::fill(padded_.begin(), padded_.end(), 0.0);
+    double* out_data = padded_.data();
     const bool planar = p_.elevations.empty();
-    const double dd = p_.spacing(), dtheta = two_pi / K;
-    const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r), h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta),
-                 h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
+    const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
+    const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r), h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
     // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
     // keeps the power recurrence below far from overflow.
     const bool recurrence = dd > 0 && dd <= p_.sigma_r;
-    double elev_w[64];
-    std::vector<double> elev_heap;
-    double* elev = L <= 64 ? elev_w : (elev_heap.resize(L), elev_heap.data());
+    // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_).
+    std::vector<double>& elev = elev_;
+    std::vector<double>& dropped_e = dropped_e_;
+    // For the truncation bound: per (layer, direction) the kept weights Σ E·A and the dropped ones,
+    // per layer Σ E over returns that reach it and Σ E over those whose distance window is empty.
+    std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
+    std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
+    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
+    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
     std::size_t valid = 0;
     double last_phi = NAN;
-    bool any_layer = true;
+    bool any_kept = true, any_dropped = false, skipped_row = false;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
         const LidarReturn& ret = returns[j];
         if (is_no_return(ret)) continue;
         check_return(ret, j);
-        ++valid;
         // Elevation factors, cached across the returns of one scanner row.
         if (!(ret.elevation == last_phi)) {
             last_phi = ret.elevation;
-            any_layer = false;
+            skipped_row = plan && std::find(plan->skipped_rows.begin(), plan->skipped_rows.end(), ret.elevation) !=
+                                      plan->skipped_rows.end();
+            any_kept = any_dropped = false;
             for (int l = 0; l < L; ++l) {
+                elev[l] = dropped_e[l] = 0.0;
                 if (planar) {
                     elev[l] = 1.0;
                 } else {
                     const double x = ret.elevation - p_.elevations[l];
-                    elev[l] = std::abs(x) <= cut_phi_ ? c_phi_ * std::exp(-x * x * h_p) : 0.0;
+                    if (std::abs(x) <= cut_row_) elev[l] = c_phi_ * std::exp(-x * x * h_p);
+                    else if (std::abs(x) <= cut_phi_) dropped_e[l] = c_phi_ * std::exp(-x * x * h_p);
                 }
-                any_layer = any_layer || elev[l] > 0.0;
+                any_kept = any_kept || elev[l] > 0.0;
+                any_dropped = any_dropped || dropped_e[l] > 0.0;
             }
         }
-        if (!any_layer) continue;
+        if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
+        ++valid;
+        if (!any_kept && !any_dropped) continue;
+        const std::size_t slot = angular(ret.azimuth);
+        const int* dir = cache_dir_.data() + slot * K;
+        const double* ang = cache_weight_.data() + slot * K;
+        const int n_dirs = cache_count_[slot];
+        for (int l = 0; l < L; ++l) {
+            layer_weight_[l] += elev[l] + dropped_e[l];
+            if (dropped_e[l] > 0.0)
+                for (int d = 0; d < n_dirs; ++d)
+                    dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
+        }
+        if (!any_kept) continue;
 
-        // Distance window [m_lo, m_hi] and the profile c_r·exp(-(r - d_m)²/2σ²) across it.
+        // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
+        // truncation toward zero serves for floor and ceil (r >= 0; no libm call on baseline x86-64).
         const double r = ret.range;
         int m_lo = 0, m_hi = 0;
         if (dd > 0) {
-            m_lo = std::max(0, static_cast<int>(std::ceil((r - cut_r_) / dd)));
-            m_hi = std::min(M - 1, static_cast<int>(std::floor((r + cut_r_) / dd)));
+            const double lo = (r - cut_r_) * inv_dd, hi = (r + cut_r_) * inv_dd;
+            m_lo = lo > 0 ? static_cast<int>(std::min(lo, 1e9)) : 0;
+            m_hi = static_cast<int>(std::min(hi, static_cast<double>(M - 2))) + 1;
         } else if (r > cut_r_) {
+            m_lo = 1;  // no cell in reach
+        }
+        if (m_lo > m_hi) {
+            for (int l = 0; l < L; ++l) far_weight_[l] += elev[l];
             continue;
         }
-        if (m_lo > m_hi) continue;
         const int W = m_hi - m_lo + 1;
 
         // The (layer, direction) rows this return feeds, with their elevation × angular weights.
         int count = 0;
-        int k_first = 0, k_last = K - 1;
-        const bool all_dirs = 2.0 * cut_theta_ >= two_pi;
-        if (!all_dirs) {
-            k_first = static_cast<int>(std::ceil((ret.azimuth - cut_theta_) / dtheta));
-            k_last = static_cast<int>(std::floor((ret.azimuth + cut_theta_) / dtheta));
-        }
-        for (int ki = k_first; ki <= k_last; ++ki) {
-            const double x = all_dirs ? wrap_pi(ret.azimuth - ki * dtheta) : ret.azimuth - ki * dtheta;
-            if (std::abs(x) > cut_theta_) continue;
-            const double ang = c_theta_ * std::exp(-x * x * h_t);
-            const int k = ((ki % K) + K) % K;
+        for (int d = 0; d < n_dirs; ++d)
             for (int l = 0; l < L; ++l) {
                 if (elev[l] == 0.0) continue;
-                weights_[count] = elev[l] * ang;
-                rows_[count] = out.data() + (static_cast<std::size_t>(l) * K + k) * M + m_lo;
+                row_weight_[count] = elev[l] * ang[d];
+                kept_weight_[static_cast<std::size_t>(l) * K + dir[d]] += row_weight_[count];
+                rows_[count] = out_data + (static_cast<std::size_t>(l) * K + dir[d]) * stride + m_lo;
                 ++count;
             }
-        }
         if (count == 0) continue;
 
         // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
@@ -173,20 +212,64 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, std::
             // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return.
             const double x0 = r - m_lo * dd;
             kernels::add_distance_profile(c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd),
-                                          dist_decay_.data(), W, weights_.data(), rows_.data(), count,
+                                          dist_decay_.data(), W, row_weight_.data(), rows_.data(), count,
                                           profile_.data());
         } else {
             for (int n = 0; n < W; ++n) {
                 const double x = r - (m_lo + n) * dd;
                 const double u = c_r_ * std::exp(-h_r * x * x);
-                for (int i = 0; i < count; ++i) rows_[i][n] += weights_[i] * u;
+                for (int i = 0; i < count; ++i) rows_[i][n] += row_weight_[i] * u;
             }
         }
     }
-    const double peak_term = c_r_ * c_theta_ * (planar ? 1.0 : c_phi_);
-    const double max_raw = out.empty() ? 0.0 : *std::max_element(out.begin(), out.end());
-    const double bound = static_cast<double>(std::max(valid, n_bound)) * peak_term * tiny;
+    for (int axis = 0; axis < L * K; ++axis)
+        std::copy(out_data + static_cast<std::size_t>(axis) * stride, out_data + static_cast<std::size_t>(axis) * stride + M,
+                  result.begin() + static_cast<std::ptrdiff_t>(axis) * M);
+
+    // Every pruned term of cell (l, k, m) is one of: a distance factor below tiny_r of a kept
+    // (return, layer, direction); an angular factor below tiny_theta of a (return, layer) whose
+    // elevation factor was evaluated; a (return, layer, direction) whose elevation factor is below
+    // tiny_row (its weight E·A is known exactly, D <= c_r); an elevation factor below tiny_phi
+    // (worst case, for every beam cast or not); the distance factor of a return whose whole window
+    // was empty; a row the plan did not cast (bounded by the plan).
+    double bound = 0;
+    for (int l = 0; l < L; ++l)
+        for (int k = 0; k < K; ++k) {
+            const std::size_t lk = static_cast<std::size_t>(l) * K + k;
+            bound = std::max(bound, kept_weight_[lk] * c_r_ * tiny_r + dropped_weight_[lk] * c_r_ +
+                                        layer_weight_[l] * c_theta_ * c_r_ * tiny_theta +
+                                        far_weight_[l] * c_theta_ * c_r_ * tiny_r +
+                                        (plan ? plan->skipped_bound[l] : 0.0));
+        }
+    const std::size_t n_beams = std::max(valid, plan ? plan->beams : std::size_t{0});
+    if (!planar) bound += static_cast<double>(n_beams) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
+    const double max_raw = result.empty() ? 0.0 : *std::max_element(result.begin(), result.end());
     return bound <= pruned_tolerance * max_raw;
+}
+
+std::size_t BoundaryVectorLayer::angular(double azimuth) const {
+    std::uint64_t bits;
+    std::memcpy(&bits, &azimuth, sizeof bits);
+    const std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 54);
+    if (cache_key_[slot] == azimuth) return slot;
+    const int K = p_.n_dir;
+    const double dtheta = two_pi / K, h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta);
+    const bool all_dirs = 2.0 * cut_theta_ >= two_pi;
+    const int k_first = all_dirs ? 0 : static_cast<int>(std::ceil((azimuth - cut_theta_) / dtheta));
+    const int k_last = all_dirs ? K - 1 : static_cast<int>(std::floor((azimuth + cut_theta_) / dtheta));
+    int count = 0;
+    int* dir = cache_dir_.data() + slot * K;
+    double* weight = cache_weight_.data() + slot * K;
+    for (int ki = k_first; ki <= k_last; ++ki) {
+        const double x = all_dirs ? wrap_pi(azimuth - ki * dtheta) : azimuth - ki * dtheta;
+        if (std::abs(x) > cut_theta_) continue;
+        dir[count] = ((ki % K) + K) % K;
+        weight[count] = c_theta_ * std::exp(-x * x * h_t);
+        ++count;
+    }
+    cache_count_[slot] = count;
+    cache_key_[slot] = azimuth;
+    return slot;
 }
 
 void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const {
@@ -221,23 +304,28 @@ void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::s
 }
 
 void BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out) const {
+    // For each direction, the first return with the smallest |wrap(azimuth - θ_k)|.
     const int K = p_.n_dir, M = p_.n_per_axis;
-    for (int k = 0; k < K; ++k) {
-        const double theta_k = k * two_pi / K;
-        std::size_t best = returns.size();
-        double best_gap = INFINITY;
-        for (std::size_t j = 0; j < returns.size(); ++j) {
-            if (is_no_return(returns[j])) continue;
-            check_return(returns[j], j);
-            const double gap = std::abs(wrap_pi(returns[j].azimuth - theta_k));
-            if (gap < best_gap) {
-                best_gap = gap;
-                best = j;
+    best_return_.assign(K, returns.size());
+    best_gap_.assign(K, INFINITY);
+    for (std::size_t j = 0; j < returns.size(); ++j) {
+        if (is_no_return(returns[j])) continue;
+        check_return(returns[j], j);
+        const double az = wrap_pi(returns[j].azimuth);
+        for (int k = 0; k < K; ++k) {
+            double gap = az - k * two_pi / K;  // in (-3π, π]: one correction wraps it
+            if (gap <= -pi) gap += two_pi;
+            gap = std::abs(gap);
+            if (gap < best_gap_[k]) {
+                best_gap_[k] = gap;
+                best_return_[k] = j;
             }
         }
-        if (best == returns.size()) continue;
+    }
+    for (int k = 0; k < K; ++k) {
+        if (best_return_[k] == returns.size()) continue;
         for (int m = 0; m < M; ++m) {
-            const double x = returns[best].range - m * p_.spacing();
+            const double x = returns[best_return_[k]].range - m * p_.spacing();
             out[static_cast<std::size_t>(k) * M + m] = c_r_ * std::exp(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
         }
     }
@@ -248,7 +336,7 @@ void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<do
     if (p_.reading == BvcReading::nearest_beam) {
         std::fill(out.begin(), out.end(), 0.0);
         raw_nearest_beam(returns, out);
-    } else if (!raw_pruned(returns, 0, out)) {
+    } else if (!raw_pruned(returns, nullptr, out)) {
         raw_exact(returns, out);
     }
 }
@@ -272,27 +360,42 @@ void BoundaryVectorLayer::rates(std::span<const LidarReturn> returns, std::span<
     normalise(out);
 }
 
-bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, std::size_t beams_in_full_scan,
+bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan,
                                        std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     if (p_.reading == BvcReading::nearest_beam) {
         rates(returns, out);
         return true;
     }
-    if (!raw_pruned(returns, beams_in_full_scan, out)) return false;
+    if (!raw_pruned(returns, &plan, out)) return false;
     normalise(out);
     return true;
 }
 
-std::vector<char> BoundaryVectorLayer::rows_needed(const LidarSpec& sensor) const {
-    std::vector<char> rows(sensor.elevations.size(), 1);
-    if (p_.elevations.empty()) return rows;  // the 2-D model reads every row
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-        bool near = false;
-        for (double psi : p_.elevations) near = near || std::abs(sensor.elevations[i] - psi) <= cut_phi_;
-        rows[i] = near;
+BoundaryVectorLayer::ScanPlan BoundaryVectorLayer::plan(const LidarSpec& sensor) const {
+    ScanPlan plan;
+    const int L = p_.n_layers();
+    plan.rows.assign(sensor.elevations.size(), 1);
+    plan.skipped_bound.assign(L, 0.0);
+    plan.beams = sensor.beam_count();
+    if (p_.elevations.empty() || p_.reading == BvcReading::nearest_beam) return plan;  // reads every row
+    // A row's beams are evenly spaced in azimuth (δ apart), so for any heading and direction
+    // Σ_columns exp(-x²/2σ_θ²) <= 1 + √(2π)·σ_θ/δ (a unimodal function summed over a lattice).
+    const double delta = two_pi / sensor.azimuth_count;
+    const double angular_sum = c_theta_ * (1.0 + std::sqrt(two_pi) * p_.sigma_theta / delta);
+    const double h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
+    for (std::size_t i = 0; i < sensor.elevations.size(); ++i) {
+        bool needed = false;
+        for (double psi : p_.elevations) needed = needed || std::abs(sensor.elevations[i] - psi) <= cut_row_;
+        if (needed) continue;
+        plan.rows[i] = 0;
+        plan.skipped_rows.push_back(sensor.elevations[i]);
+        for (int l = 0; l < L; ++l) {
+            const double x = sensor.elevations[i] - p_.elevations[l];
+            plan.skipped_bound[l] += c_phi_ * std::exp(-x * x * h_p) * angular_sum * c_r_;
+        }
     }
-    return rows;
+    return plan;
 }
 
 }  // namespace bvc3d

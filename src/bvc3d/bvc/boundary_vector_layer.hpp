@@ -3,6 +3,8 @@
 // Takes: LiDAR returns (range, azimuth, elevation). Gives: one rate per cell, cell i = (l, k, m) at
 // index (l·n_dir + k)·n_per_axis + m, for preferred elevation psi_l, azimuth theta_k = 2πk/n_dir and
 // distance d_m = m·max_dist/(n_per_axis - 1).
+#include <array>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -57,31 +59,53 @@ public:
     // Normalised rates (per_step_max: raw / (2·max raw), so the largest is exactly 0.5).
     void rates(std::span<const LidarReturn> returns, std::span<double> out) const;
 
-    // Rows of a beam table whose every beam contributes below the tolerance to every cell, so a
-    // scanner need not cast them: rows[i] = 0. When scans are pruned this way, pass the full
-    // beam count to rates()/raw() through `beams_in_full_scan`, so that the error bound counts the
-    // beams that were not cast; if it fails, `needs_full_scan()` is set and the caller re-casts.
-    std::vector<char> rows_needed(const LidarSpec& sensor) const;
-    bool rates_pruned(std::span<const LidarReturn> returns, std::size_t beams_in_full_scan, std::span<double> out) const;
+    // Which rows of a scanner's beam table this layer needs: rows[i] = 0 for a row whose weight is
+    // negligible for every layer, so the scanner need not cast it. What the skipped rows could have
+    // added is bounded in advance from the beam table (its columns are evenly spaced in azimuth).
+    struct ScanPlan {
+        std::vector<char> rows;              // one flag per row of the sensor
+        std::vector<double> skipped_rows;    // elevations of the rows not needed
+        std::vector<double> skipped_bound;   // per layer: bound on their contribution to any cell
+        std::size_t beams = 0;               // beams in the full table
+    };
+    ScanPlan plan(const LidarSpec& sensor) const;
+    // Rates from a scan cast with plan.rows (returns of other rows, e.g. cast for another model,
+    // are ignored). Returns false, leaving `out` unspecified, if the truncation bound is not met:
+    // the caller then casts every row and calls rates().
+    bool rates_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan, std::span<double> out) const;
 
     // The full triple-Gaussian sum with no pruning: the definition itself, for checking.
     void raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const;
 
 private:
     // Returns false if the pruning bound is not met (out then holds the pruned sums).
-    bool raw_pruned(std::span<const LidarReturn> returns, std::size_t n_bound, std::span<double> out) const;
+    bool raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out) const;
     void raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out) const;
     void normalise(std::span<double> out) const;
     static void check_return(const LidarReturn& r, std::size_t index);
 
     BvcParams p_;
     double c_r_, c_theta_, c_phi_;      // Gaussian normalisation constants 1/sqrt(2π σ²)
-    double cut_r_, cut_theta_, cut_phi_;  // factor windows: exp(-x²/2σ²) >= tiny inside
+    double cut_r_, cut_theta_, cut_phi_, cut_row_;  // factor windows: exp(-x²/2σ²) >= tiny inside
     std::vector<double> dist_decay_;    // exp(-n²Δ²/2σ_r²), n = 0..n_per_axis-1, zero-padded
-    // Scratch for one return (a layer is not shared between threads): its distance profile and
-    // the (layer, direction) rows it feeds with their weights.
-    mutable std::vector<double> profile_, weights_;
+    // The directions an azimuth reaches and their angular factors c_θ·exp(-x²/2σ_θ²): a pure
+    // function of the azimuth, memoised in a direct-mapped table keyed by the azimuth's bits
+    // (scanners repeat the same azimuths row after row). Slot s holds count_[s] directions at
+    // dir_/weight_[s·n_dir ...]; a NaN key never matches.
+    static constexpr std::size_t cache_slots = 1024;
+    std::size_t angular(double azimuth) const;  // the slot holding `azimuth`
+    mutable std::vector<double> cache_key_, cache_weight_;
+    mutable std::vector<int> cache_count_, cache_dir_;
+
+    // Scratch for one step (a layer is not shared between threads): a return's distance profile,
+    // the (layer, direction) rows it feeds with their weights, the elevation factors of its row.
+    mutable std::vector<double> profile_, row_weight_, elev_, dropped_e_;
+    mutable std::vector<double> kept_weight_, layer_weight_, far_weight_, dropped_weight_;  // truncation bound
+    int axis_stride_ = 0;                 // n_per_axis rounded up to 8, plus 8
+    mutable std::vector<double> padded_;  // sums with padded axes
     mutable std::vector<double*> rows_;
+    mutable std::vector<std::size_t> best_return_;  // nearest_beam reading
+    mutable std::vector<double> best_gap_;
 };
 
 }  // namespace bvc3d

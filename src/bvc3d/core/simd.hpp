@@ -8,3 +8,18 @@
 #else
 #define BVC3D_DISPATCH
 #endif
+
+namespace bvc3d::simd {
+
+// Explicit 8-lane vectors (GCC vector extensions): element-wise arithmetic that each clone lowers
+// to its own instructions. Loads and stores are unaligned (memcpy compiles to one move); vectors
+// travel by reference so that no function has a vector in its ABI.
+typedef float f8 __attribute__((vector_size(32)));
+typedef double d8 __attribute__((vector_size(64)));
+
+template <class V, class T>
+inline void load(V& v, const T* p) { __builtin_memcpy(&v, p, sizeof v); }
+template <class V, class T>
+inline void store(T* p, const V& v) { __builtin_memcpy(p, &v, sizeof v); }
+
+}  // namespace bvc3d::simd

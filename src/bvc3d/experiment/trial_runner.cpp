@@ -50,6 +50,7 @@ struct GroupRun {
     std::vector<SensorUse> sensors;
     std::vector<int> sensor_of;
     std::vector<BoundaryVectorLayer> layers;
+    std::vector<BoundaryVectorLayer::ScanPlan> plans;
     std::vector<PlaceCellNetwork> nets;
     std::vector<std::vector<double>> bvc_rates;
     RandomWalk walk;
@@ -86,8 +87,8 @@ GroupRun::GroupRun(const std::vector<TrialConfig>& t)
         }
         const int si = static_cast<int>(it - keys.begin());
         sensor_of.push_back(si);
-        const auto need = layers.back().rows_needed(c.model.sensor);
-        for (std::size_t r = 0; r < need.size(); ++r) sensors[si].rows[r] |= need[r];
+        plans.push_back(layers.back().plan(c.model.sensor));
+        for (std::size_t r = 0; r < plans.back().rows.size(); ++r) sensors[si].rows[r] |= plans.back().rows[r];
         ModelRecord rec;
         rec.n_place = c.model.place.n_place;
         rec.n_bvc = c.model.bvc.n_cells();
@@ -104,7 +105,7 @@ void GroupRun::step(const WalkStep& s, bool learn, bool record) {
     }
     for (std::size_t i = 0; i < layers.size(); ++i) {
         SensorUse& u = sensors[sensor_of[i]];
-        if (!layers[i].rates_pruned(u.scan, u.spec.beam_count(), bvc_rates[i])) {
+        if (!layers[i].rates_pruned(u.scan, plans[i], bvc_rates[i])) {
             // The pruning bound failed (almost nothing in view): every beam, the full sum.
             if (!u.full_cast) u.lidar.scan(world, pose, u.full, noise);
             u.full_cast = true;

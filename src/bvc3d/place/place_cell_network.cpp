@@ -5,27 +5,9 @@
 
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/random.hpp"
+#include "bvc3d/place/place_kernels.hpp"
 
 namespace bvc3d {
-
-namespace {
-
-// Σ a[i]·b[i] over n (a multiple of 8) in a fixed order: 8 running lanes, then a fixed tree.
-float dot8(const float* a, const float* b, std::size_t n) {
-    float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-    for (std::size_t i = 0; i < n; i += 8)
-        for (int t = 0; t < 8; ++t) acc[t] += a[i + t] * b[i + t];
-    return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-}
-
-float sum8(const float* a, std::size_t n) {
-    float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-    for (std::size_t i = 0; i < n; i += 8)
-        for (int t = 0; t < 8; ++t) acc[t] += a[i + t];
-    return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-}
-
-}  // namespace
 
 void PlaceParams::validate() const {
     auto fail = [](const std::string& what) { throw InputError("place cells: " + what); };
@@ -49,6 +31,7 @@ PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::ui
         for (int j = 0; j < n_bvc; ++j) row(i)[j] = rng.bernoulli(p_.p_connect) ? 1.0f : 0.0f;
     s_.assign(p_.n_place, 0.0f);
     v_.assign(p_.n_place, 0.0f);
+    drive_.assign(p_.n_place, 0.0f);
     vb_.assign(stride_, 0.0f);
 }
 
@@ -62,16 +45,16 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
     }
     const float k = static_cast<float>(p_.dt_over_tau);
     // Inhibition uses the BVC total and the place cells' previous rates.
-    const float inhibition = static_cast<float>(p_.gamma_pb) * sum8(vb_.data(), stride_) +
+    const float inhibition = static_cast<float>(p_.gamma_pb) * kernels::sum8(vb_.data(), stride_) +
                              static_cast<float>(p_.gamma_pp) * [&] {
                                  float s = 0;
                                  for (float v : v_) s += v;
                                  return s;
                              }();
     const float gain = static_cast<float>(p_.gain);
+    kernels::matvec8(w_.data(), stride_, vb_.data(), stride_, p_.n_place, drive_.data());
     for (int i = 0; i < p_.n_place; ++i) {
-        const float drive = dot8(row(i), vb_.data(), stride_);
-        s_[i] = s_[i] + k * (-s_[i] + drive - inhibition);
+        s_[i] = s_[i] + k * (-s_[i] + drive_[i] - inhibition);
         v_[i] = std::tanh(gain * std::max(s_[i], 0.0f));
     }
     if (learn && p_.eta > 0) {
@@ -80,9 +63,7 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
         for (int i = 0; i < p_.n_place; ++i) {
             const float vi = v_[i];
             if (vi == 0.0f) continue;
-            const float a = eta * vi, c = vi * inv_alpha;
-            float* w = row(i);
-            for (int j = 0; j < n_bvc_; ++j) w[j] = w[j] + a * (vb_[j] - c * w[j]);
+            kernels::oja_row(row(i), vb_.data(), eta * vi, vi * inv_alpha, static_cast<std::size_t>(n_bvc_));
         }
     }
     return v_;

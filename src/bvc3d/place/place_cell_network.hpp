@@ -52,7 +52,7 @@ private:
     int n_bvc_;
     std::size_t stride_;  // n_bvc rounded up to a multiple of 8; padding stays 0
     PlaceParams p_;
-    std::vector<float> w_, s_, v_, vb_;
+    std::vector<float> w_, s_, v_, vb_, drive_;
 };
 
 }  // namespace bvc3d
