@@ -2,7 +2,10 @@
 // Helpers shared by the bvc3d subcommands.
 #include <CLI/CLI.hpp>
 
+#include <atomic>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "bvc3d/sensor/lidar.hpp"
 
@@ -14,8 +17,21 @@ Pose parse_pose(const std::string& text);
 // Full-precision decimal text for numbers written to CSV.
 std::string num(double v);
 
+// Ctrl-C handling shared by the long-running commands: the flag the SIGINT handler sets, a guard
+// that installs the handler, and the clean exit (status 130).
+std::atomic<bool>& stop_flag();
+struct InterruptGuard {
+    InterruptGuard();
+    ~InterruptGuard();
+};
+[[noreturn]] void exit_interrupted();
+
+// trials.csv, summary.csv/.md and (with `report`) the figures for a folder of trial files.
+void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report);
+
 void add_simulator_commands(CLI::App& app);
 void add_model_commands(CLI::App& app);
 void add_experiment_commands(CLI::App& app);
+void add_sweep_command(CLI::App& app);
 
 }  // namespace bvc3d::cli

@@ -22,9 +22,8 @@ namespace bvc3d::cli {
 namespace {
 
 // Ctrl-C asks running trials to checkpoint and stop; a second Ctrl-C ends the program at once.
-std::atomic<bool> g_stop{false};
 extern "C" void on_sigint(int) {
-    g_stop.store(true);
+    stop_flag().store(true);
     std::signal(SIGINT, SIG_DFL);
 }
 
@@ -58,17 +57,21 @@ int run_report(const std::filesystem::path& dir) {
     return std::system(cmd.c_str());
 }
 
-struct Interrupt {
-    Interrupt() { std::signal(SIGINT, on_sigint); }
-    ~Interrupt() { std::signal(SIGINT, SIG_DFL); }
-};
+}  // namespace
 
-[[noreturn]] void exit_interrupted() {
+std::atomic<bool>& stop_flag() {
+    static std::atomic<bool> stop{false};  // set from the SIGINT handler
+    return stop;
+}
+
+InterruptGuard::InterruptGuard() { std::signal(SIGINT, on_sigint); }
+InterruptGuard::~InterruptGuard() { std::signal(SIGINT, SIG_DFL); }
+
+void exit_interrupted() {
     std::cerr << "\nbvc3d: interrupted; finished trials are kept. Run the same command again to resume.\n";
     std::exit(130);
 }
 
-// Summary files and figures for a folder of trial files.
 void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report) {
     const auto trials = read_summaries(files);
     const auto rows = summarize(trials);
@@ -79,6 +82,8 @@ void summarise(const std::filesystem::path& out, const std::vector<std::filesyst
         throw InputError("the report (figures) failed; the trial files and summary are in '" + out.string() +
                          "'; rerun with: python3 -m bvc3d.report " + out.string());
 }
+
+namespace {
 
 void add_run(CLI::App& app) {
     auto* cmd = app.add_subcommand("run", "Run one trial (SPEC §7) and write its HDF5 file");
@@ -137,9 +142,9 @@ void add_run(CLI::App& app) {
         const bool tty = ::isatty(STDERR_FILENO);
         const double total = 3600 * (t.protocol.kind == Protocol::Kind::online ? t.protocol.sample_hours
                                                                                  : t.protocol.explore_hours + t.protocol.sample_hours);
-        Interrupt guard;
+        InterruptGuard guard;
         RunControl control;
-        control.stop = &g_stop;
+        control.stop = &stop_flag();
         control.checkpoint = out.string() + ".ckpt";
         control.checkpoint_minutes = o->checkpoint_minutes;
         const auto start = std::chrono::steady_clock::now();
@@ -219,8 +224,8 @@ void add_paper(CLI::App& app) {
         opts.jobs = o->jobs;
         opts.progress = ::isatty(STDERR_FILENO);
         opts.checkpoint_minutes = o->checkpoint_minutes;
-        opts.stop = &g_stop;
-        Interrupt guard;
+        opts.stop = &stop_flag();
+        InterruptGuard guard;
         ExperimentOutcome outcome;
         try {
             outcome = run_experiment(trials, opts);
@@ -229,7 +234,9 @@ void add_paper(CLI::App& app) {
         }
         std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", trials.size(), o->out.c_str(),
                     outcome.ran, outcome.skipped, outcome.wall_seconds);
-        if (outcome.steps > 0) std::printf(", %.0f walk steps/s", outcome.steps / outcome.wall_seconds);
+        if (outcome.steps > 0)
+            std::printf(", %.0f walk steps/s, %.0f model steps/s", outcome.steps / outcome.wall_seconds,
+                        outcome.model_steps / outcome.wall_seconds);
         std::printf("\n");
         summarise(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());

@@ -5,7 +5,6 @@ find_package(assimp REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(CLI11 REQUIRED)
-find_package(TBB REQUIRED)
 find_package(Threads REQUIRED)
 
 if(BVC3D_WITH_MPI)

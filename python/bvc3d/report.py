@@ -56,6 +56,7 @@ class Folder:
         self.summary = read_csv(os.path.join(path, "summary.csv"))
         self.models = list(dict.fromkeys(r["model"] for r in self.summary))
         worlds = list(dict.fromkeys(r["world"] for r in self.summary))
+        self.conditions = list(dict.fromkeys(r["condition"] for r in self.summary))
         tilt = {r["world"]: num(r["tilt_deg"]) for r in self.summary}
         self.worlds = sorted(worlds, key=lambda w: (math.isnan(tilt[w]), tilt[w], w))
         self.tilt = tilt
@@ -222,12 +223,65 @@ def fig_environments(folder, out):
     return True
 
 
+def swept_keys(summary):
+    """The swept-key columns of summary.csv ("swept:<key>")."""
+    return [c for c in summary[0] if c.startswith("swept:")] if summary else []
+
+
+def as_number(values):
+    try:
+        return [float(v) for v in values], True
+    except ValueError:
+        return list(values), False
+
+
+def fig_sweep(folder, keys, metric, out):
+    """A metric against the first swept key, one line per combination of the other keys."""
+    label, title = METRICS[metric]
+    x_key, others = keys[0], keys[1:]
+    lines = {}
+    for r in folder.summary:
+        lines.setdefault(tuple(r[k] for k in others), []).append(r)
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    xs_all = list(dict.fromkeys(r[x_key] for r in folder.summary))
+    numeric = as_number(xs_all)[1]
+    for combo, rows in lines.items():
+        xs = [float(r[x_key]) if numeric else xs_all.index(r[x_key]) for r in rows]
+        means = [num(r[metric + "_mean"]) for r in rows]
+        sds = [0.0 if math.isnan(num(r[metric + "_sd"])) else num(r[metric + "_sd"]) for r in rows]
+        name = ", ".join(f"{k[6:]}={v}" for k, v in zip(others, combo)) or None
+        ax.errorbar(xs, means, yerr=sds, marker="o", capsize=3, label=name)
+    if not numeric:
+        ax.set_xticks(range(len(xs_all)), xs_all, rotation=20, fontsize=8)
+    ax.set_xlabel(x_key[6:])
+    ax.set_ylabel(label)
+    seeds = len(folder.seeds)
+    ax.set_title(title + (f" (mean ± sd over {seeds} seeds)" if seeds > 1 else ""))
+    if others:
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=DPI)
+    plt.close(fig)
+
+
+def make_sweep_report(folder, figdir):
+    keys = swept_keys(folder.summary)
+    figures = []
+    for metric in METRICS:
+        name = f"sweep_{metric}.png"
+        fig_sweep(folder, keys, metric, os.path.join(figdir, name))
+        shown = [k[6:] for k in keys]
+        figures.append((name, f"{METRICS[metric][1]} against {shown[0]}" +
+                        (f", one line per value of {', '.join(shown[1:])}." if shown[1:] else ".")))
+    return figures
+
+
 def write_report(folder, figures):
     with open(os.path.join(folder.path, "summary.md")) as f:
         table = f.read()
     lines = ["# bvc3d experiment report", "",
-             f"{len(folder.trials)} trials: models {', '.join(folder.models)} in worlds "
-             f"{', '.join(folder.worlds)}, seeds {', '.join(map(str, folder.seeds))}.", "",
+             f"{len(folder.trials)} trials: {len(folder.conditions)} conditions (models {', '.join(folder.models)}; "
+             f"worlds {', '.join(folder.worlds)}), seeds {', '.join(map(str, folder.seeds))}.", "",
              "## Summary", "", table, "", "## Figures", ""]
     for name, sentence in figures:
         lines += [f"### {name.split('.')[0].replace('_', ' ')}", "", sentence, "", f"![{name}](figures/{name})", ""]
@@ -243,6 +297,10 @@ def make_report(path):
     folder = Folder(path)
     figdir = os.path.join(path, "figures")
     os.makedirs(figdir, exist_ok=True)
+    if os.path.exists(os.path.join(path, "sweep.yaml")) and swept_keys(folder.summary):
+        figures = make_sweep_report(folder, figdir)
+        write_report(folder, figures)
+        return figures
     figures = []
 
     def add(name, sentence, draw):

@@ -95,8 +95,13 @@ ModelSpec model_from_yaml(const YamlView& v) {
     } else {
         m = model_preset("3d-0.2");
     }
-    m.name = v.get("name", v.file().empty() ? std::string("custom")
-                                            : std::filesystem::path(v.file()).stem().string());
+    // Unnamed: a model file is named after the file; an inline model after its base, marked as
+    // changed when it changes anything.
+    const std::string base_name = m.name;
+    const bool inline_model = !v.path().empty();
+    const bool changed = v.has("sensor") || v.has("bvc") || v.has("place");
+    m.name = v.get("name", inline_model ? base_name + (changed ? "-custom" : "")
+                                        : std::filesystem::path(v.file()).stem().string());
     if (v.has("sensor")) {
         const YamlView s = v["sensor"];
         if (s.is_scalar()) {

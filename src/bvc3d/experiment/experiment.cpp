@@ -1,7 +1,5 @@
 #include "bvc3d/experiment/experiment.hpp"
 
-#include <tbb/parallel_for_each.h>
-#include <tbb/task_arena.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -56,8 +54,12 @@ public:
     Progress(bool on, int total_trials, double total_seconds)
         : on_(on), total_trials_(total_trials), total_seconds_(total_seconds), start_(Clock::now()) {}
     void add_seconds(double s) { seconds_.fetch_add(s); }
-    void add_steps(std::int64_t n) { steps_.fetch_add(n); }
+    void add_steps(std::int64_t n, std::int64_t models) {
+        steps_.fetch_add(n);
+        model_steps_.fetch_add(n * models);
+    }
     std::int64_t steps() const { return steps_.load(); }
+    std::int64_t model_steps() const { return model_steps_.load(); }
     void trial_done() { trials_.fetch_add(1); }
     void print(bool final = false) {
         if (!on_) return;
@@ -78,7 +80,7 @@ private:
     double total_seconds_;
     Clock::time_point start_;
     std::atomic<double> seconds_{0};
-    std::atomic<std::int64_t> steps_{0};
+    std::atomic<std::int64_t> steps_{0}, model_steps_{0};
     std::atomic<int> trials_{0};
     std::mutex mutex_;
 };
@@ -100,8 +102,32 @@ analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& wor
     return analysis::analyze_trial<float>(x, y, r, params);
 }
 
-ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options) {
+namespace {
+
+class LocalCoordinator : public Coordinator {
+public:
+    explicit LocalCoordinator(std::size_t n) : n_(n) {}
+    std::vector<std::size_t> agree(std::vector<std::size_t> pending) override {
+        n_ = pending.size();
+        return pending;
+    }
+    std::optional<std::size_t> next() override {
+        const std::size_t i = next_.fetch_add(1);
+        return i < n_ ? std::optional<std::size_t>(i) : std::nullopt;
+    }
+
+private:
+    std::size_t n_;
+    std::atomic<std::size_t> next_{0};
+};
+
+}  // namespace
+
+ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options,
+                                 Coordinator* coordinator) {
     const auto start = Clock::now();
+    LocalCoordinator local(0);
+    Coordinator& coord = coordinator ? *coordinator : local;
     ExperimentOutcome outcome;
     std::set<std::string> names;
     for (const auto& t : trials) {
@@ -114,31 +140,42 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
     ensure_writable_directory(options.out_dir);
     const auto ckpt_dir = options.out_dir / ".checkpoints";
 
-    std::vector<std::size_t> todo;
-    double total_seconds = 0;
+    // Groups of trials that share a walk; the root decides which still have work.
+    std::vector<std::size_t> all(trials.size());
     for (std::size_t i = 0; i < trials.size(); ++i) {
-        const auto path = trial_path(options.out_dir, trials[i]);
-        outcome.files.push_back(path);
-        if (trial_file_fingerprint(path) == trials[i].fingerprint()) {
-            ++outcome.skipped;
-        } else {
-            todo.push_back(i);
+        all[i] = i;
+        outcome.files.push_back(trial_path(options.out_dir, trials[i]));
+    }
+    const auto groups = make_groups(trials, all);
+    auto complete = [&](std::size_t i) { return trial_file_fingerprint(outcome.files[i]) == trials[i].fingerprint(); };
+    std::vector<std::size_t> pending;
+    int complete_before = 0;
+    if (coord.is_root())
+        for (std::size_t g = 0; g < groups.size(); ++g) {
+            bool any = false;
+            for (std::size_t i : groups[g].members) {
+                const bool done = complete(i);
+                complete_before += done;
+                any = any || !done;
+            }
+            if (any) pending.push_back(g);
         }
-    }
-    const auto groups = make_groups(trials, todo);
-    for (const auto& g : groups) {
-        const auto& p = trials[g.members.front()].protocol;
+    pending = coord.agree(pending);
+    double total_seconds = 0;
+    int todo_trials = 0;
+    for (std::size_t g : pending) {
+        const auto& p = trials[groups[g].members.front()].protocol;
         total_seconds += 3600 * (p.kind == Protocol::Kind::online ? p.sample_hours : p.explore_hours + p.sample_hours);
+        todo_trials += static_cast<int>(groups[g].members.size());
     }
-    if (!groups.empty()) ensure_writable_directory(ckpt_dir);
+    if (!pending.empty()) ensure_writable_directory(ckpt_dir);
 
-    Progress progress(options.progress, static_cast<int>(todo.size()), total_seconds);
-    std::atomic<bool> interrupted{false};
+    Progress progress(options.progress && coord.is_root(), todo_trials, total_seconds);
+    std::atomic<bool> interrupted{false}, failed{false}, stop_all{false};
+    std::atomic<int> ran{0};
     std::exception_ptr error;
     std::mutex error_mutex;
-    std::atomic<bool> failed{false};
     // Stop everything on Ctrl-C or on the first error.
-    std::atomic<bool> stop_all{false};
     std::jthread watcher([&](std::stop_token st) {
         while (!st.stop_requested()) {
             if ((options.stop && options.stop->load()) || failed.load()) stop_all = true;
@@ -147,37 +184,41 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
         }
     });
 
-    const int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    tbb::task_arena arena(jobs);
-    arena.execute([&] {
-        tbb::parallel_for_each(groups.begin(), groups.end(), [&](const Group& g) {
-            if (stop_all.load()) {
-                interrupted = true;
-                return;
-            }
-            std::vector<TrialConfig> members;
-            for (std::size_t i : g.members) members.push_back(trials[i]);
-            RunControl control;
-            control.stop = &stop_all;
-            control.checkpoint = ckpt_dir / (g.key + ".h5");
-            control.checkpoint_minutes = options.checkpoint_minutes;
-            double last = 0;
-            control.progress = [&](double t) {
-                progress.add_seconds(t - last);
-                last = t;
-            };
+    auto run_group = [&](const Group& g) {
+        // Only the members whose files are missing run; they still share the walk.
+        std::vector<TrialConfig> members;
+        for (std::size_t i : g.members)
+            if (!complete(i)) members.push_back(trials[i]);
+        if (members.empty()) return;
+        RunControl control;
+        control.stop = &stop_all;
+        control.checkpoint = ckpt_dir / (g.key + ".h5");
+        control.checkpoint_minutes = options.checkpoint_minutes;
+        double last = 0;
+        control.progress = [&](double t) {
+            progress.add_seconds(t - last);
+            last = t;
+        };
+        const GroupResult result = run_trial_group(members, control);
+        const WorldDescription world = members.front().world.resolve();
+        for (std::size_t k = 0; k < members.size(); ++k) {
+            const auto metrics =
+                analyze(members[k], world, result.x, result.y, result.models[k].rates, result.models[k].n_place);
+            write_trial_file(trial_path(options.out_dir, members[k]), members[k], result, k, metrics);
+            if (options.on_trial_done) options.on_trial_done(members[k].name());
+            progress.trial_done();
+            ++ran;
+        }
+        progress.add_steps(result.stats.explore_steps + result.stats.sample_steps, static_cast<std::int64_t>(members.size()));
+        std::error_code ec;
+        std::filesystem::remove(control.checkpoint, ec);
+    };
+    auto worker = [&] {
+        while (!stop_all.load()) {
+            const auto g = coord.next();
+            if (!g) return;
             try {
-                const GroupResult result = run_trial_group(members, control);
-                const WorldDescription world = members.front().world.resolve();
-                for (std::size_t k = 0; k < members.size(); ++k) {
-                    const auto metrics = analyze(members[k], world, result.x, result.y, result.models[k].rates,
-                                                 result.models[k].n_place);
-                    write_trial_file(trial_path(options.out_dir, members[k]), members[k], result, k, metrics);
-                    progress.trial_done();
-                }
-                progress.add_steps(result.stats.explore_steps + result.stats.sample_steps);
-                std::error_code ec;
-                std::filesystem::remove(control.checkpoint, ec);
+                run_group(groups[pending[*g]]);
             } catch (const Interrupted&) {
                 interrupted = true;
             } catch (...) {
@@ -185,17 +226,26 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
                 if (!error) error = std::current_exception();
                 failed = true;
             }
-        });
-    });
+        }
+        if (stop_all.load()) interrupted = true;
+    };
+    const int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    {
+        std::vector<std::jthread> workers;
+        for (int j = 0; j < jobs; ++j) workers.emplace_back(worker);
+    }
+    coord.finish();
     watcher.request_stop();
     watcher.join();
     if (error) std::rethrow_exception(error);
-    if (interrupted) throw Interrupted();
+    if (interrupted && !failed) throw Interrupted();
     progress.print(true);
     std::error_code ec;
     std::filesystem::remove(ckpt_dir, ec);  // only if empty
-    outcome.ran = static_cast<int>(todo.size());
+    outcome.skipped = complete_before;
+    outcome.ran = coord.is_root() ? static_cast<int>(trials.size()) - complete_before : ran.load();
     outcome.steps = progress.steps();
+    outcome.model_steps = progress.model_steps();
     outcome.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return outcome;
 }

@@ -5,6 +5,9 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <string>
+#include <optional>
 #include <vector>
 
 #include "bvc3d/experiment/trial_config.hpp"
@@ -17,19 +20,37 @@ struct ExperimentOptions {
     bool progress = false;                     // a progress line on standard error
     double checkpoint_minutes = 0;             // periodic checkpoints (simulated minutes); 0: on interrupt only
     const std::atomic<bool>* stop = nullptr;   // Ctrl-C: checkpoint and stop
+    std::function<void(const std::string& name)> on_trial_done;  // called from worker threads
+};
+
+// Who runs what. Local runs deal groups to threads from a counter; under MPI, rank 0 decides which
+// groups remain and deals them out on request (src/bvc3d/experiment/mpi_coordinator.hpp).
+class Coordinator {
+public:
+    virtual ~Coordinator() = default;
+    virtual bool is_root() const { return true; }  // prints progress and writes summaries
+    // The root's list of pending groups, given to everyone.
+    virtual std::vector<std::size_t> agree(std::vector<std::size_t> pending) { return pending; }
+    // The next group (an index into the pending list) for a worker thread; nullopt when none is left.
+    virtual std::optional<std::size_t> next() = 0;
+    // This process's workers are done; the root returns once every process is.
+    virtual void finish() {}
 };
 
 struct ExperimentOutcome {
     std::vector<std::filesystem::path> files;  // every trial's file, in the order of the trials
     int ran = 0, skipped = 0;
-    std::int64_t steps = 0;                    // model steps simulated in this run (per walk)
+    std::int64_t steps = 0;                    // walk steps simulated in this run (one per group step)
+    std::int64_t model_steps = 0;              // model updates: walk steps × models sharing the walk
     double wall_seconds = 0;
 };
 
 std::filesystem::path trial_path(const std::filesystem::path& out_dir, const TrialConfig& t);
 
 // Throws InputError for bad configurations (before anything runs) and Interrupted if stopped.
-ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options);
+// Without a coordinator, options.jobs threads share the work.
+ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options,
+                                 Coordinator* coordinator = nullptr);
 
 // Analyses a trial's recorded samples (SPEC §8) with its configured parameters.
 analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& world, const std::vector<double>& x,

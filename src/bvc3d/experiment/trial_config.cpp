@@ -65,7 +65,11 @@ Protocol::Kind parse_protocol(const std::string& name) {
     throw InputError("protocol '" + name + "' is not one of explore_then_sample, online");
 }
 
-std::string TrialConfig::name() const { return world.label() + "_" + model.name + "_seed" + std::to_string(seed); }
+std::string TrialConfig::condition_label() const {
+    return condition.empty() ? world.label() + "_" + model.name : condition;
+}
+
+std::string TrialConfig::name() const { return condition_label() + "_seed" + std::to_string(seed); }
 
 std::string TrialConfig::canonical() const {
     std::ostringstream os;

@@ -40,7 +40,14 @@ struct TrialConfig {
     bool arena_extent = false;          // bin over the walkable region's bounds, not the trajectory's
     std::uint64_t seed = 0;
 
-    std::string name() const;  // "<world>_<model>_seed<N>", the trial file's stem
+    // The experimental condition this trial belongs to (its seeds are its replicates) and the
+    // values that define it, e.g. {model: 3d-0.2, world: cross-45}. Labels only: they do not
+    // change the results. Empty condition: "<world>_<model>".
+    std::string condition;
+    std::vector<std::pair<std::string, std::string>> swept;
+
+    std::string condition_label() const;
+    std::string name() const;  // "<condition>_seed<N>", the trial file's stem
     // Everything that determines the trial's results, as text: equal text, equal results.
     std::string canonical() const;
     std::string fingerprint() const;  // a short hash of canonical()

@@ -120,6 +120,11 @@ bool exists(hid_t loc, const std::string& name) {
     return H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0;
 }
 
+bool exists_attr(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    return H5Aexists(obj, name.c_str()) > 0;
+}
+
 void write_attr(hid_t obj, const std::string& name, const std::string& value) {
     auto lock = hdf5_lock();
     // Variable-length UTF-8: h5py reads it as a Python str.

@@ -36,6 +36,7 @@ Handle open_file(const std::string& path);    // read-only
 Handle create_group(hid_t loc, const std::string& name);
 Handle open_group(hid_t loc, const std::string& name);
 bool exists(hid_t loc, const std::string& name);
+bool exists_attr(hid_t obj, const std::string& name);
 
 void write_attr(hid_t obj, const std::string& name, const std::string& value);
 void write_attr(hid_t obj, const std::string& name, double value);

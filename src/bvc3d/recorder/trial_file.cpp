@@ -1,5 +1,7 @@
 #include "bvc3d/recorder/trial_file.hpp"
 
+#include <sstream>
+
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recorder/hdf5_io.hpp"
@@ -65,6 +67,10 @@ void write_trial_file(const std::filesystem::path& path, const TrialConfig& conf
         h5::write_attr(f, "format", std::string("bvc3d-trial"));
         h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_format_version));
         h5::write_attr(f, "name", config.name());
+        h5::write_attr(f, "condition", config.condition_label());
+        std::string swept;
+        for (const auto& [k, v] : config.swept) swept += k + "=" + v + "\n";
+        h5::write_attr(f, "swept", swept);
         h5::write_attr(f, "world", config.world.label());
         h5::write_attr(f, "world_source", config.world.source);
         if (config.world.source == "cross" || config.world.source.rfind("cross-", 0) == 0)
@@ -166,6 +172,13 @@ TrialSummaryRow read_trial_summary(const std::filesystem::path& path) {
     r.name = h5::read_attr_string(f, "name");
     r.world = h5::read_attr_string(f, "world");
     r.model = h5::read_attr_string(f, "model");
+    // Files from before conditions were recorded: the paper's condition, model and world.
+    r.condition = h5::exists_attr(f, "condition") ? h5::read_attr_string(f, "condition") : r.world + "_" + r.model;
+    std::istringstream swept(h5::exists_attr(f, "swept") ? h5::read_attr_string(f, "swept") : std::string());
+    for (std::string line; std::getline(swept, line);) {
+        const auto eq = line.find('=');
+        if (eq != std::string::npos) r.swept.emplace_back(line.substr(0, eq), line.substr(eq + 1));
+    }
     r.seed = static_cast<std::uint64_t>(h5::read_attr_int(f, "seed"));
     r.tilt_deg = optional_tilt(f);
     const auto g = h5::open_group(f, "metrics");

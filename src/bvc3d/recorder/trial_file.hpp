@@ -32,7 +32,8 @@ TrialFileData read_trial_samples(const std::filesystem::path& path);  // throws 
 
 // The scalar metrics stored in a trial file, by name (for summaries).
 struct TrialSummaryRow {
-    std::string name, world, model;
+    std::string name, condition, world, model;
+    std::vector<std::pair<std::string, std::string>> swept;  // the condition's defining values
     std::uint64_t seed = 0;
     double tilt_deg = NAN;
     std::vector<std::pair<std::string, double>> metrics;

@@ -35,6 +35,31 @@ const Column markdown_columns[] = {{"frac_active", "MI>0 fraction", 3},   {"mean
                                    {"frac_multimodal", "MI>1 fraction", 3}, {"msai", "MSAI", 4},
                                    {"decode_median_m", "decoding median (m)", 2}, {"decode_mean_m", "decoding mean (m)", 2}};
 
+// The swept keys of a table, in first-seen order.
+template <class Row>
+std::vector<std::string> swept_keys(const std::vector<Row>& rows) {
+    std::vector<std::string> keys;
+    for (const auto& r : rows)
+        for (const auto& [k, v] : r.swept)
+            if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
+    return keys;
+}
+
+template <class Row>
+std::string swept_value(const Row& r, const std::string& key) {
+    for (const auto& [k, v] : r.swept)
+        if (k == key) return v;
+    return "";
+}
+
+// CSV fields with commas or quotes are quoted.
+std::string csv(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+}
+
 }  // namespace
 
 std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files) {
@@ -45,20 +70,22 @@ std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::p
 
 std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials) {
     std::vector<SummaryRow> rows;
-    std::map<std::pair<std::string, std::string>, std::vector<const TrialSummaryRow*>> by_condition;
+    std::map<std::string, std::vector<const TrialSummaryRow*>> by_condition;
     for (const auto& t : trials) {
-        auto& members = by_condition[{t.model, t.world}];
+        auto& members = by_condition[t.condition];
         if (members.empty()) {
             SummaryRow r;
+            r.condition = t.condition;
             r.model = t.model;
             r.world = t.world;
             r.tilt_deg = t.tilt_deg;
+            r.swept = t.swept;
             rows.push_back(r);
         }
         members.push_back(&t);
     }
     for (auto& r : rows) {
-        const auto& members = by_condition[{r.model, r.world}];
+        const auto& members = by_condition[r.condition];
         r.n_seeds = static_cast<int>(members.size());
         for (std::size_t m = 0; m < members.front()->metrics.size(); ++m) {
             double sum = 0, sum2 = 0;
@@ -76,12 +103,17 @@ std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials) {
 void write_summary_csv(const std::filesystem::path& path, const std::vector<SummaryRow>& rows) {
     AtomicFile f(path);
     auto& os = f.stream();
-    os << "model,world,tilt_deg,n_seeds";
+    const auto keys = swept_keys(rows);
+    os << "condition,model,world,tilt_deg";
+    for (const auto& k : keys) os << ',' << csv("swept:" + k);
+    os << ",n_seeds";
     if (!rows.empty())
         for (const auto& m : rows.front().metric_names) os << ',' << m << "_mean," << m << "_sd";
     os << '\n';
     for (const auto& r : rows) {
-        os << r.model << ',' << r.world << ',' << num(r.tilt_deg) << ',' << r.n_seeds;
+        os << csv(r.condition) << ',' << csv(r.model) << ',' << csv(r.world) << ',' << num(r.tilt_deg);
+        for (const auto& k : keys) os << ',' << csv(swept_value(r, k));
+        os << ',' << r.n_seeds;
         for (std::size_t m = 0; m < r.mean.size(); ++m) os << ',' << num(r.mean[m]) << ',' << num(r.sd[m]);
         os << '\n';
     }
@@ -91,13 +123,20 @@ void write_summary_csv(const std::filesystem::path& path, const std::vector<Summ
 void write_summary_markdown(const std::filesystem::path& path, const std::vector<SummaryRow>& rows) {
     AtomicFile f(path);
     auto& os = f.stream();
-    os << "| model | world | seeds |";
+    auto keys = swept_keys(rows);
+    const bool plain = keys.empty();  // the paper's layout: model and world
+    if (plain) keys = {"model", "world"};
+    os << '|';
+    for (const auto& k : keys) os << ' ' << k << " |";
+    os << " seeds |";
     for (const auto& c : markdown_columns) os << ' ' << c.heading << " |";
-    os << "\n|---|---|---|";
-    for (std::size_t i = 0; i < std::size(markdown_columns); ++i) os << "---|";
+    os << "\n|";
+    for (std::size_t i = 0; i < keys.size() + 1 + std::size(markdown_columns); ++i) os << "---|";
     os << '\n';
     for (const auto& r : rows) {
-        os << "| " << r.model << " | " << r.world << " | " << r.n_seeds << " |";
+        os << '|';
+        for (const auto& k : keys) os << ' ' << (plain ? (k == "model" ? r.model : r.world) : swept_value(r, k)) << " |";
+        os << ' ' << r.n_seeds << " |";
         for (const auto& c : markdown_columns) {
             const auto it = std::find(r.metric_names.begin(), r.metric_names.end(), c.metric);
             const std::size_t m = static_cast<std::size_t>(it - r.metric_names.begin());
@@ -115,12 +154,17 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
 void write_trials_csv(const std::filesystem::path& path, const std::vector<TrialSummaryRow>& trials) {
     AtomicFile f(path);
     auto& os = f.stream();
-    os << "name,model,world,tilt_deg,seed";
+    const auto keys = swept_keys(trials);
+    os << "name,condition,model,world,tilt_deg";
+    for (const auto& k : keys) os << ',' << csv("swept:" + k);
+    os << ",seed";
     if (!trials.empty())
         for (const auto& [name, v] : trials.front().metrics) os << ',' << name;
     os << '\n';
     for (const auto& t : trials) {
-        os << t.name << ',' << t.model << ',' << t.world << ',' << num(t.tilt_deg) << ',' << t.seed;
+        os << csv(t.name) << ',' << csv(t.condition) << ',' << csv(t.model) << ',' << csv(t.world) << ',' << num(t.tilt_deg);
+        for (const auto& k : keys) os << ',' << csv(swept_value(t, k));
+        os << ',' << t.seed;
         for (const auto& [name, v] : t.metrics) os << ',' << num(v);
         os << '\n';
     }

@@ -11,7 +11,8 @@
 namespace bvc3d {
 
 struct SummaryRow {
-    std::string model, world;
+    std::string condition, model, world;
+    std::vector<std::pair<std::string, std::string>> swept;
     double tilt_deg = NAN;
     int n_seeds = 0;
     std::vector<std::string> metric_names;
@@ -22,10 +23,11 @@ struct SummaryRow {
 std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials);
 std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files);
 
-// Written atomically. The CSV has columns model, world, tilt_deg, n_seeds, <metric>_mean, <metric>_sd.
+// Written atomically. The CSV has columns condition, model, world, tilt_deg, swept:<key>..., n_seeds,
+// <metric>_mean, <metric>_sd; the Markdown table shows the swept keys (or model and world).
 void write_summary_csv(const std::filesystem::path& path, const std::vector<SummaryRow>& rows);
 void write_summary_markdown(const std::filesystem::path& path, const std::vector<SummaryRow>& rows);
-// One row per trial: name, model, world, tilt_deg, seed, <metric>...
+// One row per trial: name, condition, model, world, tilt_deg, swept:<key>..., seed, <metric>...
 void write_trials_csv(const std::filesystem::path& path, const std::vector<TrialSummaryRow>& trials);
 
 }  // namespace bvc3d

@@ -1,0 +1,140 @@
+// bvc3d sweep: a grid of conditions × seeds, on local threads or over MPI ranks (mpirun).
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <mutex>
+
+#include "bvc3d/config/sweep_yaml.hpp"
+#include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/experiment/experiment.hpp"
+#include "bvc3d/experiment/trial_runner.hpp"
+#include "cli_common.hpp"
+#ifdef BVC3D_HAVE_MPI
+#include "bvc3d/experiment/mpi_coordinator.hpp"
+#endif
+
+namespace bvc3d::cli {
+
+namespace {
+
+// Launched by mpirun/srun? (Checked without initialising MPI, which a plain run must not need.)
+bool launched_by_mpi() {
+    for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"})
+        if (std::getenv(v)) return true;
+    return false;
+}
+
+void copy_sweep_file(const std::string& from, const std::filesystem::path& dir) {
+    std::ifstream in(from);
+    AtomicFile out(dir / "sweep.yaml");
+    out.stream() << in.rdbuf();
+    out.commit();
+}
+
+}  // namespace
+
+void add_sweep_command(CLI::App& app) {
+    auto* cmd = app.add_subcommand("sweep", "Run a parameter sweep (conditions x seeds) on local cores or over MPI");
+    struct Options {
+        std::string file, out;
+        std::optional<double> hours;
+        int jobs = 0;
+        double checkpoint_minutes = 0;
+        bool no_report = false, dry_run = false, verbose = false;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("sweep", o->file, "Sweep YAML file (docs/sweeps.md)")->required();
+    cmd->add_option("--out", o->out, "Output folder (default results/<sweep name>)");
+    cmd->add_option("--hours", o->hours, "Shorten both phases of every trial to H simulated hours");
+    cmd->add_option("--jobs", o->jobs, "Threads (per rank under MPI; default: every core, or 1 per rank under MPI)");
+    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes, "Checkpoint running trials every M simulated minutes");
+    cmd->add_flag("--no-report", o->no_report, "Skip the figures");
+    cmd->add_flag("--dry-run", o->dry_run, "List the trials and exit");
+    cmd->add_flag("--verbose", o->verbose, "Print a line for every finished trial (with its MPI rank)");
+    cmd->footer(
+        "Under `mpirun -np N bvc3d sweep FILE`, rank 0 deals trials to the ranks as they become free; the output\n"
+        "folder must be shared by all ranks. Completed trials are skipped on a rerun. See docs/cluster.md.");
+    cmd->callback([o] {
+        // Everything that can be wrong with the input is found here, before MPI starts.
+        auto sweep = config::load_sweep_file(o->file);
+        if (o->hours) {
+            if (!(*o->hours > 0)) throw InputError("--hours must be a positive number of hours");
+            for (auto& t : sweep.trials) t.protocol.explore_hours = t.protocol.sample_hours = *o->hours;
+        }
+        if (o->jobs < 0) throw InputError("--jobs must be >= 0");
+        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+        const std::filesystem::path out =
+            o->out.empty() ? std::filesystem::path("results") / sweep.name : std::filesystem::path(o->out);
+        if (o->dry_run) {
+            for (const auto& t : sweep.trials) std::printf("%s\n", t.name().c_str());
+            std::printf("%zu trials\n", sweep.trials.size());
+            return;
+        }
+        for (const auto& t : sweep.trials) t.world.resolve();
+        ensure_writable_directory(out);
+
+        ExperimentOptions opts;
+        opts.out_dir = out;
+        opts.jobs = o->jobs;
+        opts.checkpoint_minutes = o->checkpoint_minutes;
+        opts.stop = &stop_flag();
+        opts.progress = ::isatty(STDERR_FILENO);
+        InterruptGuard guard;
+        bool root = true;
+        int rank = 0;
+        std::mutex print;
+        if (o->verbose)
+            opts.on_trial_done = [&](const std::string& name) {
+                std::lock_guard lock(print);
+                std::printf("rank %d: %s\n", rank, name.c_str());
+                std::fflush(stdout);
+            };
+        ExperimentOutcome outcome;
+#ifdef BVC3D_HAVE_MPI
+        if (launched_by_mpi()) {
+            int provided = 0;
+            MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+            if (provided < MPI_THREAD_SERIALIZED) {
+                std::cerr << "bvc3d: the MPI library does not support MPI_THREAD_SERIALIZED\n";
+                MPI_Abort(MPI_COMM_WORLD, 3);
+            }
+            if (o->jobs == 0) opts.jobs = 1;
+            MpiCoordinator coord(MPI_COMM_WORLD, &stop_flag());
+            root = coord.is_root();
+            rank = coord.rank();
+            if (root) copy_sweep_file(o->file, out);
+            try {
+                outcome = run_experiment(sweep.trials, opts, &coord);
+            } catch (const Interrupted&) {
+                MPI_Finalize();
+                exit_interrupted();
+            } catch (const std::exception& e) {
+                std::cerr << "bvc3d: error on rank " << coord.rank() << ": " << e.what() << "\n";
+                MPI_Abort(MPI_COMM_WORLD, 2);
+            }
+            MPI_Finalize();
+        } else
+#endif
+        {
+            copy_sweep_file(o->file, out);
+            try {
+                outcome = run_experiment(sweep.trials, opts);
+            } catch (const Interrupted&) {
+                exit_interrupted();
+            }
+        }
+        if (!root) return;
+        std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s\n", sweep.trials.size(), out.c_str(),
+                    outcome.ran, outcome.skipped, outcome.wall_seconds);
+        summarise(out, outcome.files, !o->no_report);
+        std::printf("summary: %s/summary.md\n", out.c_str());
+    });
+}
+
+}  // namespace bvc3d::cli

@@ -1,0 +1,173 @@
+#include "bvc3d/config/sweep_yaml.hpp"
+
+#include <filesystem>
+#include <sstream>
+
+#include "bvc3d/config/trial_yaml.hpp"
+
+namespace bvc3d::config {
+
+namespace {
+
+std::vector<std::string> split_key(const std::string& key) {
+    std::vector<std::string> parts;
+    std::stringstream ss(key);
+    for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+    return parts;
+}
+
+// Sets the dotted `key` of `root` to `value`, creating mappings on the way. A preset name where a
+// mapping is needed becomes one: `model: 3d-0.2` -> `{base: 3d-0.2}`, `world: cross` -> `{source: cross}`.
+void set_key(YAML::Node root, const std::string& key, const YAML::Node& value, const YamlView& where) {
+    const auto parts = split_key(key);
+    if (parts.empty()) where.fail("empty key");
+    YAML::Node node = root;
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+        YAML::Node child = node[parts[i]];
+        if (!child.IsDefined() || child.IsNull()) {
+            node[parts[i]] = YAML::Node(YAML::NodeType::Map);
+        } else if (child.IsScalar()) {
+            const std::string promoted = i == 0 && parts[i] == "model"   ? "base"
+                                         : i == 0 && parts[i] == "world" ? "source"
+                                                                         : "";
+            if (promoted.empty()) where.fail("'" + parts[i] + "' is a value, so '" + key + "' cannot be set inside it");
+            YAML::Node m(YAML::NodeType::Map);
+            m[promoted] = child.Scalar();
+            node[parts[i]] = m;
+        } else if (!child.IsMap()) {
+            where.fail("'" + parts[i] + "' is a list, so '" + key + "' cannot be set inside it");
+        }
+        node.reset(node[parts[i]]);
+    }
+    node[parts.back()] = YAML::Clone(value);
+}
+
+// A short text for a value in labels: [0.0, 0.2] -> 0-0.2.
+std::string value_text(const YAML::Node& v) {
+    if (v.IsScalar()) return v.Scalar();
+    std::string out;
+    if (v.IsSequence())
+        for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "-" : "") + value_text(v[i]);
+    else
+        out = "map";
+    return out;
+}
+
+std::string sanitize(const std::string& s) {
+    std::string out;
+    for (char c : s) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+') ? c : '_';
+    return out;
+}
+
+std::string yaml_text(const YAML::Node& v) {
+    YAML::Emitter e;
+    e << YAML::Flow << v;
+    return e.c_str();
+}
+
+}  // namespace
+
+Sweep load_sweep_file(const std::string& path) {
+    const YamlView v = YamlView::load_file(path);
+    v.expect_map({"name", "base", "grid", "list", "seeds"});
+    Sweep sweep;
+    sweep.name = v.get("name", std::filesystem::path(path).stem().string());
+    const YAML::Node base = v.has("base") ? v["base"].node() : YAML::Node(YAML::NodeType::Map);
+    if (v.has("base")) v["base"].expect_map(trial_keys());
+    if (!v.has("grid") && !v.has("list")) v.fail("a sweep needs a 'grid' and/or a 'list' of conditions");
+
+    // Conditions: every combination of the grid (first key slowest), then the explicit list.
+    std::vector<std::vector<std::pair<std::string, YAML::Node>>> conditions;
+    std::vector<YamlView> condition_where;
+    if (v.has("grid")) {
+        const YamlView grid = v["grid"];
+        std::vector<std::pair<std::string, YamlView>> axes;
+        for (const auto& key : grid.keys()) {
+            const YamlView values = grid[key];
+            if (!values.is_sequence()) values.fail("expected a list of values to sweep");
+            if (values.size() == 0) values.fail("lists no values: an empty grid runs nothing");
+            axes.emplace_back(key, values);
+            sweep.keys.push_back(key);
+        }
+        if (axes.empty()) grid.fail("has no keys");
+        std::vector<std::size_t> idx(axes.size(), 0);
+        for (bool more = true; more;) {
+            std::vector<std::pair<std::string, YAML::Node>> c;
+            for (std::size_t a = 0; a < axes.size(); ++a) c.emplace_back(axes[a].first, axes[a].second.at(idx[a]).node());
+            conditions.push_back(c);
+            condition_where.push_back(axes.back().second.at(idx.back()));
+            more = false;
+            for (std::size_t a = axes.size(); a-- > 0;) {
+                if (++idx[a] < axes[a].second.size()) {
+                    more = true;
+                    break;
+                }
+                idx[a] = 0;
+            }
+        }
+    }
+    if (v.has("list")) {
+        const YamlView list = v["list"];
+        if (list.size() == 0) list.fail("is empty");
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            const YamlView item = list.at(i);
+            if (!item.is_map() || item.keys().empty()) item.fail("each condition is a mapping of keys to values");
+            std::vector<std::pair<std::string, YAML::Node>> c;
+            for (const auto& key : item.keys()) {
+                c.emplace_back(key, item[key].node());
+                if (std::find(sweep.keys.begin(), sweep.keys.end(), key) == sweep.keys.end()) sweep.keys.push_back(key);
+            }
+            conditions.push_back(c);
+            condition_where.push_back(item);
+        }
+    }
+
+    std::vector<std::uint64_t> seeds{0};
+    if (v.has("seeds")) {
+        const YamlView s = v["seeds"];
+        seeds.clear();
+        if (s.is_scalar()) {
+            const long long n = s.as_int();
+            if (n < 1) s.fail("must be >= 1 (a number of seeds) or a list of seeds");
+            for (long long i = 0; i < n; ++i) seeds.push_back(static_cast<std::uint64_t>(i));
+        } else {
+            if (s.size() == 0) s.fail("lists no seeds");
+            for (std::size_t i = 0; i < s.size(); ++i) {
+                const long long x = s.at(i).as_int();
+                if (x < 0) s.at(i).fail("seeds must be >= 0");
+                seeds.push_back(static_cast<std::uint64_t>(x));
+            }
+        }
+    }
+
+    for (std::size_t c = 0; c < conditions.size(); ++c) {
+        YAML::Node tree = YAML::Clone(base);
+        if (!tree.IsMap()) tree = YAML::Node(YAML::NodeType::Map);
+        std::string label = std::to_string(c);
+        label = "c" + std::string(label.size() < 3 ? 3 - label.size() : 0, '0') + label;
+        std::vector<std::pair<std::string, std::string>> swept;
+        for (const auto& [key, value] : conditions[c]) {
+            set_key(tree, key, value, condition_where[c]);
+            const auto parts = split_key(key);
+            label += "_" + sanitize(parts.back()) + "=" + sanitize(value_text(value));
+            swept.emplace_back(key, yaml_text(value));
+        }
+        TrialConfig t;
+        try {
+            t = trial_from_yaml(YamlView(tree, path, ""));
+        } catch (const ConfigError& e) {
+            std::string values;
+            for (const auto& [k, val] : swept) values += (values.empty() ? "" : ", ") + k + "=" + val;
+            throw ConfigError(path, e.key(), e.reason() + " (in condition " + std::to_string(c) + ": " + values + ")");
+        }
+        t.condition = label;
+        t.swept = swept;
+        for (auto s : seeds) {
+            t.seed = s;
+            sweep.trials.push_back(t);
+        }
+    }
+    return sweep;
+}
+
+}  // namespace bvc3d::config
