@@ -134,3 +134,12 @@ def test_cli_custom_models(tmp_path, source_dir):
         assert str(f) in proc.stderr and key in proc.stderr and reason in proc.stderr, proc.stderr
     proc = run_cli("bvc", "--model", "4d", "--pose", "0,0,0")
     assert proc.returncode == 2 and "unknown model '4d'" in proc.stderr
+
+
+def test_python_example_runs(source_dir):
+    import subprocess
+    import os
+    proc = subprocess.run(["/usr/bin/python3", str(source_dir / "example/python_api.py"), "0.1"],
+                          capture_output=True, text=True, env=dict(os.environ))
+    assert proc.returncode == 0, proc.stderr
+    assert "MSAI" in proc.stdout and "decoding" in proc.stdout
