@@ -11,8 +11,15 @@ namespace bvc3d::config {
 namespace {
 
 void read_bvc(const YamlView& v, BvcParams& b) {
-    v.expect_map({"elevations", "elevations_deg", "n_dir", "n_per_axis", "max_dist", "sigma_r", "sigma_theta",
-                  "sigma_phi", "normalization", "norm_constant", "reading"});
+    read_fields(v,
+                {{"n_dir", &b.n_dir},
+                 {"n_per_axis", &b.n_per_axis},
+                 {"max_dist", &b.max_dist},
+                 {"sigma_r", &b.sigma_r},
+                 {"sigma_theta", &b.sigma_theta},
+                 {"sigma_phi", &b.sigma_phi},
+                 {"norm_constant", &b.norm_constant}},
+                {"elevations", "elevations_deg", "normalization", "reading"});
     if (v.has("elevations") && v.has("elevations_deg")) v.fail("give 'elevations' (rad) or 'elevations_deg', not both");
     if (v.has("elevations")) {
         b.elevations = v["elevations"].is_sequence() ? v["elevations"].as_doubles() : std::vector<double>{};
@@ -25,13 +32,6 @@ void read_bvc(const YamlView& v, BvcParams& b) {
     }
     for (double e : b.elevations)
         if (std::abs(e) > pi / 2) v.fail_key("elevations", "must lie within ±π/2 rad");
-    b.n_dir = v.get("n_dir", b.n_dir);
-    b.n_per_axis = v.get("n_per_axis", b.n_per_axis);
-    b.max_dist = v.get("max_dist", b.max_dist);
-    b.sigma_r = v.get("sigma_r", b.sigma_r);
-    b.sigma_theta = v.get("sigma_theta", b.sigma_theta);
-    b.sigma_phi = v.get("sigma_phi", b.sigma_phi);
-    b.norm_constant = v.get("norm_constant", b.norm_constant);
     if (b.n_dir < 1) v["n_dir"].fail("must be >= 1");
     if (b.n_per_axis < 1) v["n_per_axis"].fail("must be >= 1");
     require_positive(v, "max_dist", b.max_dist);
@@ -57,15 +57,14 @@ void read_bvc(const YamlView& v, BvcParams& b) {
 }
 
 void read_place(const YamlView& v, PlaceParams& p) {
-    v.expect_map({"n_place", "p_connect", "dt_over_tau", "gamma_pb", "gamma_pp", "gain", "eta", "alpha_pb"});
-    p.n_place = v.get("n_place", p.n_place);
-    p.p_connect = v.get("p_connect", p.p_connect);
-    p.dt_over_tau = v.get("dt_over_tau", p.dt_over_tau);
-    p.gamma_pb = v.get("gamma_pb", p.gamma_pb);
-    p.gamma_pp = v.get("gamma_pp", p.gamma_pp);
-    p.gain = v.get("gain", p.gain);
-    p.eta = v.get("eta", p.eta);
-    p.alpha_pb = v.get("alpha_pb", p.alpha_pb);
+    read_fields(v, {{"n_place", &p.n_place},
+                    {"p_connect", &p.p_connect},
+                    {"dt_over_tau", &p.dt_over_tau},
+                    {"gamma_pb", &p.gamma_pb},
+                    {"gamma_pp", &p.gamma_pp},
+                    {"gain", &p.gain},
+                    {"eta", &p.eta},
+                    {"alpha_pb", &p.alpha_pb}});
     if (p.n_place < 1) v["n_place"].fail("must be >= 1");
     require_range(v, "p_connect", p.p_connect, 0.0, 1.0);
     require_range(v, "dt_over_tau", p.dt_over_tau, 1e-12, 1.0);

@@ -50,8 +50,10 @@ ModelSpec model_from(const YamlView& v) {
 }
 
 Protocol protocol_from(const YamlView& v) {
-    v.expect_map({"kind", "explore_hours", "sample_hours", "record_bvc"});
     Protocol p;
+    read_fields(v,
+                {{"explore_hours", &p.explore_hours}, {"sample_hours", &p.sample_hours}, {"record_bvc", &p.record_bvc}},
+                {"kind"});
     if (v.has("kind")) {
         try {
             p.kind = parse_protocol(v["kind"].as_string());
@@ -59,25 +61,21 @@ Protocol protocol_from(const YamlView& v) {
             v["kind"].fail(e.what());
         }
     }
-    p.explore_hours = v.get("explore_hours", p.explore_hours);
-    p.sample_hours = v.get("sample_hours", p.sample_hours);
-    p.record_bvc = v.get_bool("record_bvc", p.record_bvc);
     require_range(v, "explore_hours", p.explore_hours, 0.0, 1e6);
     if (!(p.sample_hours > 0)) v.fail_key("sample_hours", "must be > 0");
     return p;
 }
 
 RobotParams robot_from(const YamlView& v) {
-    v.expect_map({"radius", "height", "speed", "turn_rate", "model_dt", "n_walk", "turn_sd", "min_update_move"});
     RobotParams r;
-    r.radius = v.get("radius", r.radius);
-    r.height = v.get("height", r.height);
-    r.speed = v.get("speed", r.speed);
-    r.turn_rate = v.get("turn_rate", r.turn_rate);
-    r.model_dt = v.get("model_dt", r.model_dt);
-    r.n_walk = v.get("n_walk", r.n_walk);
-    r.turn_sd = v.get("turn_sd", r.turn_sd);
-    r.min_update_move = v.get("min_update_move", r.min_update_move);
+    read_fields(v, {{"radius", &r.radius},
+                    {"height", &r.height},
+                    {"speed", &r.speed},
+                    {"turn_rate", &r.turn_rate},
+                    {"model_dt", &r.model_dt},
+                    {"n_walk", &r.n_walk},
+                    {"turn_sd", &r.turn_sd},
+                    {"min_update_move", &r.min_update_move}});
     for (const char* k : {"radius", "height", "speed", "turn_rate", "model_dt"})
         if (v.has(k)) require_positive(v, k, v[k].as_double());
     if (r.n_walk < 1) v["n_walk"].fail("must be >= 1");
@@ -87,14 +85,14 @@ RobotParams robot_from(const YamlView& v) {
 }
 
 void analysis_from(const YamlView& v, TrialConfig& t) {
-    v.expect_map({"gridsize", "quantile", "eps", "min_samples", "d_th", "extent"});
     auto& a = t.analysis;
-    a.gridsize = v.get("gridsize", a.gridsize);
-    a.quantile = v.get("quantile", a.quantile);
-    a.dbscan.eps = v.get("eps", a.dbscan.eps);
-    a.dbscan.min_samples = v.get("min_samples", a.dbscan.min_samples);
-    a.d_th = v.get("d_th", a.d_th);
-    const std::string extent = v.get("extent", "data");
+    std::string extent = "data";
+    read_fields(v, {{"gridsize", &a.gridsize},
+                    {"quantile", &a.quantile},
+                    {"eps", &a.dbscan.eps},
+                    {"min_samples", &a.dbscan.min_samples},
+                    {"d_th", &a.d_th},
+                    {"extent", &extent}});
     if (extent != "data" && extent != "arena") v["extent"].fail("must be 'data' or 'arena'");
     t.arena_extent = extent == "arena";
     if (a.gridsize < 2) v["gridsize"].fail("must be >= 2");

@@ -53,15 +53,14 @@ Eigen::Isometry3d pose_from_yaml(const YamlView& v, const std::string& position_
 }
 
 CrossArenaParams cross_from_yaml(const YamlView& v) {
-    v.expect_map({"tilt_deg", "lean", "half_width", "height", "wall_length", "wall_thickness", "start_offset"});
     CrossArenaParams p;
-    p.tilt_deg = v.get("tilt_deg", p.tilt_deg);
-    p.lean = v.get("lean", p.lean);
-    p.half_width = v.get("half_width", p.half_width);
-    p.height = v.get("height", p.height);
-    p.wall_length = v.get("wall_length", p.wall_length);
-    p.wall_thickness = v.get("wall_thickness", p.wall_thickness);
-    p.start_offset = v.get("start_offset", p.start_offset);
+    read_fields(v, {{"tilt_deg", &p.tilt_deg},
+                    {"lean", &p.lean},
+                    {"half_width", &p.half_width},
+                    {"height", &p.height},
+                    {"wall_length", &p.wall_length},
+                    {"wall_thickness", &p.wall_thickness},
+                    {"start_offset", &p.start_offset}});
     return p;
 }
 
@@ -99,14 +98,14 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         for (int i = 0; i < 4; ++i) c[i] = vec3(v.at(i));
         part.add_quad(c[0], c[1], c[2], c[3]);
     } else if (kind == "tilted_wall") {
-        v.expect_map({"center", "length", "thickness", "height", "yaw_deg", "tilt_deg"});
         TiltedWall t;
+        double yaw = 0.0, tilt = 0.0;
+        read_fields(v,
+                    {{"length", &t.length}, {"thickness", &t.thickness}, {"height", &t.height}, {"yaw_deg", &yaw},
+                     {"tilt_deg", &tilt}},
+                    {"center"});
         t.centre = vec2(v["center"]);
-        t.length = v.get("length", t.length);
-        t.thickness = v.get("thickness", t.thickness);
-        t.height = v.get("height", t.height);
-        t.yaw = deg_to_rad(v.get("yaw_deg", 0.0));
-        const double tilt = v.get("tilt_deg", 0.0);
+        t.yaw = deg_to_rad(yaw);
         require_positive(v, "length", t.length);
         require_positive(v, "thickness", t.thickness);
         require_positive(v, "height", t.height);
@@ -205,8 +204,6 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
 }
 
 LidarSpec sensor_from_yaml(const YamlView& v) {
-    v.expect_map({"preset", "name", "elevations", "elevations_deg", "keep_rows", "azimuth_count", "azimuth_offset",
-                  "azimuth_offset_deg", "height", "max_range", "range_noise_sd", "dropout"});
     if (v.has("elevations") && v.has("elevations_deg")) v.fail("give 'elevations' (rad) or 'elevations_deg', not both");
     if (v.has("azimuth_offset") && v.has("azimuth_offset_deg"))
         v.fail("give 'azimuth_offset' (rad) or 'azimuth_offset_deg', not both");
@@ -237,13 +234,15 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
             s.elevations.push_back(degrees ? deg_to_rad(d) : d);
         }
     }
-    s.azimuth_count = v.get("azimuth_count", s.azimuth_count);
     if (v.has("azimuth_offset_deg")) s.azimuth_offset = deg_to_rad(v["azimuth_offset_deg"].as_double());
-    s.azimuth_offset = v.get("azimuth_offset", s.azimuth_offset);
-    s.height = v.get("height", s.height);
-    s.max_range = v.get("max_range", s.max_range);
-    s.range_noise_sd = v.get("range_noise_sd", s.range_noise_sd);
-    s.dropout = v.get("dropout", s.dropout);
+    read_fields(v,
+                {{"azimuth_count", &s.azimuth_count},
+                 {"azimuth_offset", &s.azimuth_offset},
+                 {"height", &s.height},
+                 {"max_range", &s.max_range},
+                 {"range_noise_sd", &s.range_noise_sd},
+                 {"dropout", &s.dropout}},
+                {"preset", "name", "elevations", "elevations_deg", "keep_rows", "azimuth_offset_deg"});
     if (s.azimuth_count < 1) v["azimuth_count"].fail("must be >= 1");
     require_range(v, "height", s.height, 0.0, 1e3);
     require_positive(v, "max_range", s.max_range);

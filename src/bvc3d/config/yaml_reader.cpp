@@ -151,6 +151,23 @@ bool YamlView::get_bool(const std::string& key, bool fallback) const {
     return has(key) ? (*this)[key].as_bool() : fallback;
 }
 
+void read_fields(const YamlView& v, std::initializer_list<Field> fields, std::initializer_list<const char*> also) {
+    std::vector<std::string> allowed;
+    for (const auto& f : fields) allowed.emplace_back(f.key);
+    for (const char* k : also) allowed.emplace_back(k);
+    v.expect_map(allowed);
+    for (const auto& f : fields) {
+        if (!v.has(f.key)) continue;
+        std::visit(
+            [&](auto* target) {
+                using T = std::remove_pointer_t<decltype(target)>;
+                if constexpr (std::is_same_v<T, bool>) *target = v.get_bool(f.key, *target);
+                else *target = v.get(f.key, *target);
+            },
+            f.target);
+    }
+}
+
 namespace {
 [[noreturn]] void fail_at(const YamlView& v, const std::string& key, const std::string& reason) {
     if (v.has(key)) v[key].fail(reason);

@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "bvc3d/core/error.hpp"
@@ -64,6 +65,16 @@ private:
     YAML::Node node_;
     std::string file_, path_;
 };
+
+// One optional member of a mapping and the field it fills.
+struct Field {
+    const char* key;
+    std::variant<double*, int*, std::string*, bool*> target;
+};
+
+// Fills each field whose key is present (checking its type) and rejects any key that is neither a
+// field nor in `also` (keys the caller reads itself). One table per struct: every key written once.
+void read_fields(const YamlView& v, std::initializer_list<Field> fields, std::initializer_list<const char*> also = {});
 
 // Number checks with the standard message.
 void require_positive(const YamlView& v, const std::string& key, double value);

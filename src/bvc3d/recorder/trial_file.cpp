@@ -134,12 +134,21 @@ h5::Handle open_trial(const std::filesystem::path& path) {
     return f;
 }
 
-double optional_tilt(hid_t f) {
-    try {
-        return h5::read_attr_double(f, "tilt_deg");
-    } catch (const InputError&) {
-        return NAN;
+TrialIdentity read_identity(hid_t f) {
+    TrialIdentity id;
+    id.name = h5::read_attr_string(f, "name");
+    id.world = h5::read_attr_string(f, "world");
+    id.model = h5::read_attr_string(f, "model");
+    id.seed = static_cast<std::uint64_t>(h5::read_attr_int(f, "seed"));
+    id.tilt_deg = h5::exists_attr(f, "tilt_deg") ? h5::read_attr_double(f, "tilt_deg") : NAN;
+    // Files from before conditions were recorded: the paper's condition, model and world.
+    id.condition = h5::exists_attr(f, "condition") ? h5::read_attr_string(f, "condition") : id.world + "_" + id.model;
+    std::istringstream swept(h5::exists_attr(f, "swept") ? h5::read_attr_string(f, "swept") : std::string());
+    for (std::string line; std::getline(swept, line);) {
+        const auto eq = line.find('=');
+        if (eq != std::string::npos) id.swept.emplace_back(line.substr(0, eq), line.substr(eq + 1));
     }
+    return id;
 }
 }  // namespace
 
@@ -147,13 +156,9 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     auto lock = h5::hdf5_lock();
     const auto f = open_trial(path);
     TrialFileData d;
-    d.name = h5::read_attr_string(f, "name");
-    d.world = h5::read_attr_string(f, "world");
-    d.model = h5::read_attr_string(f, "model");
+    static_cast<TrialIdentity&>(d) = read_identity(f);
     d.protocol = h5::read_attr_string(f, "protocol");
     d.config = h5::read_attr_string(f, "config");
-    d.seed = static_cast<std::uint64_t>(h5::read_attr_int(f, "seed"));
-    d.tilt_deg = optional_tilt(f);
     const auto s = h5::open_group(f, "samples");
     d.x = h5::read_doubles(s, "x");
     d.y = h5::read_doubles(s, "y");
@@ -169,18 +174,7 @@ TrialSummaryRow read_trial_summary(const std::filesystem::path& path) {
     auto lock = h5::hdf5_lock();
     const auto f = open_trial(path);
     TrialSummaryRow r;
-    r.name = h5::read_attr_string(f, "name");
-    r.world = h5::read_attr_string(f, "world");
-    r.model = h5::read_attr_string(f, "model");
-    // Files from before conditions were recorded: the paper's condition, model and world.
-    r.condition = h5::exists_attr(f, "condition") ? h5::read_attr_string(f, "condition") : r.world + "_" + r.model;
-    std::istringstream swept(h5::exists_attr(f, "swept") ? h5::read_attr_string(f, "swept") : std::string());
-    for (std::string line; std::getline(swept, line);) {
-        const auto eq = line.find('=');
-        if (eq != std::string::npos) r.swept.emplace_back(line.substr(0, eq), line.substr(eq + 1));
-    }
-    r.seed = static_cast<std::uint64_t>(h5::read_attr_int(f, "seed"));
-    r.tilt_deg = optional_tilt(f);
+    static_cast<TrialIdentity&>(r) = read_identity(f);
     const auto g = h5::open_group(f, "metrics");
     for (const auto& name : scalar_metric_names()) r.metrics.emplace_back(name, h5::read_attr_double(g, name));
     return r;

@@ -20,22 +20,24 @@ void write_trial_file(const std::filesystem::path& path, const TrialConfig& conf
 // The fingerprint of a complete trial file, or nullopt if it is missing, broken or not a trial file.
 std::optional<std::string> trial_file_fingerprint(const std::filesystem::path& path);
 
-// What `bvc3d analyze` and summaries read back.
-struct TrialFileData {
-    std::string name, world, model, protocol, config;
+// Which trial a file holds.
+struct TrialIdentity {
+    std::string name, condition, world, model;
+    std::vector<std::pair<std::string, std::string>> swept;  // the condition's defining values
     std::uint64_t seed = 0;
-    double tilt_deg = NAN;
+    double tilt_deg = NAN;  // cross arenas only
+};
+
+// What `bvc3d analyze` reads back.
+struct TrialFileData : TrialIdentity {
+    std::string protocol, config;
     std::vector<double> x, y;
     analysis::RowMatrixXf rates;  // samples × cells
 };
 TrialFileData read_trial_samples(const std::filesystem::path& path);  // throws InputError
 
 // The scalar metrics stored in a trial file, by name (for summaries).
-struct TrialSummaryRow {
-    std::string name, condition, world, model;
-    std::vector<std::pair<std::string, std::string>> swept;  // the condition's defining values
-    std::uint64_t seed = 0;
-    double tilt_deg = NAN;
+struct TrialSummaryRow : TrialIdentity {
     std::vector<std::pair<std::string, double>> metrics;
 };
 TrialSummaryRow read_trial_summary(const std::filesystem::path& path);  // throws InputError
