@@ -149,7 +149,7 @@ void add_run(CLI::App& app) {
         control.checkpoint_minutes = o->checkpoint_minutes;
         const auto start = std::chrono::steady_clock::now();
         if (tty)
-            control.progress = [&](double s) {
+            control.progress = [&](double s, std::int64_t) {
                 const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
                 std::fprintf(stderr, "\r  %.2f/%.2f simulated hours  ~%.0f s left   ", s / 3600, total / 3600,
                              s > 0 ? wall * (total - s) / s : 0.0);

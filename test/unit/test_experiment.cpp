@@ -83,7 +83,7 @@ TEST(TrialGroup, InterruptedAndResumedFromCheckpointIsIdentical) {
     control.stop = &stop;
     control.checkpoint = dir / "group.h5";
     control.checkpoint_minutes = 3;
-    control.progress = [&](double t) {
+    control.progress = [&](double t, std::int64_t) {
         if (t > 0.13 * 3600) stop = true;  // interrupt during the sampling phase
     };
     EXPECT_THROW(run_trial_group(group, control), Interrupted);

@@ -53,7 +53,10 @@ class Progress {
 public:
     Progress(bool on, int total_trials, double total_seconds)
         : on_(on), total_trials_(total_trials), total_seconds_(total_seconds), start_(Clock::now()) {}
-    void add_seconds(double s) { seconds_.fetch_add(s); }
+    void add(double seconds, std::int64_t walk_steps, std::int64_t models) {
+        seconds_.fetch_add(seconds);
+        live_model_steps_.fetch_add(walk_steps * models);
+    }
     void add_steps(std::int64_t n, std::int64_t models) {
         steps_.fetch_add(n);
         model_steps_.fetch_add(n * models);
@@ -66,10 +69,11 @@ public:
         std::lock_guard lock(mutex_);
         const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
         const double done = seconds_.load();
-        const double left = done > 0 ? wall * (total_seconds_ - done) / done : 0;
-        std::fprintf(stderr, "\r  %d/%d trials  %.1f/%.1f simulated hours  %.0f steps/s  %s%.0f s       %s",
+        char left[32] = "?";
+        if (final || done > 0) std::snprintf(left, sizeof left, "%.0f", final ? wall : wall * (total_seconds_ - done) / done);
+        std::fprintf(stderr, "\r  %d/%d trials  %.1f/%.1f simulated hours  %.0f model steps/s  %s%s s       %s",
                      trials_.load(), total_trials_, done / 3600, total_seconds_ / 3600,
-                     wall > 0 ? static_cast<double>(steps_.load()) / wall : 0.0, final ? "took " : "~", final ? wall : left,
+                     wall > 0 ? static_cast<double>(live_model_steps_.load()) / wall : 0.0, final ? "took " : "~", left,
                      final ? "\n" : "");
         std::fflush(stderr);
     }
@@ -80,7 +84,7 @@ private:
     double total_seconds_;
     Clock::time_point start_;
     std::atomic<double> seconds_{0};
-    std::atomic<std::int64_t> steps_{0}, model_steps_{0};
+    std::atomic<std::int64_t> steps_{0}, model_steps_{0}, live_model_steps_{0};
     std::atomic<int> trials_{0};
     std::mutex mutex_;
 };
@@ -195,9 +199,12 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
         control.checkpoint = ckpt_dir / (g.key + ".h5");
         control.checkpoint_minutes = options.checkpoint_minutes;
         double last = 0;
-        control.progress = [&](double t) {
-            progress.add_seconds(t - last);
+        std::int64_t last_steps = 0;
+        const auto n_models = static_cast<std::int64_t>(members.size());
+        control.progress = [&](double t, std::int64_t steps) {
+            progress.add(t - last, steps - last_steps, n_models);
             last = t;
+            last_steps = steps;
         };
         const GroupResult result = run_trial_group(members, control);
         const WorldDescription world = members.front().world.resolve();

@@ -188,7 +188,7 @@ GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunCon
             continue;  // exploration is over: go on sampling from here
         }
         run.step(*s, !sampling || online, sampling);
-        if (control.progress && n % 512 == 0) control.progress(run.walk.time());
+        if (control.progress && n % 512 == 0) control.progress(run.walk.time(), run.step_index);
         const bool stop = control.stop && n % 64 == 0 && control.stop->load();
         if (!control.checkpoint.empty() && (stop || run.walk.time() >= next_ckpt)) {
             write_checkpoint(control.checkpoint, run.checkpoint(fingerprint));
@@ -196,7 +196,7 @@ GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunCon
         }
         if (stop) throw Interrupted();
     }
-    if (control.progress) control.progress(run.walk.time());
+    if (control.progress) control.progress(run.walk.time(), run.step_index);
     for (std::size_t i = 0; i < run.nets.size(); ++i) run.result.models[i].weights = run.nets[i].weights();
     run.result.stats.end_time = run.walk.time();
     return std::move(run.result);

@@ -24,7 +24,7 @@ public:
 
 struct RunControl {
     const std::atomic<bool>* stop = nullptr;            // checked every few steps
-    std::function<void(double seconds_done)> progress;  // simulated seconds, every few hundred steps
+    std::function<void(double seconds_done, std::int64_t steps_done)> progress;  // every few hundred steps
     std::filesystem::path checkpoint;                   // empty: no checkpoints
     double checkpoint_minutes = 0;                      // > 0: also every this many simulated minutes
 };
