@@ -247,11 +247,7 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     return bound <= pruned_tolerance * max_raw;
 }
 
-std::size_t BoundaryVectorLayer::angular(double azimuth) const {
-    std::uint64_t bits;
-    std::memcpy(&bits, &azimuth, sizeof bits);
-    const std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 54);
-    if (cache_key_[slot] == azimuth) return slot;
+std::size_t BoundaryVectorLayer::fill_angular(std::size_t slot, double azimuth) const {
     const int K = p_.n_dir;
     const double dtheta = two_pi / K, h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta);
     const bool all_dirs = 2.0 * cut_theta_ >= two_pi;

@@ -5,6 +5,7 @@
 // distance d_m = m·max_dist/(n_per_axis - 1).
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string>
 #include <vector>
@@ -93,7 +94,14 @@ private:
     // (scanners repeat the same azimuths row after row). Slot s holds count_[s] directions at
     // dir_/weight_[s·n_dir ...]; a NaN key never matches.
     static constexpr std::size_t cache_slots = 1024;
-    std::size_t angular(double azimuth) const;  // the slot holding `azimuth`
+    // The slot holding `azimuth`: a hit is a multiply, a shift and a compare; a miss fills the slot.
+    std::size_t angular(double azimuth) const {
+        std::uint64_t bits;
+        std::memcpy(&bits, &azimuth, sizeof bits);
+        const std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 54);
+        return cache_key_[slot] == azimuth ? slot : fill_angular(slot, azimuth);
+    }
+    std::size_t fill_angular(std::size_t slot, double azimuth) const;
     mutable std::vector<double> cache_key_, cache_weight_;
     mutable std::vector<int> cache_count_, cache_dir_;
 
