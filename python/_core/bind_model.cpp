@@ -2,7 +2,10 @@
 #include "bindings.hpp"
 
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/model_spec.hpp"
+#include "bvc3d/experiment/trial_runner.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
 
 namespace bvc3d::py {
 
@@ -132,6 +135,51 @@ Cell i = (l, k, m) sits at index (l·n_dir + k)·n_per_axis + m. elevations=None
         .def_property_readonly("n_place", &PlaceCellNetwork::n_place)
         .def_property_readonly("n_bvc", &PlaceCellNetwork::n_bvc)
         .def("reset", &PlaceCellNetwork::reset, "Membrane and rates back to zero; weights kept");
+
+    m.def(
+        "run_trial",
+        [](const std::string& model, const std::string& world, std::optional<double> tilt_deg, std::uint64_t seed,
+           double explore_hours, double sample_hours, const std::string& protocol, bool record_bvc) {
+            TrialConfig t;
+            t.model = config::resolve_model(model);
+            t.world = WorldSpec{world, tilt_deg, "+x+y"};
+            t.seed = seed;
+            t.protocol.kind = parse_protocol(protocol);
+            t.protocol.explore_hours = explore_hours;
+            t.protocol.sample_hours = sample_hours;
+            t.protocol.record_bvc = record_bvc;
+            t.protocol.validate();
+            const WorldDescription w = t.world.resolve();
+            GroupResult r;
+            analysis::TrialMetrics metrics;
+            {
+                pyb::gil_scoped_release release;
+                r = run_trial_group({t});
+                metrics = analyze(t, w, r.x, r.y, r.models[0].rates, r.models[0].n_place);
+            }
+            const auto n = static_cast<pyb::ssize_t>(r.t.size());
+            const auto& rec = r.models[0];
+            pyb::dict out;
+            out["t"] = to_numpy(r.t.data(), {n});
+            out["x"] = to_numpy(r.x.data(), {n});
+            out["y"] = to_numpy(r.y.data(), {n});
+            out["heading"] = to_numpy(r.heading.data(), {n});
+            out["rates"] = to_numpy(rec.rates.data(), {n, rec.n_place});
+            if (record_bvc) out["bvc_rates"] = to_numpy(rec.bvc.data(), {n, rec.n_bvc});
+            out["weights"] = to_numpy(rec.weights.data(), {rec.n_place, rec.n_bvc});
+            pyb::dict scalars;
+            for (const auto& [name, v] : scalar_metrics(metrics)) scalars[name.c_str()] = v;
+            out["metrics"] = scalars;
+            out["name"] = t.name();
+            return out;
+        },
+        pyb::arg("model") = "3d-0.2", pyb::arg("world") = "cross", pyb::arg("tilt_deg") = pyb::none(),
+        pyb::arg("seed") = 0, pyb::arg("explore_hours") = 4.0, pyb::arg("sample_hours") = 4.0,
+        pyb::arg("protocol") = "explore_then_sample", pyb::arg("record_bvc") = false,
+        R"doc(One trial (SPEC §7) at full speed, as `bvc3d run` does it, returned as numpy arrays: t, x, y,
+heading (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded,
+and metrics (dict of SPEC §8's scalar metrics). model: a preset or model YAML; world: a preset or world
+YAML; tilt_deg: for world="cross".)doc");
 
     m.def("model_presets", &model_preset_names, "Names of the model presets");
     m.def(

@@ -5,9 +5,9 @@ Stages follow the data flow: World -> Sensor scan -> BoundaryVectorLayer -> Plac
 -> recorded samples -> bvc3d.analysis -> bvc3d.report.
 """
 from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Sensor, World, model_presets, model_sensor,
-                    random_walk)
+                    random_walk, run_trial)
 from . import analysis
 
 __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Sensor", "World", "analysis", "model_presets",
-           "model_sensor", "random_walk"]
+           "model_sensor", "random_walk", "run_trial"]
 __version__ = "0.1.0"

@@ -216,3 +216,25 @@ def test_trial_yaml(tmp_path):
     cfg.write_text("world: cross\nmodel: 3d-0.1\nprotocol: {explore_hours: 1, sample_hour: 1}\n")
     proc = run_cli("run", "--config", cfg, "--out", out)
     assert proc.returncode == 2 and "protocol.sample_hour" in proc.stderr and "unknown key" in proc.stderr
+
+
+def test_python_run_trial_matches_the_cli(tmp_path):
+    import bvc3d
+    r = bvc3d.run_trial(model="3d-0.1", world="cross", tilt_deg=30, seed=2, explore_hours=0.05, sample_hours=0.05,
+                        record_bvc=True)
+    n = len(r["t"])
+    assert r["rates"].shape == (n, 250) and r["rates"].dtype == np.float32
+    assert r["bvc_rates"].shape == (n, 960) and r["weights"].shape == (250, 960)
+    out = tmp_path / "t.h5"
+    run_cli("run", "--model", "3d-0.1", "--world", "cross", "--tilt", 30, "--seed", 2, "--hours", HOURS, "--out", out,
+            check=True)
+    with h5py.File(out) as f:
+        np.testing.assert_array_equal(f["samples/rates"][:], r["rates"])
+        np.testing.assert_array_equal(f["weights"][:], r["weights"])
+        for k, v in r["metrics"].items():
+            assert v == pytest.approx(f["metrics"].attrs[k], nan_ok=True), k
+    assert r["name"] == "cross-30_3d-0.1_seed2"
+    with pytest.raises(ValueError, match="unknown model"):
+        bvc3d.run_trial(model="4d")
+    with pytest.raises(ValueError, match="sample_hours"):
+        bvc3d.run_trial(sample_hours=0)
