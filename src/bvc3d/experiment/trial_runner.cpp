@@ -94,6 +94,15 @@ GroupRun::GroupRun(const std::vector<TrialConfig>& t)
         rec.n_bvc = c.model.bvc.n_cells();
         result.models.push_back(std::move(rec));
     }
+    // Room for the samples a full recording phase can hold (a model step takes model_dt of forward
+    // motion), so growing buffers never double past it: with many models on one walk that matters.
+    const auto& first = trials.front();
+    const auto expected = static_cast<std::size_t>(first.protocol.sample_hours * 3600.0 / first.robot.model_dt) + 64;
+    for (auto* v : {&result.t, &result.x, &result.y, &result.heading}) v->reserve(expected);
+    for (auto& rec : result.models) {
+        rec.rates.reserve(expected * rec.n_place);
+        if (first.protocol.record_bvc) rec.bvc.reserve(expected * rec.n_bvc);
+    }
 }
 
 void GroupRun::step(const WalkStep& s, bool learn, bool record) {
