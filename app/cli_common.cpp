@@ -7,19 +7,33 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d::cli {
 
-namespace {
 double parse_number(const std::string& s, const std::string& what) {
     double v = 0;
     const auto* end = s.data() + s.size();
     const auto r = std::from_chars(s.data(), end, v);
     if (s.empty() || r.ec != std::errc() || r.ptr != end || !std::isfinite(v))
-        throw InputError("--pose: " + what + " '" + s + "' is not a finite number");
+        throw InputError(what + " '" + s + "' is not a finite number");
     return v;
 }
-}  // namespace
+
+const CLI::Validator seed_check(
+    [](std::string& s) -> std::string {
+        return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos ? "" : "a seed is a whole number >= 0";
+    },
+    "SEED>=0");
+
+const CLI::Validator non_negative_check(
+    [](std::string& s) -> std::string {
+        double v = 0;
+        const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+        return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(v) && v >= 0 ? ""
+                                                                                                  : "must be a number >= 0";
+    },
+    "NUMBER>=0");
 
 Pose parse_pose(const std::string& text) {
     std::vector<std::string> parts;
@@ -31,20 +45,16 @@ Pose parse_pose(const std::string& text) {
         }
     if (parts.size() != 3) throw InputError("--pose expects X,Y,HEADING (three comma-separated numbers), got '" + text + "'");
     Pose p;
-    p.x = parse_number(parts[0], "X");
-    p.y = parse_number(parts[1], "Y");
+    p.x = parse_number(parts[0], "--pose: X");
+    p.y = parse_number(parts[1], "--pose: Y");
     std::string h = parts[2];
     const bool degrees = h.size() > 3 && h.compare(h.size() - 3, 3, "deg") == 0;
     if (degrees) h.resize(h.size() - 3);
-    p.heading = parse_number(h, "HEADING");
+    p.heading = parse_number(h, "--pose: HEADING");
     if (degrees) p.heading = deg_to_rad(p.heading);
     return p;
 }
 
-std::string num(double v) {
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest exact round-trip form
-    return std::string(buf, r.ptr);
-}
+std::string num(double v) { return format_number(v); }
 
 }  // namespace bvc3d::cli

@@ -17,6 +17,13 @@ Pose parse_pose(const std::string& text);
 // Full-precision decimal text for numbers written to CSV.
 std::string num(double v);
 
+// A finite number (std::from_chars: no spaces, no trailing text); `what` names it in the error.
+double parse_number(const std::string& text, const std::string& what);
+
+// Option checks with short messages: seeds are whole numbers >= 0, durations numbers >= 0.
+extern const CLI::Validator seed_check;
+extern const CLI::Validator non_negative_check;
+
 // Ctrl-C handling shared by the long-running commands: the flag the SIGINT handler sets, a guard
 // that installs the handler, and the clean exit (status 130).
 std::atomic<bool>& stop_flag();

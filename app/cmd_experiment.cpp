@@ -1,4 +1,5 @@
 // bvc3d run / paper / analyze: trials, the paper's experiment, and analysis of trial files.
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -21,10 +22,11 @@ namespace bvc3d::cli {
 
 namespace {
 
-// Ctrl-C asks running trials to checkpoint and stop; a second Ctrl-C ends the program at once.
-extern "C" void on_sigint(int) {
+// Ctrl-C (SIGINT) or SIGTERM (mpirun passing on a Ctrl-C, a batch system's time limit) asks running
+// trials to checkpoint and stop; a second signal ends the program at once.
+extern "C" void on_stop_signal(int sig) {
     stop_flag().store(true);
-    std::signal(SIGINT, SIG_DFL);
+    std::signal(sig, SIG_DFL);
 }
 
 std::vector<std::string> split(const std::string& s) {
@@ -35,26 +37,27 @@ std::vector<std::string> split(const std::string& s) {
     return out;
 }
 
-double parse_double(const std::string& s, const std::string& what) {
-    try {
-        std::size_t used = 0;
-        const double v = std::stod(s, &used);
-        if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument(s);
-        return v;
-    } catch (const std::exception&) {
-        throw InputError(what + ": '" + s + "' is not a number");
-    }
-}
-
-// Runs the report module: /usr/bin/python3 -m bvc3d.report DIR.
+// Runs the report module, `python3 -m bvc3d.report DIR`, as a child process (no shell); returns
+// its exit status.
 int run_report(const std::filesystem::path& dir) {
     const char* py_env = std::getenv("BVC3D_PYTHON");
     const std::string python = py_env ? py_env : BVC3D_PYTHON;
     const char* path_env = std::getenv("BVC3D_PYTHONPATH");
     std::string pythonpath = path_env ? path_env : BVC3D_PYTHON_DIR;
     if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing) pythonpath += std::string(":") + existing;
-    const std::string cmd = "PYTHONPATH='" + pythonpath + "' '" + python + "' -m bvc3d.report '" + dir.string() + "'";
-    return std::system(cmd.c_str());
+    std::fflush(stdout);  // our lines first, then the report's
+    const pid_t pid = ::fork();
+    if (pid < 0) return -1;
+    if (pid == 0) {
+        ::setenv("PYTHONPATH", pythonpath.c_str(), 1);
+        ::execl(python.c_str(), python.c_str(), "-m", "bvc3d.report", dir.c_str(), static_cast<char*>(nullptr));
+        std::perror(("bvc3d: cannot run " + python).c_str());
+        ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace
@@ -64,8 +67,14 @@ std::atomic<bool>& stop_flag() {
     return stop;
 }
 
-InterruptGuard::InterruptGuard() { std::signal(SIGINT, on_sigint); }
-InterruptGuard::~InterruptGuard() { std::signal(SIGINT, SIG_DFL); }
+InterruptGuard::InterruptGuard() {
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+}
+InterruptGuard::~InterruptGuard() {
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+}
 
 void exit_interrupted() {
     std::cerr << "\nbvc3d: interrupted; finished trials are kept. Run the same command again to resume.\n";
@@ -100,7 +109,7 @@ void add_run(CLI::App& app) {
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward (default +x+y)");
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
-    cmd->add_option("--seed", o->seed, "Random seed (default 0)");
+    cmd->add_option("--seed", o->seed, "Random seed (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
     cmd->add_option("--sample-hours", o->sample_hours, "Simulated hours of sampling (recorded)");
@@ -130,7 +139,7 @@ void add_run(CLI::App& app) {
             t.arena_extent = o->extent == "arena";
         }
         if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-        t.protocol.validate();
+        t.validate();
         const WorldDescription world = t.world.resolve();
         const std::filesystem::path out = o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
                                                          : std::filesystem::path(o->out);
@@ -161,7 +170,7 @@ void add_run(CLI::App& app) {
             exit_interrupted();
         }
         const auto metrics = analyze(t, world, result.x, result.y, result.models[0].rates, result.models[0].n_place);
-        write_trial_file(out, t, result, 0, metrics);
+        write_trial_file(out, t, result, 0, metrics, analysis_params(t, world));
         std::filesystem::remove(control.checkpoint);
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (tty) std::fprintf(stderr, "\n");
@@ -204,7 +213,7 @@ void add_paper(CLI::App& app) {
         for (const auto& m : split(o->models)) models.push_back(config::resolve_model(m));
         if (models.empty()) throw InputError("--models lists no model");
         std::vector<double> tilts;
-        for (const auto& t : split(o->tilts)) tilts.push_back(parse_double(t, "--tilts"));
+        for (const auto& t : split(o->tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
         if (tilts.empty()) throw InputError("--tilts lists no tilt");
         std::vector<TrialConfig> trials;
         for (int seed = 0; seed < o->seeds; ++seed)
@@ -247,32 +256,46 @@ void add_analyze(CLI::App& app) {
     auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files (SPEC §8), optionally with other parameters");
     struct Options {
         std::vector<std::string> files;
-        analysis::AnalysisParams params;
+        std::optional<int> gridsize, min_samples;
+        std::optional<double> quantile, eps, d_th;
         std::string extent, cells;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("files", o->files, "Trial files (.h5)")->required();
-    cmd->add_option("--gridsize", o->params.gridsize, "Hexagons across x")->capture_default_str();
-    cmd->add_option("--quantile", o->params.quantile, "Rate-map threshold quantile")->capture_default_str();
-    cmd->add_option("--eps", o->params.dbscan.eps, "DBSCAN radius, m")->capture_default_str();
-    cmd->add_option("--min-samples", o->params.dbscan.min_samples, "DBSCAN min_samples")->capture_default_str();
-    cmd->add_option("--d-th", o->params.d_th, "SAI exclusion distance, m")->capture_default_str();
-    cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX (default: the trajectory's)");
+    cmd->add_option("--gridsize", o->gridsize, "Hexagons across x");
+    cmd->add_option("--quantile", o->quantile, "Rate-map threshold quantile");
+    cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
+    cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
+    cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
+    cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX, or 'data' for the trajectory's own");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
+    cmd->footer("Each file is analysed with the parameters its metrics were computed with; the options change only\n"
+                "what they name (SPEC §8 defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2).");
     cmd->callback([o] {
-        if (!o->extent.empty()) {
+        std::optional<analysis::Extent> extent;
+        if (!o->extent.empty() && o->extent != "data") {
             const auto parts = split(o->extent);
-            if (parts.size() != 4) throw InputError("--extent expects XMIN,XMAX,YMIN,YMAX");
-            o->params.extent = analysis::Extent{parse_double(parts[0], "--extent"), parse_double(parts[1], "--extent"),
-                                                parse_double(parts[2], "--extent"), parse_double(parts[3], "--extent")};
+            if (parts.size() != 4) throw InputError("--extent expects XMIN,XMAX,YMIN,YMAX or 'data'");
+            extent = analysis::Extent{parse_number(parts[0], "--extent: a bound"), parse_number(parts[1], "--extent: a bound"),
+                                      parse_number(parts[2], "--extent: a bound"), parse_number(parts[3], "--extent: a bound")};
         }
-        o->params.validate();
+        std::vector<TrialFileData> trials;
+        for (const auto& f : o->files) trials.push_back(read_trial_samples(f));  // all readable before any output
         std::printf("%-40s", "trial");
         for (const auto& n : scalar_metric_names()) std::printf(" %15s", n.c_str());
         std::printf("\n");
-        for (std::size_t i = 0; i < o->files.size(); ++i) {
-            const auto d = read_trial_samples(o->files[i]);
-            const auto m = analysis::analyze_trial<float>(d.x, d.y, d.rates, o->params);
+        for (std::size_t i = 0; i < trials.size(); ++i) {
+            const auto& d = trials[i];
+            analysis::AnalysisParams params = d.analysis;
+            if (o->gridsize) params.gridsize = *o->gridsize;
+            if (o->quantile) params.quantile = *o->quantile;
+            if (o->eps) params.dbscan.eps = *o->eps;
+            if (o->min_samples) params.dbscan.min_samples = *o->min_samples;
+            if (o->d_th) params.d_th = *o->d_th;
+            if (o->extent == "data") params.extent.reset();
+            if (extent) params.extent = extent;
+            params.validate();
+            const auto m = analysis::analyze_trial<float>(d.x, d.y, d.rates, params);
             std::printf("%-40s", d.name.c_str());
             for (const auto& [name, v] : scalar_metrics(m)) std::printf(" %15.6g", v);
             std::printf("\n");

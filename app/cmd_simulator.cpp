@@ -72,8 +72,8 @@ void add_walk(CLI::App& app) {
     auto seed = std::make_shared<std::uint64_t>(0);
     auto out = std::make_shared<std::string>();
     world->add_to(*cmd);
-    cmd->add_option("--hours", *hours, "Simulated hours to walk")->capture_default_str()->check(CLI::NonNegativeNumber);
-    cmd->add_option("--seed", *seed, "Random seed")->capture_default_str();
+    cmd->add_option("--hours", *hours, "Simulated hours to walk")->capture_default_str()->check(non_negative_check);
+    cmd->add_option("--seed", *seed, "Random seed")->capture_default_str()->check(seed_check);
     cmd->add_option("--out", *out, "CSV file to write (default: standard output)");
     cmd->footer(
         "One row per model step (SPEC §4): t in simulated seconds, position in metres, heading in radians,\n"

@@ -86,6 +86,11 @@ void add_sweep_command(CLI::App& app) {
         opts.stop = &stop_flag();
         opts.progress = ::isatty(STDERR_FILENO);
         InterruptGuard guard;
+#ifndef BVC3D_HAVE_MPI
+        if (launched_by_mpi())
+            throw InputError("this bvc3d was built without MPI, so under mpirun every rank would run every trial: "
+                             "rebuild with MPI (libopenmpi-dev) or run `bvc3d sweep` without mpirun");
+#endif
         bool root = true;
         int rank = 0;
         std::mutex print;

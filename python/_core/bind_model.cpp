@@ -148,7 +148,7 @@ Cell i = (l, k, m) sits at index (l·n_dir + k)·n_per_axis + m. elevations=None
             t.protocol.explore_hours = explore_hours;
             t.protocol.sample_hours = sample_hours;
             t.protocol.record_bvc = record_bvc;
-            t.protocol.validate();
+            t.validate();
             const WorldDescription w = t.world.resolve();
             GroupResult r;
             analysis::TrialMetrics metrics;

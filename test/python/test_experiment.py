@@ -167,7 +167,7 @@ def test_single_trial_checkpoint_resume_is_identical(tmp_path):
     (["paper", "--models", "2d,4d"], "unknown model '4d'"),
     (["paper", "--hours", "-1"], "--hours must be a positive"),
     (["paper", "--seeds", "0"], "--seeds must be >= 1"),
-    (["paper", "--tilts", "0,abc"], "'abc' is not a number"),
+    (["paper", "--tilts", "0,abc"], "'abc' is not a finite number"),
     (["paper", "--tilts", "75"], "pass through the outer walls"),
     (["run", "--world", "atlantis"], "neither a preset"),
     (["run", "--sample-hours", "0"], "sample_hours must be a positive"),
@@ -238,3 +238,45 @@ def test_python_run_trial_matches_the_cli(tmp_path):
         bvc3d.run_trial(model="4d")
     with pytest.raises(ValueError, match="sample_hours"):
         bvc3d.run_trial(sample_hours=0)
+
+
+def test_analyze_starts_from_the_files_own_parameters(tmp_path):
+    out = tmp_path / "arena.h5"
+    run_cli("run", "--tilt", 45, "--hours", HOURS, "--extent", "arena", "--out", out, check=True)
+    row = run_cli("analyze", out, check=True).stdout.splitlines()[1].split()
+    with h5py.File(out) as f:
+        assert float(row[1]) == pytest.approx(f["metrics"].attrs["frac_active"])
+        assert float(row[7]) == f["metrics"].attrs["n_bins"]
+        np.testing.assert_array_equal(f["metrics/extent"][:], [-5, 5, -5, 5])
+    data = run_cli("analyze", out, "--extent", "data", check=True).stdout.splitlines()[1].split()
+    assert data[7] != row[7]  # binned over the trajectory instead: another grid
+
+
+def test_sigterm_checkpoints_like_ctrl_c(tmp_path):
+    target = tmp_path / "t.h5"
+    proc = subprocess.Popen([CLI, "run", "--model", "3d-3l", "--hours", "0.5", "--out", str(target),
+                             "--checkpoint-minutes", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    ckpt = tmp_path / "t.h5.ckpt"
+    deadline = time.time() + 60
+    while time.time() < deadline and not ckpt.exists():
+        time.sleep(0.005)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    if proc.returncode == 0:
+        pytest.skip("the trial finished before the signal arrived")
+    assert proc.returncode == 130 and "interrupted" in err
+    assert ckpt.exists() and not target.exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["run", "--seed", "-1"], "seed"),
+    (["walk", "--seed", "1.5"], "seed"),
+    (["walk", "--hours", "-1"], "must be a number >= 0"),
+    (["scan", "--pose", "1e30,0,0"], "within ±1e6 m"),
+    (["run", "--hours", "0.0001"], "fewer than 2 model steps"),
+])
+def test_more_bad_input(tmp_path, args, message):
+    proc = run_cli(*args, *(["--out", str(tmp_path / "t.h5")] if args[0] == "run" else []))
+    assert proc.returncode != 0, proc.stderr
+    assert message in proc.stderr, proc.stderr
+    assert len(proc.stderr) < 400  # a short message, not a wall of digits

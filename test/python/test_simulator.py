@@ -136,7 +136,7 @@ def test_cli_bad_worlds(cli, tmp_path, source_dir, name, command):
     (["scan", "--pose", "0,0"], "--pose expects X,Y,HEADING"),
     (["scan", "--pose", "0,nan,0"], "not a finite number"),
     (["scan", "--sensor", "radar", "--pose", "0,0,0"], "neither 'horizontal', 'spherical'"),
-    (["walk", "--world", "cross-30", "--tilt", "45"], "--tilt only applies"),
+    (["walk", "--world", "cross-30", "--tilt", "45"], "a tilt only applies"),
     (["walk", "--world", "cross", "--tilt", "95"], "tilt_deg must be in [0, 90)"),
     (["walk", "--world", "cross", "--lean", "up"], "lean 'up'"),
 ])
@@ -158,3 +158,10 @@ def test_cli_negative_hours_is_a_usage_error(cli):
     proc = cli("walk", "--hours", "-1")
     assert proc.returncode != 0
     assert "hours" in proc.stderr.lower()
+
+
+def test_scan_rejects_non_finite_poses():
+    w = bvc3d.World.cross()
+    for pose in [(float("nan"), 0, 0), (0, 0, float("inf")), (1e30, 0, 0)]:
+        with pytest.raises(ValueError, match="finite and within"):
+            w.scan("spherical", *pose)

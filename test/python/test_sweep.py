@@ -94,7 +94,7 @@ BAD = {
     "grid: {model.bvc.sigma_phi: [0.01, -1]}\n": ("model.bvc.sigma_phi", "must be > 0"),
     "grid: {model.bvc.colour: [1]}\n": ("model.bvc.colour", "unknown key"),
     "base: {model: 3d-0.2}\n": ("", "needs a 'grid' and/or a 'list'"),
-    "grid: {seed: [1]}\nseeds: 0\n": ("seeds", "must be >= 1"),
+    "grid: {world.tilt_deg: [10]}\nseeds: 0\n": ("seeds", "must be >= 1"),
     "grid: {model: [2d, 5d]}\n": ("model", "unknown model '5d'"),
     "list: [3]\n": ("list[0]", "mapping of keys to values"),
 }
@@ -109,3 +109,26 @@ def test_bad_sweep_files(tmp_path, text):
     assert proc.returncode == 2, proc.stderr
     assert str(f) in proc.stderr and key in proc.stderr and reason in proc.stderr, proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_robot_settings_get_their_own_walks(tmp_path):
+    f = tmp_path / "speed.yaml"
+    f.write_text("base: {model: 2d, world: {source: cross, tilt_deg: 0}}\ngrid: {robot.speed: [0.5, 1.0]}\n")
+    run_cli("sweep", f, "--out", tmp_path / "out", "--hours", "0.02", "--no-report", check=True)
+    import h5py
+    import numpy as np
+    steps = {}
+    for p in (tmp_path / "out").glob("*.h5"):
+        with h5py.File(p) as h:
+            x, y, bumped = h["samples/x"][:], h["samples/y"][:], h["samples/bumped"][:] if "bumped" in h["samples"] else None
+            d = np.hypot(np.diff(x), np.diff(y))
+            steps[p.name.split("_seed")[0].split("=")[-1]] = np.median(d)
+    assert steps["0.5"] == pytest.approx(0.144, abs=1e-6)
+    assert steps["1.0"] == pytest.approx(0.288, abs=1e-6)
+
+
+def test_seed_is_not_a_grid_key(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text("grid: {seed: [1, 2]}\n")
+    proc = run_cli("sweep", f)
+    assert proc.returncode == 2 and "list them under 'seeds:'" in proc.stderr

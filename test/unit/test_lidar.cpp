@@ -161,3 +161,12 @@ TEST(SensorSpec, RejectsImpossibleValues) {
     s.azimuth_count = 0;
     EXPECT_THROW(Lidar{s}, InputError);
 }
+
+TEST(SensorSpec, RejectsPosesOutsideAnyWorld) {
+    const World w = box_world();
+    const Lidar lidar(LidarSpec::horizontal());
+    EXPECT_THROW(lidar.scan(w, Pose{NAN, 0, 0}), InputError);
+    EXPECT_THROW(lidar.scan(w, Pose{0, 0, INFINITY}), InputError);
+    EXPECT_THROW(lidar.scan(w, Pose{1e30, 0, 0}), InputError);
+    EXPECT_NO_THROW(lidar.scan(w, Pose{0, 0, 100.0}));  // a heading of many turns is fine
+}

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/error.hpp"
 #include "bvc3d/robot/random_walk.hpp"
 
 using namespace bvc3d;
@@ -236,4 +237,57 @@ TEST(BodyCollider, ExactContactDistances) {
     // Touching and moving into the contact: blocked; moving away: free.
     EXPECT_EQ(body.free_distance(Vec2(-0.75 + 1e-12, 0), Vec2(1, 0), 1.0), 0.0);
     EXPECT_EQ(body.free_distance(Vec2(-0.75 + 1e-12, 0), Vec2(-1, 0), 1.0), 1.0);
+}
+
+namespace {
+// A walkable square with a solid 2 x 2 x 1 m box in its middle.
+WorldDescription box_world(StartRegion start = {}) {
+    WorldDescription w;
+    w.name = "box";
+    w.mesh.append(box_mesh(Vec3(2, 2, 1)), Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.5)));
+    w.mesh.add_quad(Vec3(-4, -4, 3), Vec3(4, -4, 3), Vec3(4, 4, 3), Vec3(-4, 4, 3));  // a ceiling, for rays
+    w.walkable = Polygon2::rectangle(-4, -4, 4, 4);
+    w.start = start;
+    if (w.start.points.empty() && w.start.region.points.empty()) w.start.region = w.walkable;
+    return w;
+}
+}  // namespace
+
+TEST(RandomWalk, NeverStartsInsideASolidObstacle) {
+    const World world(box_world());
+    for (std::uint64_t seed = 0; seed < 120; ++seed) {
+        const auto s = random_walk(world, 0.002, seed);
+        ASSERT_FALSE(s.empty());
+        // Outside the box's footprint grown by the body radius (the box spans |x|, |y| <= 1).
+        EXPECT_GT(std::max(std::abs(s[0].x), std::abs(s[0].y)), 1.0 + R - 1e-6) << "seed " << seed;
+    }
+    const BodyCollider body(box_world(), R, 0.1);
+    EXPECT_TRUE(body.is_free(Vec2(0, 0)));  // far from every wall, yet inside the box:
+    EXPECT_FALSE(body.can_start_at(Vec2(0, 0)));
+    EXPECT_TRUE(body.can_start_at(Vec2(3, 3)));
+    const auto [inside, largest] = body.free_area(Vec2(0, 0));
+    EXPECT_NEAR(inside, 1.5 * 1.5, 0.3);  // the body's centre can roam |x|, |y| <= 0.75 in there
+    EXPECT_NEAR(largest, 64 - 2.5 * 2.5 - (8 * 8 - 7.5 * 7.5), 1.5);
+    // An explicit start point inside the box, or a start region that lies entirely inside it.
+    try {
+        World w(box_world(StartRegion{{Vec2(0, 0)}, {}}));
+        random_walk(w, 0.01, 1);
+        ADD_FAILURE();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("closed-off free area"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(random_walk(World(box_world(StartRegion{{}, Polygon2::rectangle(-0.5, -0.5, 0.5, 0.5)})), 0.01, 1),
+                 InputError);
+}
+
+TEST(RandomWalk, AJammedRobotIsAnErrorNotAHang) {
+    // A pocket barely wider than the body: every heading is blocked at once.
+    WorldDescription w;
+    w.name = "pocket";
+    w.mesh.add_quad(Vec3(-1, -1, 2), Vec3(1, -1, 2), Vec3(1, 1, 2), Vec3(-1, 1, 2));
+    w.walkable = Polygon2::rectangle(-0.2501, -0.2501, 0.2501, 0.2501);
+    w.start.points = {Vec2(0, 0)};
+    RobotParams fast;
+    fast.turn_rate = 1e6;  // turns take no time: without the jam check this would never end
+    EXPECT_THROW(random_walk(World(w), 1.0, 0, fast), InputError);
 }

@@ -143,6 +143,8 @@ TEST(WorldYamlErrors, NameFileKeyAndReason) {
     expect_config_error("objects:\n  - cross_arena: {}\nstart: {points: [[9, 9]]}\n", "start.points[0]",
                         "outside the walkable region");
     expect_config_error("", "", "empty");
+    expect_config_error("objects:\n  - box: {center: [0,0,0], size: [1,1,1], size: [2,2,2]}\n" + std::string(walls),
+                        "objects[0].box.size", "appears twice");
 }
 
 TEST(WorldYamlErrors, BrokenAndDegenerateMeshFiles) {

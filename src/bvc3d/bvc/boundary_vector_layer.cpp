@@ -32,8 +32,9 @@ void BvcParams::validate() const {
     auto fail = [](const std::string& what) { throw InputError("BVC layer: " + what); };
     for (double e : elevations)
         if (!std::isfinite(e) || std::abs(e) > pi / 2) fail("every elevation must be finite and within ±π/2 rad");
-    if (n_dir < 1) fail("n_dir must be >= 1");
-    if (n_per_axis < 1) fail("n_per_axis must be >= 1");
+    if (n_dir < 1 || n_dir > 4096) fail("n_dir must be in [1, 4096]");
+    if (n_per_axis < 1 || n_per_axis > 100000) fail("n_per_axis must be in [1, 100000]");
+    if (elevations.size() > 1024) fail("at most 1024 elevation layers");
     if (!std::isfinite(max_dist) || max_dist < 0 || (n_per_axis > 1 && max_dist == 0))
         fail("max_dist must be > 0");
     if (!std::isfinite(sigma_r) || sigma_r <= 0) fail("sigma_r must be > 0");
@@ -166,7 +167,7 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
         ++valid;
         if (!any_kept && !any_dropped) continue;
-        const std::size_t slot = angular(ret.azimuth);
+        const std::size_t slot = angular(wrap_pi(ret.azimuth));  // any azimuth, however many turns
         const int* dir = cache_dir_.data() + slot * K;
         const double* ang = cache_weight_.data() + slot * K;
         const int n_dirs = cache_count_[slot];

@@ -5,6 +5,7 @@
 
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d::config {
 
@@ -73,12 +74,6 @@ void read_place(const YamlView& v, PlaceParams& p) {
     require_positive(v, "alpha_pb", p.alpha_pb);
 }
 
-std::string fmt(double x) {
-    std::ostringstream os;
-    os.precision(17);
-    os << x;
-    return os.str();
-}
 
 }  // namespace
 
@@ -129,20 +124,20 @@ std::string model_to_yaml(const ModelSpec& m) {
     std::ostringstream os;
     os << "name: " << m.name << "\n";
     os << "sensor:\n  name: " << m.sensor.name << "\n  elevations: [";
-    for (std::size_t i = 0; i < m.sensor.elevations.size(); ++i) os << (i ? ", " : "") << fmt(m.sensor.elevations[i]);
-    os << "]\n  azimuth_count: " << m.sensor.azimuth_count << "\n  azimuth_offset: " << fmt(m.sensor.azimuth_offset)
-       << "\n  height: " << fmt(m.sensor.height) << "\n  max_range: " << fmt(m.sensor.max_range)
-       << "\n  range_noise_sd: " << fmt(m.sensor.range_noise_sd) << "\n  dropout: " << fmt(m.sensor.dropout) << "\n";
+    for (std::size_t i = 0; i < m.sensor.elevations.size(); ++i) os << (i ? ", " : "") << format_number(m.sensor.elevations[i]);
+    os << "]\n  azimuth_count: " << m.sensor.azimuth_count << "\n  azimuth_offset: " << format_number(m.sensor.azimuth_offset)
+       << "\n  height: " << format_number(m.sensor.height) << "\n  max_range: " << format_number(m.sensor.max_range)
+       << "\n  range_noise_sd: " << format_number(m.sensor.range_noise_sd) << "\n  dropout: " << format_number(m.sensor.dropout) << "\n";
     os << "bvc:\n  elevations: [";
-    for (std::size_t i = 0; i < m.bvc.elevations.size(); ++i) os << (i ? ", " : "") << fmt(m.bvc.elevations[i]);
-    os << "]\n  n_dir: " << m.bvc.n_dir << "\n  n_per_axis: " << m.bvc.n_per_axis << "\n  max_dist: " << fmt(m.bvc.max_dist)
-       << "\n  sigma_r: " << fmt(m.bvc.sigma_r) << "\n  sigma_theta: " << fmt(m.bvc.sigma_theta)
-       << "\n  sigma_phi: " << fmt(m.bvc.sigma_phi) << "\n  normalization: " << to_string(m.bvc.normalization)
-       << "\n  norm_constant: " << fmt(m.bvc.norm_constant) << "\n  reading: " << to_string(m.bvc.reading) << "\n";
+    for (std::size_t i = 0; i < m.bvc.elevations.size(); ++i) os << (i ? ", " : "") << format_number(m.bvc.elevations[i]);
+    os << "]\n  n_dir: " << m.bvc.n_dir << "\n  n_per_axis: " << m.bvc.n_per_axis << "\n  max_dist: " << format_number(m.bvc.max_dist)
+       << "\n  sigma_r: " << format_number(m.bvc.sigma_r) << "\n  sigma_theta: " << format_number(m.bvc.sigma_theta)
+       << "\n  sigma_phi: " << format_number(m.bvc.sigma_phi) << "\n  normalization: " << to_string(m.bvc.normalization)
+       << "\n  norm_constant: " << format_number(m.bvc.norm_constant) << "\n  reading: " << to_string(m.bvc.reading) << "\n";
     const auto& p = m.place;
-    os << "place:\n  n_place: " << p.n_place << "\n  p_connect: " << fmt(p.p_connect) << "\n  dt_over_tau: " << fmt(p.dt_over_tau)
-       << "\n  gamma_pb: " << fmt(p.gamma_pb) << "\n  gamma_pp: " << fmt(p.gamma_pp) << "\n  gain: " << fmt(p.gain)
-       << "\n  eta: " << fmt(p.eta) << "\n  alpha_pb: " << fmt(p.alpha_pb) << "\n";
+    os << "place:\n  n_place: " << p.n_place << "\n  p_connect: " << format_number(p.p_connect) << "\n  dt_over_tau: " << format_number(p.dt_over_tau)
+       << "\n  gamma_pb: " << format_number(p.gamma_pb) << "\n  gamma_pp: " << format_number(p.gamma_pp) << "\n  gain: " << format_number(p.gain)
+       << "\n  eta: " << format_number(p.eta) << "\n  alpha_pb: " << format_number(p.alpha_pb) << "\n";
     return os.str();
 }
 

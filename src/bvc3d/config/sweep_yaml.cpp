@@ -83,6 +83,7 @@ Sweep load_sweep_file(const std::string& path) {
         const YamlView grid = v["grid"];
         std::vector<std::pair<std::string, YamlView>> axes;
         for (const auto& key : grid.keys()) {
+            if (key == "seed") grid.fail_key(key, "seeds are not a grid key: list them under 'seeds:'");
             const YamlView values = grid[key];
             if (!values.is_sequence()) values.fail("expected a list of values to sweep");
             if (values.size() == 0) values.fail("lists no values: an empty grid runs nothing");
@@ -114,6 +115,7 @@ Sweep load_sweep_file(const std::string& path) {
             if (!item.is_map() || item.keys().empty()) item.fail("each condition is a mapping of keys to values");
             std::vector<std::pair<std::string, YAML::Node>> c;
             for (const auto& key : item.keys()) {
+                if (key == "seed") item.fail_key(key, "seeds are not a condition key: list them under 'seeds:'");
                 c.emplace_back(key, item[key].node());
                 if (std::find(sweep.keys.begin(), sweep.keys.end(), key) == sweep.keys.end()) sweep.keys.push_back(key);
             }

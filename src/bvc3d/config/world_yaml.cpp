@@ -151,6 +151,7 @@ WorldDescription world_from_yaml(const YamlView& v) {
     std::optional<WorldDescription> arena;
     for (std::size_t i = 0; i < objects.size(); ++i) add_object(objects.at(i), w, arena);
 
+    if (arena) w.tilt_deg = arena->tilt_deg;
     if (v.has("walkable")) {
         w.walkable = region_from_yaml(v["walkable"]);
     } else if (arena) {
@@ -186,14 +187,14 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
         CrossArenaParams p;
         p.lean = lean;
         if (name != "cross") {
-            if (tilt_deg) throw InputError("--tilt only applies to the 'cross' world; '" + name + "' fixes its tilt");
+            if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world; '" + name + "' fixes its own");
             p.tilt_deg = std::stod(name.substr(6));
         } else if (tilt_deg) {
             p.tilt_deg = *tilt_deg;
         }
         return cross_arena(p);
     }
-    if (tilt_deg) throw InputError("--tilt only applies to the 'cross' world, not to '" + name + "'");
+    if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world, not to '" + name + "'");
     std::error_code ec;
     if (!std::filesystem::exists(name, ec)) {
         std::string list;

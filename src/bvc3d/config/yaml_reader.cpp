@@ -1,5 +1,8 @@
 #include "bvc3d/config/yaml_reader.hpp"
 
+#include "bvc3d/core/format.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -52,8 +55,12 @@ void YamlView::expect_map(std::initializer_list<const char*> allowed) const {
 
 void YamlView::expect_map(const std::vector<std::string>& allowed) const {
     if (!node_.IsMap()) fail("expected a mapping of keys to values");
+    std::vector<std::string> seen;
     for (const auto& kv : node_) {
         const std::string k = kv.first.as<std::string>();
+        if (std::find(seen.begin(), seen.end(), k) != seen.end())
+            YamlView(kv.first, file_, child_path(k)).fail("appears twice in the same mapping");
+        seen.push_back(k);
         bool ok = false;
         for (const auto& a : allowed) ok = ok || a == k;
         if (!ok) {
@@ -176,13 +183,12 @@ namespace {
 }  // namespace
 
 void require_positive(const YamlView& v, const std::string& key, double value) {
-    if (!(value > 0)) fail_at(v, key, "must be > 0, got " + std::to_string(value));
+    if (!(value > 0)) fail_at(v, key, "must be > 0, got " + format_number(value));
 }
 
 void require_range(const YamlView& v, const std::string& key, double value, double lo, double hi) {
     if (!(value >= lo && value <= hi))
-        fail_at(v, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                            std::to_string(value));
+        fail_at(v, key, "must be in [" + format_number(lo) + ", " + format_number(hi) + "], got " + format_number(value));
 }
 
 }  // namespace bvc3d::config

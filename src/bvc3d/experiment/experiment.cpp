@@ -25,16 +25,13 @@ struct Group {
     std::string key;
 };
 
-// Trials that share world, seed and protocol run on one walk.
+// Trials that share world, seed, protocol and robot run on one walk.
 std::vector<Group> make_groups(const std::vector<TrialConfig>& trials, const std::vector<std::size_t>& todo) {
     std::map<std::string, Group> by_key;
     std::vector<std::string> order;
     for (std::size_t i : todo) {
         const auto& t = trials[i];
-        const std::string key = t.world.label() + "_seed" + std::to_string(t.seed) + "_" +
-                                protocol_name(t.protocol.kind) + "_" + std::to_string(t.protocol.explore_hours) + "_" +
-                                std::to_string(t.protocol.sample_hours) + (t.protocol.record_bvc ? "_bvc" : "") + "_" +
-                                t.world.fingerprint();
+        const std::string key = t.walk_key();
         if (!by_key.count(key)) order.push_back(key);
         by_key[key].members.push_back(i);
     }
@@ -95,13 +92,18 @@ std::filesystem::path trial_path(const std::filesystem::path& out_dir, const Tri
     return out_dir / (t.name() + ".h5");
 }
 
-analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& world, const std::vector<double>& x,
-                               const std::vector<double>& y, const std::vector<float>& rates, int n_place) {
+analysis::AnalysisParams analysis_params(const TrialConfig& t, const WorldDescription& world) {
     analysis::AnalysisParams params = t.analysis;
     if (t.arena_extent) {
         const auto box = world.walkable.bounds();
         params.extent = analysis::Extent{box.min().x(), box.max().x(), box.min().y(), box.max().y()};
     }
+    return params;
+}
+
+analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& world, const std::vector<double>& x,
+                               const std::vector<double>& y, const std::vector<float>& rates, int n_place) {
+    const analysis::AnalysisParams params = analysis_params(t, world);
     const Eigen::Map<const analysis::RowMatrixXf> r(rates.data(), static_cast<Eigen::Index>(x.size()), n_place);
     return analysis::analyze_trial<float>(x, y, r, params);
 }
@@ -136,9 +138,7 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
     std::set<std::string> names;
     for (const auto& t : trials) {
         if (!names.insert(t.name()).second) throw InputError("two trials would share the file name '" + t.name() + "'");
-        t.model.validate();
-        t.protocol.validate();
-        t.analysis.validate();
+        t.validate();
         t.world.resolve();  // fail early on bad worlds
     }
     ensure_writable_directory(options.out_dir);
@@ -211,7 +211,8 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
         for (std::size_t k = 0; k < members.size(); ++k) {
             const auto metrics =
                 analyze(members[k], world, result.x, result.y, result.models[k].rates, result.models[k].n_place);
-            write_trial_file(trial_path(options.out_dir, members[k]), members[k], result, k, metrics);
+            write_trial_file(trial_path(options.out_dir, members[k]), members[k], result, k, metrics,
+                             analysis_params(members[k], world));
             if (options.on_trial_done) options.on_trial_done(members[k].name());
             progress.trial_done();
             ++ran;

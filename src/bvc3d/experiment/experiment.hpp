@@ -52,6 +52,9 @@ std::filesystem::path trial_path(const std::filesystem::path& out_dir, const Tri
 ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options,
                                  Coordinator* coordinator = nullptr);
 
+// A trial's analysis parameters, with the arena's bounds as the extent when it asks for them.
+analysis::AnalysisParams analysis_params(const TrialConfig& t, const WorldDescription& world);
+
 // Analyses a trial's recorded samples (SPEC §8) with its configured parameters.
 analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& world, const std::vector<double>& x,
                                const std::vector<double>& y, const std::vector<float>& rates, int n_place);

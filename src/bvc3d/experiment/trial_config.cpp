@@ -9,17 +9,13 @@
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
 
 namespace bvc3d {
 
 namespace {
 
-std::string fmt(double x) {
-    std::ostringstream os;
-    os << std::setprecision(17) << x;
-    return os.str();
-}
 
 std::uint64_t text_hash(const std::string& s) {
     std::uint64_t h = 0x6276633364ull;
@@ -33,7 +29,7 @@ WorldDescription WorldSpec::resolve() const { return config::resolve_world(sourc
 
 std::string WorldSpec::label() const {
     if (source == "cross") {
-        std::string l = "cross-" + fmt(tilt_deg.value_or(0.0));
+        std::string l = "cross-" + format_number(tilt_deg.value_or(0.0));
         return lean == "+x+y" ? l : l + "_" + lean;
     }
     const auto presets = config::world_preset_names();
@@ -44,7 +40,7 @@ std::string WorldSpec::label() const {
 std::string WorldSpec::fingerprint() const {
     const auto presets = config::world_preset_names();
     if (std::find(presets.begin(), presets.end(), source) != presets.end())
-        return "preset " + source + " tilt " + fmt(tilt_deg.value_or(0.0)) + " lean " + lean;
+        return "preset " + source + " tilt " + format_number(tilt_deg.value_or(0.0)) + " lean " + lean;
     std::ifstream in(source);
     std::stringstream text;
     text << in.rdbuf();
@@ -65,24 +61,40 @@ Protocol::Kind parse_protocol(const std::string& name) {
     throw InputError("protocol '" + name + "' is not one of explore_then_sample, online");
 }
 
+void TrialConfig::validate() const {
+    model.validate();
+    protocol.validate();
+    robot.validate();
+    analysis.validate();
+    // Decoding compares two halves of the recorded samples: at least two model steps are needed.
+    if (protocol.sample_hours * 3600.0 < 2.0 * robot.model_dt)
+        throw InputError("sample_hours = " + format_number(protocol.sample_hours) + " h records fewer than 2 model steps (" +
+                         format_number(robot.model_dt) + " s each)");
+}
+
 std::string TrialConfig::condition_label() const {
     return condition.empty() ? world.label() + "_" + model.name : condition;
 }
 
 std::string TrialConfig::name() const { return condition_label() + "_seed" + std::to_string(seed); }
 
+std::string TrialConfig::walk_key() const {
+    std::ostringstream os;
+    os << "world: " << world.fingerprint() << "\nprotocol:\n  kind: " << protocol_name(protocol.kind)
+       << "\n  explore_hours: " << format_number(protocol.explore_hours) << "\n  sample_hours: " << format_number(protocol.sample_hours)
+       << "\n  record_bvc: " << (protocol.record_bvc ? "true" : "false") << "\nrobot:\n  radius: " << format_number(robot.radius)
+       << "\n  height: " << format_number(robot.height) << "\n  speed: " << format_number(robot.speed) << "\n  turn_rate: " << format_number(robot.turn_rate)
+       << "\n  model_dt: " << format_number(robot.model_dt) << "\n  n_walk: " << robot.n_walk << "\n  turn_sd: " << format_number(robot.turn_sd)
+       << "\n  min_update_move: " << format_number(robot.min_update_move) << "\nseed: " << seed << "\n";
+    return os.str();
+}
+
 std::string TrialConfig::canonical() const {
     std::ostringstream os;
-    os << "world: " << world.fingerprint() << "\n"
-       << config::model_to_yaml(model) << "protocol:\n  kind: " << protocol_name(protocol.kind)
-       << "\n  explore_hours: " << fmt(protocol.explore_hours) << "\n  sample_hours: " << fmt(protocol.sample_hours)
-       << "\n  record_bvc: " << (protocol.record_bvc ? "true" : "false") << "\nrobot:\n  radius: " << fmt(robot.radius)
-       << "\n  height: " << fmt(robot.height) << "\n  speed: " << fmt(robot.speed) << "\n  turn_rate: " << fmt(robot.turn_rate)
-       << "\n  model_dt: " << fmt(robot.model_dt) << "\n  n_walk: " << robot.n_walk << "\n  turn_sd: " << fmt(robot.turn_sd)
-       << "\n  min_update_move: " << fmt(robot.min_update_move) << "\nanalysis:\n  gridsize: " << analysis.gridsize
-       << "\n  quantile: " << fmt(analysis.quantile) << "\n  eps: " << fmt(analysis.dbscan.eps)
-       << "\n  min_samples: " << analysis.dbscan.min_samples << "\n  d_th: " << fmt(analysis.d_th)
-       << "\n  extent: " << (arena_extent ? "arena" : "data") << "\nseed: " << seed << "\n";
+    os << walk_key() << config::model_to_yaml(model) << "analysis:\n  gridsize: " << analysis.gridsize
+       << "\n  quantile: " << format_number(analysis.quantile) << "\n  eps: " << format_number(analysis.dbscan.eps)
+       << "\n  min_samples: " << analysis.dbscan.min_samples << "\n  d_th: " << format_number(analysis.d_th)
+       << "\n  extent: " << (arena_extent ? "arena" : "data") << "\n";
     return os.str();
 }
 

@@ -47,7 +47,12 @@ struct TrialConfig {
     std::vector<std::pair<std::string, std::string>> swept;
 
     std::string condition_label() const;
+    // Throws InputError for impossible values (model, protocol, robot, analysis, durations).
+    void validate() const;
     std::string name() const;  // "<condition>_seed<N>", the trial file's stem
+    // Everything that determines the walk (world, seed, protocol, robot), as text: trials with equal
+    // keys can share one walk.
+    std::string walk_key() const;
     // Everything that determines the trial's results, as text: equal text, equal results.
     std::string canonical() const;
     std::string fingerprint() const;  // a short hash of canonical()

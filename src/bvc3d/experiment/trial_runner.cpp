@@ -3,7 +3,6 @@
 #include <filesystem>
 #include <sstream>
 
-#include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recorder/checkpoint_file.hpp"
 
@@ -20,26 +19,13 @@ struct SensorUse {
     bool full_cast = false;
 };
 
-std::string sensor_key(const LidarSpec& s) {
-    ModelSpec m;
-    m.sensor = s;
-    const std::string y = config::model_to_yaml(m);
-    return y.substr(0, y.find("bvc:"));
-}
-
 void check_group(const std::vector<TrialConfig>& trials) {
     if (trials.empty()) throw InputError("a trial group needs at least one trial");
     const TrialConfig& a = trials.front();
     for (const auto& b : trials) {
-        b.model.validate();
-        b.protocol.validate();
-        b.robot.validate();
-        b.analysis.validate();
-        if (b.world.fingerprint() != a.world.fingerprint() || b.seed != a.seed ||
-            protocol_name(b.protocol.kind) != protocol_name(a.protocol.kind) ||
-            b.protocol.explore_hours != a.protocol.explore_hours || b.protocol.sample_hours != a.protocol.sample_hours ||
-            b.protocol.record_bvc != a.protocol.record_bvc)
-            throw InputError("trials in one group must share world, seed and protocol");
+        b.validate();
+        if (b.walk_key() != a.walk_key())
+            throw InputError("trials in one group must share world, seed, protocol and robot");
     }
 }
 
@@ -72,20 +58,18 @@ RandomWalk make_walk(const World& world, const TrialConfig& c) {
 
 GroupRun::GroupRun(const std::vector<TrialConfig>& t)
     : trials(t), world(t.front().world.resolve()), walk(make_walk(world, t.front())) {
-    std::vector<std::string> keys;
     for (const auto& c : trials) {
         layers.emplace_back(c.model.bvc);
         nets.emplace_back(c.model.bvc.n_cells(), c.model.place, c.seed);
         bvc_rates.emplace_back(layers.back().n_cells());
-        const std::string key = sensor_key(c.model.sensor);
-        auto it = std::find(keys.begin(), keys.end(), key);
-        if (it == keys.end()) {
-            keys.push_back(key);
+        auto it = std::find_if(sensors.begin(), sensors.end(),
+                               [&](const SensorUse& u) { return u.spec.same_beams(c.model.sensor); });
+        if (it == sensors.end()) {
             sensors.push_back(SensorUse{c.model.sensor, Lidar(c.model.sensor),
                                         std::vector<char>(c.model.sensor.elevations.size(), 0), {}, {}, false});
-            it = keys.end() - 1;
+            it = sensors.end() - 1;
         }
-        const int si = static_cast<int>(it - keys.begin());
+        const int si = static_cast<int>(it - sensors.begin());
         sensor_of.push_back(si);
         plans.push_back(layers.back().plan(c.model.sensor));
         for (std::size_t r = 0; r < plans.back().rows.size(); ++r) sensors[si].rows[r] |= plans.back().rows[r];
@@ -107,7 +91,10 @@ GroupRun::GroupRun(const std::vector<TrialConfig>& t)
 
 void GroupRun::step(const WalkStep& s, bool learn, bool record) {
     const Pose pose{s.x, s.y, s.heading};
-    const NoiseKey noise{trials.front().seed, static_cast<std::uint64_t>(step_index)};
+    // Sensor noise: the trial's own stream, the same draws for every sensor of the group (common
+    // random numbers: conditions that differ in their noise level see the same underlying draws).
+    const NoiseKey noise{hash_u64(trials.front().seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0),
+                         static_cast<std::uint64_t>(step_index)};
     for (auto& u : sensors) {
         u.lidar.scan(world, pose, u.scan, noise, u.rows);
         u.full_cast = false;

@@ -1,5 +1,6 @@
 #include "bvc3d/place/place_cell_network.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -11,7 +12,7 @@ namespace bvc3d {
 
 void PlaceParams::validate() const {
     auto fail = [](const std::string& what) { throw InputError("place cells: " + what); };
-    if (n_place < 1) fail("n_place must be >= 1");
+    if (n_place < 1 || n_place > 1000000) fail("n_place must be in [1, 1000000]");
     if (!(p_connect >= 0 && p_connect <= 1)) fail("p_connect must be in [0, 1]");
     if (!(std::isfinite(dt_over_tau) && dt_over_tau > 0 && dt_over_tau <= 1)) fail("dt_over_tau must be in (0, 1]");
     if (!(std::isfinite(gamma_pb) && std::isfinite(gamma_pp))) fail("gamma_pb and gamma_pp must be finite");
@@ -57,6 +58,10 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
         s_[i] = s_[i] + k * (-s_[i] + drive_[i] - inhibition);
         v_[i] = std::tanh(gain * std::max(s_[i], 0.0f));
     }
+    // Weights that ran away (a learning rate far too large) show up here first: stop early.
+    if (!std::isfinite(inhibition) || !std::all_of(s_.begin(), s_.end(), [](float x) { return std::isfinite(x); }))
+        throw InputError("place cells diverged (non-finite membrane potentials): the weights ran away; is the "
+                         "learning rate eta = " + std::to_string(p_.eta) + " too large?");
     if (learn && p_.eta > 0) {
         // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
         const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);

@@ -15,9 +15,16 @@ std::vector<T> column(const Eigen::Ref<const Eigen::VectorXd>& v) {
     return std::vector<T>(v.data(), v.data() + v.size());
 }
 
-void write_metrics(hid_t f, const analysis::TrialMetrics& m) {
+void write_metrics(hid_t f, const analysis::TrialMetrics& m, const analysis::AnalysisParams& p) {
     const auto g = h5::create_group(f, "metrics");
     for (const auto& [name, value] : scalar_metrics(m)) h5::write_attr(g, name, value);
+    // How they were computed, so that `bvc3d analyze` starts from the same parameters.
+    h5::write_attr(g, "gridsize", static_cast<std::int64_t>(p.gridsize));
+    h5::write_attr(g, "quantile", p.quantile);
+    h5::write_attr(g, "eps", p.dbscan.eps);
+    h5::write_attr(g, "min_samples", static_cast<std::int64_t>(p.dbscan.min_samples));
+    h5::write_attr(g, "d_th", p.d_th);
+    if (p.extent) h5::write(g, "extent", std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, {4}, false);
     const auto& bins = m.maps.bins;
     const std::size_t nb = static_cast<std::size_t>(bins.size()), nc = static_cast<std::size_t>(m.maps.map.cols());
     h5::write(g, "modality", std::vector<std::int64_t>(m.modality.begin(), m.modality.end()), {m.modality.size()});
@@ -57,7 +64,8 @@ std::vector<std::pair<std::string, double>> scalar_metrics(const analysis::Trial
 }
 
 void write_trial_file(const std::filesystem::path& path, const TrialConfig& config, const GroupResult& group,
-                      std::size_t model_index, const analysis::TrialMetrics& metrics) {
+                      std::size_t model_index, const analysis::TrialMetrics& metrics,
+                      const analysis::AnalysisParams& params) {
     const ModelRecord& rec = group.models.at(model_index);
     const std::size_t n = group.t.size();
     AtomicFile out(path);
@@ -73,9 +81,7 @@ void write_trial_file(const std::filesystem::path& path, const TrialConfig& conf
         h5::write_attr(f, "swept", swept);
         h5::write_attr(f, "world", config.world.label());
         h5::write_attr(f, "world_source", config.world.source);
-        if (config.world.source == "cross" || config.world.source.rfind("cross-", 0) == 0)
-            h5::write_attr(f, "tilt_deg", config.world.source == "cross" ? config.world.tilt_deg.value_or(0.0)
-                                                                        : std::stod(config.world.source.substr(6)));
+        if (const auto tilt = config.world.resolve().tilt_deg) h5::write_attr(f, "tilt_deg", *tilt);
         h5::write_attr(f, "model", config.model.name);
         h5::write_attr(f, "sensor", config.model.sensor.name);
         h5::write_attr(f, "seed", static_cast<std::int64_t>(config.seed));
@@ -100,7 +106,7 @@ void write_trial_file(const std::filesystem::path& path, const TrialConfig& conf
         h5::write_attr(w, "bumps", group.stats.bumps);
         h5::write_attr(w, "full_scan_fallbacks", group.stats.full_scan_fallbacks);
         h5::write_attr(w, "end_time", group.stats.end_time);
-        write_metrics(f, metrics);
+        write_metrics(f, metrics, params);
     }
     out.commit();
 }
@@ -159,6 +165,18 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     static_cast<TrialIdentity&>(d) = read_identity(f);
     d.protocol = h5::read_attr_string(f, "protocol");
     d.config = h5::read_attr_string(f, "config");
+    const auto g = h5::open_group(f, "metrics");
+    if (h5::exists_attr(g, "gridsize")) {
+        d.analysis.gridsize = static_cast<int>(h5::read_attr_int(g, "gridsize"));
+        d.analysis.quantile = h5::read_attr_double(g, "quantile");
+        d.analysis.dbscan.eps = h5::read_attr_double(g, "eps");
+        d.analysis.dbscan.min_samples = static_cast<int>(h5::read_attr_int(g, "min_samples"));
+        d.analysis.d_th = h5::read_attr_double(g, "d_th");
+    }
+    if (h5::exists(g, "extent")) {
+        const auto e = h5::read_doubles(g, "extent");
+        if (e.size() == 4) d.analysis.extent = analysis::Extent{e[0], e[1], e[2], e[3]};
+    }
     const auto s = h5::open_group(f, "samples");
     d.x = h5::read_doubles(s, "x");
     d.y = h5::read_doubles(s, "y");

@@ -14,8 +14,10 @@ namespace bvc3d {
 inline constexpr int trial_file_format_version = 1;
 
 // Writes the file atomically: it appears only when complete.
+// `params` are the analysis parameters the metrics were computed with; they are stored with them.
 void write_trial_file(const std::filesystem::path& path, const TrialConfig& config, const GroupResult& group,
-                      std::size_t model_index, const analysis::TrialMetrics& metrics);
+                      std::size_t model_index, const analysis::TrialMetrics& metrics,
+                      const analysis::AnalysisParams& params);
 
 // The fingerprint of a complete trial file, or nullopt if it is missing, broken or not a trial file.
 std::optional<std::string> trial_file_fingerprint(const std::filesystem::path& path);
@@ -31,6 +33,7 @@ struct TrialIdentity {
 // What `bvc3d analyze` reads back.
 struct TrialFileData : TrialIdentity {
     std::string protocol, config;
+    analysis::AnalysisParams analysis;  // the parameters its metrics were computed with (defaults if unrecorded)
     std::vector<double> x, y;
     analysis::RowMatrixXf rates;  // samples × cells
 };

@@ -6,17 +6,13 @@
 #include <map>
 
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 
 namespace {
 
-std::string num(double v) {
-    if (std::isnan(v)) return "nan";
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);
-    return std::string(buf, r.ptr);
-}
+std::string num(double v) { return format_number(v); }
 
 std::string fixed(double v, int digits) {
     if (std::isnan(v)) return "–";

@@ -174,6 +174,79 @@ double BodyCollider::free_distance(const Vec2& p, const Vec2& u, double max_dist
     return t;
 }
 
+const BodyCollider::FreeSpace& BodyCollider::free_space() const {
+    std::call_once(free_once_, [this] {
+        FreeSpace& f = free_;
+        f.box = walkable_.bounds();
+        f.step = std::clamp(radius_ / 4, 0.02, 0.1);
+        f.nx = std::max(1, static_cast<int>(std::ceil(f.box.sizes().x() / f.step)));
+        f.ny = std::max(1, static_cast<int>(std::ceil(f.box.sizes().y() / f.step)));
+        const auto centre = [&](int i, int j) {
+            return Vec2(f.box.min().x() + (i + 0.5) * f.step, f.box.min().y() + (j + 0.5) * f.step);
+        };
+        std::vector<char> clear(static_cast<std::size_t>(f.nx) * f.ny);
+        for (int j = 0; j < f.ny; ++j)
+            for (int i = 0; i < f.nx; ++i) clear[static_cast<std::size_t>(j) * f.nx + i] = is_free(centre(i, j));
+        // Flood fill over moves between neighbouring centres that the body can make.
+        f.label.assign(clear.size(), -1);
+        std::vector<int> stack;
+        const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+        for (std::size_t start = 0; start < clear.size(); ++start) {
+            if (!clear[start] || f.label[start] >= 0) continue;
+            const int comp = static_cast<int>(f.area.size());
+            f.area.push_back(0.0);
+            f.label[start] = comp;
+            stack.assign(1, static_cast<int>(start));
+            while (!stack.empty()) {
+                const int c = stack.back();
+                stack.pop_back();
+                f.area[comp] += f.step * f.step;
+                const int i = c % f.nx, j = c / f.nx;
+                for (int d = 0; d < 4; ++d) {
+                    const int ni = i + di[d], nj = j + dj[d];
+                    if (ni < 0 || nj < 0 || ni >= f.nx || nj >= f.ny) continue;
+                    const int n = nj * f.nx + ni;
+                    if (!clear[n] || f.label[n] >= 0) continue;
+                    if (free_distance(centre(i, j), Vec2(di[d], dj[d]), f.step) < f.step) continue;
+                    f.label[n] = comp;
+                    stack.push_back(n);
+                }
+            }
+        }
+        for (double a : f.area) f.largest = std::max(f.largest, a);
+    });
+    return free_;
+}
+
+int BodyCollider::component_at(const Vec2& p) const {
+    const FreeSpace& f = free_space();
+    if (!is_free(p)) return -1;
+    const int i0 = static_cast<int>(std::floor((p.x() - f.box.min().x()) / f.step));
+    const int j0 = static_cast<int>(std::floor((p.y() - f.box.min().y()) / f.step));
+    // The cell holding p, or a neighbour whose centre p can reach in a straight line.
+    for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+            const int i = i0 + di, j = j0 + dj;
+            if (i < 0 || j < 0 || i >= f.nx || j >= f.ny) continue;
+            const int label = f.label[static_cast<std::size_t>(j) * f.nx + i];
+            if (label < 0) continue;
+            const Vec2 c(f.box.min().x() + (i + 0.5) * f.step, f.box.min().y() + (j + 0.5) * f.step);
+            const double dist = (c - p).norm();
+            if (dist == 0.0 || free_distance(p, (c - p) / dist, dist) >= dist) return label;
+        }
+    return -1;
+}
+
+std::pair<double, double> BodyCollider::free_area(const Vec2& p) const {
+    const int c = component_at(p);
+    return {c < 0 ? 0.0 : free_.area[c], free_space().largest};
+}
+
+bool BodyCollider::can_start_at(const Vec2& p) const {
+    const auto [area, largest] = free_area(p);
+    return area > 0 && area >= 0.25 * largest;
+}
+
 double BodyCollider::clearance(const Vec2& p) const {
     // Grow the search box until it holds a segment, then check everything that could be closer.
     double best = std::numeric_limits<double>::infinity();

@@ -5,6 +5,7 @@
 // projection of the triangle's part with 0 < z <= H. Those projections are convex polygons, so
 // the 3-D test reduces to a disc against 2-D segments (their edges), exactly. Triangles lying at
 // z <= 0 are floor and never collide. The walkable region's boundary also counts as a wall.
+#include <mutex>
 #include <vector>
 
 #include "bvc3d/world/world.hpp"
@@ -29,8 +30,16 @@ public:
     // Distance from the centre p to the nearest segment, minus the radius (< 0: overlap).
     double clearance(const Vec2& p) const;
 
-    // Inside the walkable region and not overlapping anything.
+    // Inside the walkable region and not touching any wall. (A centre deep inside a solid obstacle is
+    // far from its walls too: see can_start_at.)
     bool is_free(const Vec2& p) const { return walkable_.contains(p) && clearance(p) >= 0.0; }
+
+    // A place a walk may start: free, and connected by collision-free motion to a free area at least
+    // a quarter the size of the largest one. The inside of a solid obstacle, or a closed-off pocket,
+    // is a separate, smaller area. (Orientation-free: meshes need not have consistent normals.)
+    bool can_start_at(const Vec2& p) const;
+    // Area of the free region p belongs to (0 if none) and of the largest one, m².
+    std::pair<double, double> free_area(const Vec2& p) const;
 
 private:
     void add_segment(const Vec2& a, const Vec2& b);
@@ -47,6 +56,20 @@ private:
     std::vector<std::vector<int>> grid_;
     mutable std::vector<unsigned> stamp_;
     mutable unsigned epoch_ = 0;
+
+    // Connected free areas on a grid of body-centre positions, built on first use.
+    struct FreeSpace {
+        Eigen::AlignedBox2d box;
+        double step = 0;
+        int nx = 0, ny = 0;
+        std::vector<int> label;      // per cell: component, or -1 where the body does not fit
+        std::vector<double> area;    // per component, m²
+        double largest = 0;
+    };
+    const FreeSpace& free_space() const;
+    int component_at(const Vec2& p) const;  // -1 if p cannot reach a free cell centre next to it
+    mutable std::once_flag free_once_;
+    mutable FreeSpace free_;
 };
 
 }  // namespace bvc3d

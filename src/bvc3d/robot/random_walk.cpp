@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 
@@ -14,6 +15,7 @@ void RobotParams::validate() const {
     positive(height, "height");
     positive(speed, "speed");
     positive(turn_rate, "turn_rate");
+    if (turn_rate > 1e6) throw InputError("robot: turn_rate must be <= 1e6 rad/s");
     positive(model_dt, "model_dt");
     if (n_walk < 1) throw InputError("robot: n_walk must be >= 1");
     if (!std::isfinite(turn_sd) || turn_sd < 0) throw InputError("robot: turn_sd must be >= 0");
@@ -36,9 +38,16 @@ Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& b
         const auto i = std::min(n - 1, static_cast<std::size_t>(rng.uniform() * static_cast<double>(n)));
         pose.x = world.start.points[i].x();
         pose.y = world.start.points[i].y();
+        const std::string where = "world '" + world.name + "': start point (" + format_number(pose.x) + ", " +
+                                  format_number(pose.y) + ")";
         if (!body.is_free(world.start.points[i]))
-            throw InputError("world '" + world.name + "': start point (" + std::to_string(pose.x) + ", " +
-                             std::to_string(pose.y) + ") is blocked or outside the walkable region");
+            throw InputError(where + " is blocked or outside the walkable region");
+        if (!body.can_start_at(world.start.points[i])) {
+            const auto [area, largest] = body.free_area(world.start.points[i]);
+            throw InputError(where + " lies in a closed-off free area of " + format_number(std::round(area * 100) / 100) +
+                             " m² (the largest is " + format_number(std::round(largest * 100) / 100) +
+                             " m²): inside an obstacle?");
+        }
     } else {
         const auto& region = world.start.region;
         if (region.points.size() < 3 || region.area() <= 0)
@@ -47,14 +56,15 @@ Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& b
         bool found = false;
         for (int attempt = 0; attempt < 100000 && !found; ++attempt) {
             const Vec2 p(rng.uniform(box.min().x(), box.max().x()), rng.uniform(box.min().y(), box.max().y()));
-            if (region.contains(p) && body.is_free(p)) {
+            if (region.contains(p) && body.can_start_at(p)) {
                 pose.x = p.x();
                 pose.y = p.y();
                 found = true;
             }
         }
         if (!found)
-            throw InputError("world '" + world.name + "': the start region has no place where the robot fits");
+            throw InputError("world '" + world.name + "': the start region has no place where the robot fits, "
+                             "outside obstacles and closed-off pockets");
     }
     pose.heading = rng.uniform(-pi, pi);
     return pose;
@@ -76,8 +86,12 @@ void RandomWalk::bump() {
 
 std::optional<WalkStep> RandomWalk::next(double t_end) {
     const double step_len = p_.speed * p_.model_dt;
+    int stuck = 0;  // bumps in a row without moving
     while (state_.t < t_end) {
         if (state_.bump_pending) {
+            if (++stuck > 100000)
+                throw InputError("the robot is stuck at (" + std::to_string(state_.pose.x) + ", " +
+                                 std::to_string(state_.pose.y) + "): every heading is blocked");
             bump();
             continue;
         }

@@ -34,7 +34,8 @@ void LidarSpec::validate() const {
     if (elevations.empty()) fail("elevations must not be empty");
     for (double e : elevations)
         if (!std::isfinite(e) || std::abs(e) > pi / 2) fail("every elevation must lie in [-90°, 90°]");
-    if (azimuth_count < 1) fail("azimuth_count must be at least 1");
+    if (azimuth_count < 1 || azimuth_count > 1000000) fail("azimuth_count must be in [1, 1000000]");
+    if (elevations.size() > 100000) fail("at most 100000 rows");
     if (!std::isfinite(azimuth_offset)) fail("azimuth_offset must be finite");
     if (!std::isfinite(height) || height < 0) fail("height must be >= 0");
     if (!std::isfinite(max_range) || max_range <= 0) fail("max_range must be > 0");
@@ -58,6 +59,11 @@ Lidar::Lidar(LidarSpec spec) : spec_(std::move(spec)) {
 void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise,
                  const std::vector<char>& rows) const {
     out.clear();
+    // Poses far outside any world are mistakes, and beyond ~1e18 Embree rejects the rays outright.
+    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.heading) || std::abs(pose.x) > 1e6 ||
+        std::abs(pose.y) > 1e6)
+        throw InputError("scan pose (" + std::to_string(pose.x) + ", " + std::to_string(pose.y) + ", " +
+                         std::to_string(pose.heading) + "): coordinates must be finite and within ±1e6 m");
     const std::size_t n_rows = spec_.elevations.size(), n_cols = column_azimuth_.size();
     if (!rows.empty() && rows.size() != n_rows) throw InputError("row mask has the wrong length");
     const Vec3 origin(pose.x, pose.y, spec_.height);

@@ -40,6 +40,11 @@ struct LidarSpec {
     static LidarSpec spherical(bool upper_only = true);
 
     std::size_t beam_count() const { return elevations.size() * static_cast<std::size_t>(azimuth_count); }
+    // Same beams, same noise: scans are identical whatever the names.
+    bool same_beams(const LidarSpec& o) const {
+        return elevations == o.elevations && azimuth_count == o.azimuth_count && azimuth_offset == o.azimuth_offset &&
+               height == o.height && max_range == o.max_range && range_noise_sd == o.range_noise_sd && dropout == o.dropout;
+    }
     void validate() const;  // throws InputError naming the bad field
 };
 

@@ -14,6 +14,10 @@ struct RayCaster::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     int packet = 4;  // widest ray packet the CPU runs natively: 4, 8 or 16
+    ~Impl() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
 };
 
 namespace {
@@ -26,16 +30,10 @@ void check_device(RTCDevice device, const char* what) {
 
 }  // namespace
 
-RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(new Impl) {
-    if (mesh.empty()) {
-        delete impl_;
-        throw InputError("world has no geometry (no triangles)");
-    }
+RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
+    if (mesh.empty()) throw InputError("world has no geometry (no triangles)");
     impl_->device = rtcNewDevice("verbose=0");
-    if (!impl_->device) {
-        delete impl_;
-        throw std::runtime_error("could not create an Embree device");
-    }
+    if (!impl_->device) throw std::runtime_error("could not create an Embree device");
     impl_->scene = rtcNewScene(impl_->device);
     // Robust traversal: rays through shared edges of adjacent triangles never slip through.
     rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
@@ -67,11 +65,7 @@ RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(new Impl) {
     }
 }
 
-RayCaster::~RayCaster() {
-    if (impl_->scene) rtcReleaseScene(impl_->scene);
-    if (impl_->device) rtcReleaseDevice(impl_->device);
-    delete impl_;
-}
+RayCaster::~RayCaster() = default;
 
 double RayCaster::refine(unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const {
     const Vec3& n = plane_normal_[prim];

@@ -3,6 +3,7 @@
 // Embree finds the triangle a ray hits (in float); the distance is then recomputed in double
 // against that triangle's plane, so ranges are exact to ~1e-12 m rather than float's ~1e-6 m.
 #include <limits>
+#include <memory>
 #include <span>
 
 #include "bvc3d/world/mesh.hpp"
@@ -28,7 +29,7 @@ private:
     double refine(unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const;
 
     struct Impl;
-    Impl* impl_;
+    std::unique_ptr<Impl> impl_;  // the Embree device and scene
     std::vector<Vec3> plane_point_, plane_normal_;  // per triangle, double precision
 };
 

@@ -4,6 +4,7 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/world/ray_caster.hpp"
 
 namespace bvc3d {
@@ -28,18 +29,19 @@ std::pair<double, double> lean_signs(const std::string& lean) {
 WorldDescription cross_arena(const CrossArenaParams& p) {
     const auto [sx, sy] = lean_signs(p.lean);
     require(std::isfinite(p.tilt_deg) && p.tilt_deg >= 0.0 && p.tilt_deg < 90.0,
-            "tilt_deg must be in [0, 90), got " + std::to_string(p.tilt_deg));
+            "tilt_deg must be in [0, 90), got " + format_number(p.tilt_deg));
     require(p.half_width > 0 && p.height > 0 && p.wall_thickness > 0 && p.wall_length > 0,
             "sizes must be positive");
     require(p.wall_length < 2.0 * p.half_width, "wall_length must be shorter than the arena");
     const double alpha = deg_to_rad(p.tilt_deg);
     const double reach = p.height * std::tan(alpha) + 0.5 * p.wall_thickness / std::cos(alpha);
-    require(reach < p.half_width, "tilt_deg " + std::to_string(p.tilt_deg) +
+    require(reach < p.half_width, "tilt_deg " + format_number(p.tilt_deg) +
                                       " makes the central walls' tops pass through the outer walls");
     require(std::abs(p.start_offset) < p.half_width, "start_offset must lie inside the arena");
 
     WorldDescription w;
-    w.name = "cross-" + std::to_string(static_cast<int>(std::lround(p.tilt_deg)));
+    w.name = "cross-" + format_number(p.tilt_deg);
+    w.tilt_deg = p.tilt_deg;
     const double a = p.half_width, h = p.height;
     auto& m = w.mesh;
     m.add_quad(Vec3(-a, -a, 0), Vec3(a, -a, 0), Vec3(a, a, 0), Vec3(-a, a, 0));  // floor

@@ -3,6 +3,7 @@
 // Takes: a WorldDescription (triangles + floor regions), built in code, from YAML or meshes.
 // Gives: ray casts (RayCaster, through Embree) and the geometry for body collision.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bvc3d/world/mesh.hpp"
@@ -19,6 +20,7 @@ struct StartRegion {
 
 struct WorldDescription {
     std::string name;
+    std::optional<double> tilt_deg;  // the tilt of the cross arena, when the world is (or holds) one
     TriangleMesh mesh;
     Polygon2 walkable;  // the robot's body stays inside this floor polygon
     StartRegion start;
