@@ -15,6 +15,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"
+#include "bvc3d/recorder/checkpoint_file.hpp"
 #include "bvc3d/report/summary.hpp"
 #include "cli_common.hpp"
 
@@ -171,7 +172,7 @@ void add_run(CLI::App& app) {
         }
         const auto metrics = analyze(t, world, result.x, result.y, result.models[0].rates, result.models[0].n_place);
         write_trial_file(out, t, result, 0, metrics, analysis_params(t, world));
-        std::filesystem::remove(control.checkpoint);
+        remove_checkpoint(control.checkpoint);
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (tty) std::fprintf(stderr, "\n");
         std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), result.t.size(),

@@ -12,6 +12,7 @@
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"
+#include "bvc3d/recorder/checkpoint_file.hpp"
 #include "bvc3d/recorder/trial_file.hpp"
 
 namespace bvc3d {
@@ -218,8 +219,7 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
             ++ran;
         }
         progress.add_steps(result.stats.explore_steps + result.stats.sample_steps, static_cast<std::int64_t>(members.size()));
-        std::error_code ec;
-        std::filesystem::remove(control.checkpoint, ec);
+        remove_checkpoint(control.checkpoint);
     };
     auto worker = [&] {
         while (!stop_all.load()) {

@@ -44,7 +44,9 @@ struct GroupRun {
     std::int64_t step_index = 0;
 
     explicit GroupRun(const std::vector<TrialConfig>& t);
+    void reserve_samples();
     void step(const WalkStep& s, bool learn, bool record);
+    std::size_t ckpt_segments = 0, ckpt_saved = 0;  // samples already in checkpoint segments
     GroupCheckpoint checkpoint(const std::string& fingerprint) const;
     void restore(const GroupCheckpoint& c);
 };
@@ -80,6 +82,10 @@ GroupRun::GroupRun(const std::vector<TrialConfig>& t)
     }
     // Room for the samples a full recording phase can hold (a model step takes model_dt of forward
     // motion), so growing buffers never double past it: with many models on one walk that matters.
+    reserve_samples();
+}
+
+void GroupRun::reserve_samples() {
     const auto& first = trials.front();
     const auto expected = static_cast<std::size_t>(first.protocol.sample_hours * 3600.0 / first.robot.model_dt) + 64;
     for (auto* v : {&result.t, &result.x, &result.y, &result.heading}) v->reserve(expected);
@@ -128,12 +134,27 @@ void GroupRun::step(const WalkStep& s, bool learn, bool record) {
 }
 
 GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {
+    // The state, and only the samples recorded since the last checkpoint.
     GroupCheckpoint c;
     c.fingerprint = fingerprint;
     c.walk = walk.state();
     c.step_index = step_index;
-    c.partial = result;
+    c.segments = ckpt_segments;
+    c.saved = ckpt_saved;
+    c.partial.stats = result.stats;
+    const auto from = static_cast<std::ptrdiff_t>(ckpt_saved);
+    c.partial.t.assign(result.t.begin() + from, result.t.end());
+    c.partial.x.assign(result.x.begin() + from, result.x.end());
+    c.partial.y.assign(result.y.begin() + from, result.y.end());
+    c.partial.heading.assign(result.heading.begin() + from, result.heading.end());
     for (std::size_t i = 0; i < nets.size(); ++i) {
+        const auto& rec = result.models[i];
+        ModelRecord m;
+        m.n_place = rec.n_place;
+        m.n_bvc = rec.n_bvc;
+        m.rates.assign(rec.rates.begin() + from * rec.n_place, rec.rates.end());
+        if (!rec.bvc.empty()) m.bvc.assign(rec.bvc.begin() + from * rec.n_bvc, rec.bvc.end());
+        c.partial.models.push_back(std::move(m));
         c.partial.models[i].weights = nets[i].weights();
         c.membrane.emplace_back(nets[i].membrane().begin(), nets[i].membrane().end());
         c.place_rates.emplace_back(nets[i].rates().begin(), nets[i].rates().end());
@@ -145,7 +166,10 @@ void GroupRun::restore(const GroupCheckpoint& c) {
     if (c.partial.models.size() != nets.size()) throw InputError("checkpoint does not match the group");
     walk.restore(c.walk);
     step_index = c.step_index;
+    ckpt_segments = c.segments;
+    ckpt_saved = c.saved;
     result = c.partial;
+    reserve_samples();
     for (std::size_t i = 0; i < nets.size(); ++i) {
         nets[i].set_weights(result.models[i].weights);
         nets[i].set_state(c.membrane[i], c.place_rates[i]);
@@ -187,7 +211,10 @@ GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunCon
         if (control.progress && n % 512 == 0) control.progress(run.walk.time(), run.step_index);
         const bool stop = control.stop && n % 64 == 0 && control.stop->load();
         if (!control.checkpoint.empty() && (stop || run.walk.time() >= next_ckpt)) {
-            write_checkpoint(control.checkpoint, run.checkpoint(fingerprint));
+            GroupCheckpoint c = run.checkpoint(fingerprint);
+            write_checkpoint(control.checkpoint, c);
+            run.ckpt_segments = c.segments;
+            run.ckpt_saved = c.saved;
             while (next_ckpt <= run.walk.time()) next_ckpt += ckpt_every;
         }
         if (stop) throw Interrupted();

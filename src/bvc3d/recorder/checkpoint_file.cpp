@@ -8,24 +8,65 @@ namespace bvc3d {
 
 namespace {
 
-void write_samples(hid_t f, const GroupResult& r) {
-    const auto g = h5::create_group(f, "samples");
-    const std::size_t n = r.t.size();
-    h5::write(g, "t", r.t, {n});
-    h5::write(g, "x", r.x, {n});
-    h5::write(g, "y", r.y, {n});
-    h5::write(g, "heading", r.heading, {n});
+std::filesystem::path segment_path(const std::filesystem::path& state, std::size_t k) {
+    std::filesystem::path p = state;
+    p += ".seg" + std::to_string(k);
+    return p;
+}
+
+void write_segment(const std::filesystem::path& path, const GroupResult& r) {
+    AtomicFile out(path);
+    {
+        auto lock = h5::hdf5_lock();
+        const auto f = h5::create_file(out.temp_path().string());
+        const std::size_t n = r.t.size();
+        h5::write_attr(f, "format", std::string("bvc3d-checkpoint-segment"));
+        h5::write_attr(f, "samples", static_cast<std::int64_t>(n));
+        h5::write(f, "t", r.t, {n});
+        h5::write(f, "x", r.x, {n});
+        h5::write(f, "y", r.y, {n});
+        h5::write(f, "heading", r.heading, {n});
+        for (std::size_t i = 0; i < r.models.size(); ++i) {
+            h5::write(f, "rates" + std::to_string(i), r.models[i].rates, {r.models[i].rates.size()});
+            h5::write(f, "bvc" + std::to_string(i), r.models[i].bvc, {r.models[i].bvc.size()});
+        }
+    }
+    out.commit();
+}
+
+template <class T>
+void append(std::vector<T>& to, const std::vector<T>& from) {
+    to.insert(to.end(), from.begin(), from.end());
+}
+
+void read_segment(const std::filesystem::path& path, GroupResult& r) {
+    auto lock = h5::hdf5_lock();
+    const auto f = h5::open_file(path.string());
+    if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint-segment") throw InputError("not a checkpoint segment");
+    append(r.t, h5::read_doubles(f, "t"));
+    append(r.x, h5::read_doubles(f, "x"));
+    append(r.y, h5::read_doubles(f, "y"));
+    append(r.heading, h5::read_doubles(f, "heading"));
+    for (std::size_t i = 0; i < r.models.size(); ++i) {
+        append(r.models[i].rates, h5::read_floats(f, "rates" + std::to_string(i)));
+        append(r.models[i].bvc, h5::read_floats(f, "bvc" + std::to_string(i)));
+    }
 }
 
 }  // namespace
 
-void write_checkpoint(const std::filesystem::path& path, const GroupCheckpoint& c) {
+void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c) {
+    const std::size_t fresh = c.partial.t.size();
+    if (fresh > 0) write_segment(segment_path(path, c.segments), c.partial);
+    const std::size_t segments = c.segments + (fresh > 0 ? 1 : 0), saved = c.saved + fresh;
     AtomicFile out(path);
     {
         auto lock = h5::hdf5_lock();
         const auto f = h5::create_file(out.temp_path().string());
         h5::write_attr(f, "format", std::string("bvc3d-checkpoint"));
         h5::write_attr(f, "fingerprint", c.fingerprint);
+        h5::write_attr(f, "segments", static_cast<std::int64_t>(segments));
+        h5::write_attr(f, "samples", static_cast<std::int64_t>(saved));
         h5::write_attr(f, "step_index", c.step_index);
         h5::write_attr(f, "walk_x", c.walk.pose.x);
         h5::write_attr(f, "walk_y", c.walk.pose.y);
@@ -40,20 +81,19 @@ void write_checkpoint(const std::filesystem::path& path, const GroupCheckpoint& 
         h5::write_attr(f, "bumps", s.bumps);
         h5::write_attr(f, "full_scan_fallbacks", s.full_scan_fallbacks);
         h5::write_attr(f, "n_models", static_cast<std::int64_t>(c.partial.models.size()));
-        write_samples(f, c.partial);
         for (std::size_t i = 0; i < c.partial.models.size(); ++i) {
             const auto& m = c.partial.models[i];
             const auto g = h5::create_group(f, "model" + std::to_string(i));
             h5::write_attr(g, "n_place", static_cast<std::int64_t>(m.n_place));
             h5::write_attr(g, "n_bvc", static_cast<std::int64_t>(m.n_bvc));
-            h5::write(g, "rates", m.rates, {m.rates.size()});
-            h5::write(g, "bvc", m.bvc, {m.bvc.size()});
-            h5::write(g, "weights", m.weights, {m.weights.size()});
+            h5::write(g, "weights", m.weights, {m.weights.size()}, false);  // dense: compression would only cost time
             h5::write(g, "membrane", c.membrane[i], {c.membrane[i].size()}, false);
             h5::write(g, "place_rates", c.place_rates[i], {c.place_rates[i].size()}, false);
         }
     }
     out.commit();
+    c.segments = segments;
+    c.saved = saved;
 }
 
 std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path) {
@@ -65,6 +105,8 @@ std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path
         if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint") return std::nullopt;
         GroupCheckpoint c;
         c.fingerprint = h5::read_attr_string(f, "fingerprint");
+        c.segments = static_cast<std::size_t>(h5::read_attr_int(f, "segments"));
+        c.saved = static_cast<std::size_t>(h5::read_attr_int(f, "samples"));
         c.step_index = h5::read_attr_int(f, "step_index");
         c.walk.pose = {h5::read_attr_double(f, "walk_x"), h5::read_attr_double(f, "walk_y"),
                        h5::read_attr_double(f, "walk_heading")};
@@ -77,27 +119,31 @@ std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path
         s.sample_steps = h5::read_attr_int(f, "sample_steps");
         s.bumps = h5::read_attr_int(f, "bumps");
         s.full_scan_fallbacks = h5::read_attr_int(f, "full_scan_fallbacks");
-        const auto g = h5::open_group(f, "samples");
-        c.partial.t = h5::read_doubles(g, "t");
-        c.partial.x = h5::read_doubles(g, "x");
-        c.partial.y = h5::read_doubles(g, "y");
-        c.partial.heading = h5::read_doubles(g, "heading");
         const auto n_models = h5::read_attr_int(f, "n_models");
         for (std::int64_t i = 0; i < n_models; ++i) {
             const auto mg = h5::open_group(f, "model" + std::to_string(i));
             ModelRecord m;
             m.n_place = static_cast<int>(h5::read_attr_int(mg, "n_place"));
             m.n_bvc = static_cast<int>(h5::read_attr_int(mg, "n_bvc"));
-            m.rates = h5::read_floats(mg, "rates");
-            m.bvc = h5::read_floats(mg, "bvc");
             m.weights = h5::read_floats(mg, "weights");
             c.membrane.push_back(h5::read_floats(mg, "membrane"));
             c.place_rates.push_back(h5::read_floats(mg, "place_rates"));
             c.partial.models.push_back(std::move(m));
         }
+        for (std::size_t k = 0; k < c.segments; ++k) read_segment(segment_path(path, k), c.partial);
+        if (c.partial.t.size() != c.saved) return std::nullopt;
+        for (const auto& m : c.partial.models)
+            if (m.rates.size() != c.saved * static_cast<std::size_t>(m.n_place)) return std::nullopt;
         return c;
     } catch (const InputError&) {
         return std::nullopt;
+    }
+}
+
+void remove_checkpoint(const std::filesystem::path& path) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    for (std::size_t k = 0; std::filesystem::remove(segment_path(path, k), ec); ++k) {
     }
 }
 

@@ -1,5 +1,8 @@
 #pragma once
-// Checkpoints of a running trial group (HDF5), written atomically.
+// Checkpoints of a running trial group (HDF5). The samples are stored in segments, each holding
+// what was recorded since the previous checkpoint, so checkpointing costs time in proportion to
+// the new samples, not to everything so far. Every file is written atomically and the state file
+// (which lists the segments) last, so a crash leaves the previous checkpoint usable.
 #include <filesystem>
 #include <optional>
 
@@ -7,8 +10,13 @@
 
 namespace bvc3d {
 
-void write_checkpoint(const std::filesystem::path& path, const GroupCheckpoint& c);
-// nullopt if the file is missing or not a readable checkpoint (a stale or broken one is ignored).
+// Writes c.partial's samples as segment number c.segments (unless there are none) and the state,
+// then advances c.segments and c.saved. c.partial holds only the samples recorded since c.saved.
+void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c);
+// The whole checkpoint with every segment's samples joined, or nullopt if the files are missing or
+// not a readable, consistent checkpoint (a stale or broken one is ignored).
 std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path);
+// Removes the state file and its segments.
+void remove_checkpoint(const std::filesystem::path& path);
 
 }  // namespace bvc3d

@@ -32,8 +32,11 @@ struct GroupCheckpoint {
     std::string fingerprint;  // of the group's configuration
     WalkState walk;
     std::int64_t step_index = 0;
-    GroupResult partial;  // samples so far; per model the current weights
+    GroupResult partial;  // samples (see below); per model the current weights
     std::vector<std::vector<float>> membrane, place_rates;  // per model
+    // On disk the samples sit in `segments` files holding the first `saved` of them. When writing,
+    // `partial` holds only the samples after those; when read back, all of them.
+    std::size_t segments = 0, saved = 0;
 };
 
 }  // namespace bvc3d
