@@ -248,7 +248,7 @@ void add_analyze(CLI::App& app) {
     struct Options {
         std::vector<std::string> files;
         analysis::AnalysisParams params;
-        std::string extent, cells;
+        std::string extent, cells, templates = "rate_maps";
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("files", o->files, "Trial files (.h5)")->required();
@@ -258,6 +258,9 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--min-samples", o->params.dbscan.min_samples, "DBSCAN min_samples")->capture_default_str();
     cmd->add_option("--d-th", o->params.d_th, "SAI exclusion distance, m")->capture_default_str();
     cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX (default: the trajectory's)");
+    cmd->add_option("--decoding-templates", o->templates,
+                    "Decoder templates: rate_maps (SPEC: thresholded, normalised maps) or means (raw mean rates)")
+        ->capture_default_str();
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
     cmd->callback([o] {
         if (!o->extent.empty()) {
@@ -266,6 +269,7 @@ void add_analyze(CLI::App& app) {
             o->params.extent = analysis::Extent{parse_double(parts[0], "--extent"), parse_double(parts[1], "--extent"),
                                                 parse_double(parts[2], "--extent"), parse_double(parts[3], "--extent")};
         }
+        o->params.decoding_templates = analysis::parse_decoding_templates(o->templates);
         o->params.validate();
         std::printf("%-40s", "trial");
         for (const auto& n : scalar_metric_names()) std::printf(" %15s", n.c_str());

@@ -23,7 +23,7 @@ TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
     m.modality = modality(m.maps.bins.centers, m.maps.map, params.dbscan);
     m.modality_summary = summarize_modality(m.modality);
     m.aliasing = spatial_aliasing(m.maps.bins.centers, m.maps.map, params.d_th);
-    m.decoding = decoding_error<T>(m.maps.bins.grid, x, y, rates);
+    m.decoding = decoding_error<T>(m.maps.bins.grid, x, y, rates, params.decoding_templates, params.quantile);
     m.cells = cell_stats(m.maps);
     return m;
 }

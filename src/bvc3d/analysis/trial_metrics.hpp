@@ -22,6 +22,7 @@ struct AnalysisParams {
     DbscanParams dbscan;           // eps 1.0 m, min_samples 20
     double d_th = 2.0;             // m, SAI exclusion radius
     std::optional<Extent> extent;  // default: the trial's own trajectory; the arena's for a fixed grid
+    DecodingTemplates decoding_templates = DecodingTemplates::rate_maps;  // SPEC §8: the rate maps
     void validate() const;
 };
 
@@ -30,7 +31,7 @@ struct TrialMetrics {
     std::vector<int> modality;  // per cell
     ModalitySummary modality_summary;
     AliasingResult aliasing;
-    DecodingResult decoding;    // on the same grid as the maps
+    DecodingResult decoding;    // on the same grid as the maps, with the same quantile
     CellStats cells;
 };
 
