@@ -209,7 +209,7 @@ def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, template
     the sample's rates (ties: first bin in matplotlib's order); its error is the distance from its
     true position to that bin's centre. Samples with no positive similarity to any template (e.g.
     all cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of the
-    statistics. Needs at least 2 samples.
+    statistics. Needs at least 2 samples (ValueError otherwise; ``analyze`` copes with fewer).
 
     Returns a dict: ``median_m``, ``mean_m`` (NaN if nothing was decoded), ``n_decoded``,
     ``n_undecoded``.
@@ -246,6 +246,10 @@ def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_t
     ``modality``, ``modality_summary`` (dict), ``sai``, ``msai``, ``decoding`` (dict as
     ``decoding_error(..., quantile=quantile, templates=decoding_templates)``; same grid as the
     maps), ``cells`` (dict as ``cell_stats``).
+
+    Any number of samples is accepted: with none there are no bins (every MI 0, MSAI NaN, cell
+    statistics NaN); with fewer than 2 nothing is decoded (NaN errors, ``n_decoded`` 0,
+    ``n_undecoded`` = ``n - n // 2``).
     """
     x, y = _positions(x, y)
     r, _ = _samples(rates, len(x), "rates")

@@ -535,6 +535,43 @@ def test_analyze_equals_the_single_metrics(quantile, templates):
         np.testing.assert_array_equal(out["cells"][k], st[k])
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_analyze_zero_and_one_sample(dtype):
+    """A trial may record fewer than 2 samples: analyze reports it instead of raising."""
+    for n in (0, 1):
+        x, y = np.full(n, 1.5), np.full(n, -2.0)
+        rates = np.zeros((n, 4), dtype=dtype)
+        if n:
+            rates[0, 1] = 0.7
+        out = A.analyze(x, y, rates)
+        d = out["decoding"]
+        assert math.isnan(d["median_m"]) and math.isnan(d["mean_m"])
+        assert d["n_decoded"] == 0 and d["n_undecoded"] == n - n // 2
+        assert out["modality"].tolist() == [0, 0, 0, 0]
+        assert out["maps"].shape == (n, 4) and out["mean_maps"].shape == (n, 4) and out["centers"].shape == (n, 2)
+        assert out["counts"].tolist() == [1] * n and len(out["sai"]) == n
+        s = out["modality_summary"]
+        assert s["frac_active"] == 0 and s["frac_multimodal"] == 0 and math.isnan(s["mean_mi_active"])
+        if n == 0:
+            assert math.isnan(out["msai"])
+            assert all(np.all(np.isnan(out["cells"][k])) for k in ("peak_rate", "mean_rate", "spatial_info"))
+        else:
+            # One point is what matplotlib makes of it: one bin at the point's own (expanded) grid.
+            off, arr = mpl_hexbin(x, y, rates[:, 1].astype(np.float64))
+            assert np.array_equal(out["centers"], off) and out["mean_maps"][:, 1].tolist() == arr.tolist()
+            assert out["maps"].tolist() == [[0.0, 1.0, 0.0, 0.0]]
+            assert out["msai"] == 0.0 and out["sai"].tolist() == [0.0]
+            assert out["cells"]["peak_rate"][1] == pytest.approx(0.7)
+        # The single metrics agree where they are defined (decoding needs 2 samples).
+        centers, maps = A.rate_maps(x, y, rates)
+        assert np.array_equal(out["centers"], centers) and np.array_equal(out["maps"], maps)
+        with pytest.raises(ValueError, match="at least 2 samples"):
+            A.decoding_error(x, y, rates)
+    # Two samples are decoded: the second from the first one's template.
+    x, y = np.array([0.0, 0.0]), np.array([0.0, 1.0])
+    d = A.analyze(x, y, np.ones((2, 3), dtype=dtype))["decoding"]
+    assert d["n_decoded"] == 1 and d["n_undecoded"] == 0 and d["median_m"] == pytest.approx(1.0, abs=0.05)
+
 
 # ---------------------------------------------------------------------------------------------
 # bad input

@@ -296,6 +296,38 @@ TEST(AnalysisTrial, AllMetricsOfOneTrial) {
     EXPECT_GT(m.decoding.n_decoded, 0u);
 }
 
+TEST(AnalysisTrial, ZeroAndOneSampleDoNotThrow) {
+    const std::vector<double> none;
+    const TrialMetrics m0 = analyze_trial<float>(none, none, RowMatrixXf(0, 3));
+    EXPECT_EQ(m0.maps.bins.size(), 0);
+    EXPECT_EQ(m0.maps.map.rows(), 0);
+    EXPECT_EQ(m0.maps.map.cols(), 3);
+    EXPECT_EQ(m0.modality, (std::vector<int>{0, 0, 0}));
+    EXPECT_EQ(m0.modality_summary.frac_active, 0.0);
+    EXPECT_TRUE(std::isnan(m0.modality_summary.mean_mi_active));
+    EXPECT_TRUE(std::isnan(m0.aliasing.msai));
+    EXPECT_TRUE(std::isnan(m0.decoding.median_m));
+    EXPECT_TRUE(std::isnan(m0.decoding.mean_m));
+    EXPECT_EQ(m0.decoding.n_decoded, 0u);
+    EXPECT_EQ(m0.decoding.n_undecoded, 0u);
+    EXPECT_EQ(m0.cells.peak_rate.size(), 3u);
+
+    const std::vector<double> x{2.0}, y{-1.0};
+    RowMatrixXf r = RowMatrixXf::Zero(1, 3);
+    r(0, 2) = 0.5f;
+    const TrialMetrics m1 = analyze_trial<float>(x, y, r);
+    ASSERT_EQ(m1.maps.bins.size(), 1);  // matplotlib: one bin, the grid expanded around the point
+    EXPECT_EQ(m1.maps.map(0, 2), 1.0);
+    EXPECT_EQ(m1.maps.map(0, 0), 0.0);
+    EXPECT_EQ(m1.modality, (std::vector<int>{0, 0, 0}));
+    EXPECT_EQ(m1.aliasing.msai, 0.0);
+    EXPECT_TRUE(std::isnan(m1.decoding.median_m));
+    EXPECT_EQ(m1.decoding.n_decoded, 0u);
+    EXPECT_EQ(m1.decoding.n_undecoded, 1u);  // the second half of 1 sample is that sample
+    EXPECT_DOUBLE_EQ(m1.cells.peak_rate[2], 0.5);
+    EXPECT_THROW(decoding_error<float>(x, y, r), InputError);  // called directly, decoding still needs 2
+}
+
 TEST(AnalysisInput, BadInputThrows) {
     const std::vector<double> x{0, 1, 2}, y{0, 1}, y3{0, 1, NAN};
     EXPECT_THROW(hexbin(x, y), InputError);

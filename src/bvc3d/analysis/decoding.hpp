@@ -45,6 +45,7 @@ struct DecodingResult {
 // - A sample whose best cosine similarity is not positive (an all-zero population vector, or one
 //   that shares no active cell with any template) is not decoded; it is counted in n_undecoded and
 //   left out of the median and mean. Ties go to the first bin in matplotlib's order.
+// - Needs at least 2 samples (InputError otherwise); analyze_trial reports fewer as undecoded.
 template <class T>
 DecodingResult decoding_error(std::span<const double> x, std::span<const double> y,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, const DecodingParams& params = {});

@@ -35,6 +35,8 @@ struct TrialMetrics {
     CellStats cells;
 };
 
+// Any number of samples: with none the maps have no bins (MI 0 for every cell, MSAI NaN); with
+// fewer than 2 nothing is decoded (NaN errors, n_undecoded = the second half's n − n/2 samples).
 template <class T>
 TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
                            const Eigen::Ref<const RowMatrixX<T>>& rates, const AnalysisParams& params = {});
