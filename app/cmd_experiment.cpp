@@ -259,7 +259,7 @@ void add_analyze(CLI::App& app) {
         std::vector<std::string> files;
         std::optional<int> gridsize, min_samples;
         std::optional<double> quantile, eps, d_th;
-        std::string extent, cells;
+        std::string extent, cells, templates;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("files", o->files, "Trial files (.h5)")->required();
@@ -269,9 +269,12 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
     cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
     cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX, or 'data' for the trajectory's own");
+    cmd->add_option("--decoding-templates", o->templates,
+                    "Decoder templates: rate_maps (SPEC: thresholded, normalised maps) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
     cmd->footer("Each file is analysed with the parameters its metrics were computed with; the options change only\n"
-                "what they name (SPEC §8 defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2).");
+                "what they name (SPEC §8 defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2,\n"
+                "decoding templates rate_maps).");
     cmd->callback([o] {
         std::optional<analysis::Extent> extent;
         if (!o->extent.empty() && o->extent != "data") {
@@ -293,6 +296,7 @@ void add_analyze(CLI::App& app) {
             if (o->eps) params.dbscan.eps = *o->eps;
             if (o->min_samples) params.dbscan.min_samples = *o->min_samples;
             if (o->d_th) params.d_th = *o->d_th;
+            if (!o->templates.empty()) params.decoding_templates = analysis::parse_decoding_templates(o->templates);
             if (o->extent == "data") params.extent.reset();
             if (extent) params.extent = extent;
             params.validate();

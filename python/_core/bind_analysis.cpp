@@ -111,17 +111,20 @@ void bind_sample_functions(pyb::module_& a) {
         pyb::arg("extent"));
     a.def(
         "decoding_error",
-        [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, const MaybeExtent& extent) {
+        [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, const MaybeExtent& extent,
+           double quantile, const std::string& templates) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
+            const an::DecodingParams params{gridsize, quantile, extent_of(extent), an::parse_decoding_templates(templates)};
             an::DecodingResult d;
             {
                 pyb::gil_scoped_release release;
-                d = an::decoding_error<T>(xs, ys, r, {gridsize, extent_of(extent)});
+                d = an::decoding_error<T>(xs, ys, r, params);
             }
             return decoding_dict(d);
         },
-        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("extent"));
+        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("extent"),
+        pyb::arg("quantile"), pyb::arg("templates"));
     a.def(
         "cell_stats",
         [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile,
@@ -140,13 +143,15 @@ void bind_sample_functions(pyb::module_& a) {
     a.def(
         "analyze",
         [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile, double eps,
-           int min_samples, double d_th, const MaybeExtent& extent) {
+           int min_samples, double d_th, const MaybeExtent& extent, const std::string& decoding_templates) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
+            const an::AnalysisParams params{gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent),
+                                            an::parse_decoding_templates(decoding_templates)};
             an::TrialMetrics m;
             {
                 pyb::gil_scoped_release release;
-                m = an::analyze_trial<T>(xs, ys, r, {gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent)});
+                m = an::analyze_trial<T>(xs, ys, r, params);
             }
             pyb::dict d;
             d["centers"] = numpy_of(m.maps.bins.centers);
@@ -163,7 +168,8 @@ void bind_sample_functions(pyb::module_& a) {
             return d;
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
-        pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"));
+        pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"),
+        pyb::arg("decoding_templates"));
 }
 
 }  // namespace

@@ -93,6 +93,15 @@ def _d_th(d_th):
     return d_th
 
 
+_TEMPLATES = ("rate_maps", "means")
+
+
+def _templates(templates, name="templates"):
+    if templates not in _TEMPLATES:
+        raise ValueError(f"{name} must be 'rate_maps' or 'means', got {templates!r}")
+    return templates
+
+
 def _centers_maps(centers, maps):
     c = np.ascontiguousarray(centers, dtype=np.float64)
     if c.ndim != 2 or c.shape[1] != 2:
@@ -188,23 +197,27 @@ def aliasing(centers, maps, d_th=2.0):
     return sai, float(msai)
 
 
-def decoding_error(x, y, rates, gridsize=50, extent=None):
+def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, templates="rate_maps"):
     """Localisation error of a population-vector decoder (SPEC §8).
 
-    Templates: the mean rate of every cell in every bin visited by the first half of the samples
-    (raw means on the trial's grid, whose extent comes from all samples unless given). Each
-    sample of the second half is decoded to the bin whose template is most cosine-similar to the
-    sample's rates (ties: first bin in matplotlib's order); its error is the distance from its true
-    position to that bin's centre. Samples with no positive similarity to any template (e.g. all
-    cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of the
-    statistics.
+    Templates (``templates="rate_maps"``, SPEC's decoder): the rate maps of the first ``n // 2``
+    samples, i.e. the mean rate of every cell in every bin they visit, thresholded at the cell's
+    ``quantile`` and divided by the cell's maximum, exactly as ``rate_maps`` does it, but on the
+    trial's grid (extent from all samples unless given). ``templates="means"`` uses the raw mean
+    rates per bin instead (no threshold, no per-cell scaling; ``quantile`` is then unused).
+    Each sample of the second half is decoded to the bin whose template is most cosine-similar to
+    the sample's rates (ties: first bin in matplotlib's order); its error is the distance from its
+    true position to that bin's centre. Samples with no positive similarity to any template (e.g.
+    all cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of the
+    statistics. Needs at least 2 samples (ValueError otherwise; ``analyze`` copes with fewer).
 
     Returns a dict: ``median_m``, ``mean_m`` (NaN if nothing was decoded), ``n_decoded``,
     ``n_undecoded``.
     """
     x, y = _positions(x, y)
     r, _ = _samples(rates, len(x), "rates")
-    return dict(_an.decoding_error(x, y, r, _gridsize(gridsize), _extent(extent)))
+    return dict(_an.decoding_error(x, y, r, _gridsize(gridsize), _extent(extent), _quantile(quantile),
+                                   _templates(templates)))
 
 
 def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
@@ -225,18 +238,24 @@ def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
             _an.cell_stats(x, y, r, _gridsize(gridsize), _quantile(quantile), _extent(extent)).items()}
 
 
-def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_th=2.0, extent=None):
+def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_th=2.0, extent=None,
+            decoding_templates="rate_maps"):
     """Every metric of one trial in one call (the C++ entry point the experiment uses).
 
     Returns a dict: ``centers``, ``counts``, ``mean_maps``, ``maps``, ``bin_area_m2``,
     ``modality``, ``modality_summary`` (dict), ``sai``, ``msai``, ``decoding`` (dict as
-    ``decoding_error``; same grid as the maps), ``cells`` (dict as ``cell_stats``).
+    ``decoding_error(..., quantile=quantile, templates=decoding_templates)``; same grid as the
+    maps), ``cells`` (dict as ``cell_stats``).
+
+    Any number of samples is accepted: with none there are no bins (every MI 0, MSAI NaN, cell
+    statistics NaN); with fewer than 2 nothing is decoded (NaN errors, ``n_decoded`` 0,
+    ``n_undecoded`` = ``n - n // 2``).
     """
     x, y = _positions(x, y)
     r, _ = _samples(rates, len(x), "rates")
     eps, min_samples = _dbscan_params(eps, min_samples)
     out = dict(_an.analyze(x, y, r, _gridsize(gridsize), _quantile(quantile), eps, min_samples, _d_th(d_th),
-                           _extent(extent)))
+                           _extent(extent), _templates(decoding_templates, "decoding_templates")))
     out["decoding"] = dict(out["decoding"])
     out["modality_summary"] = dict(out["modality_summary"])
     out["cells"] = dict(out["cells"])

@@ -145,11 +145,38 @@ def fig_sai_grid(folder, out):
     plt.close(fig)
 
 
+def modality_kind(mi):
+    """What a cell with modality index ``mi`` is: "multimodal" (MI > 1), "unimodal" (MI == 1),
+    "silent" (no field)."""
+    return "multimodal" if mi > 1 else "unimodal" if mi == 1 else "silent"
+
+
+def pick_example_cell(mi, maps, want):
+    """The example cell for a panel that should show a ``want`` ("multimodal" or "unimodal") cell.
+
+    Returns ``(cell, title)``, ``cell`` None if no cell has a field. Among the cells of the wanted
+    kind, the one with the largest field (most active bins) shows the pattern best; if the model has
+    none, the largest cell with any field is shown and the title says so."""
+    mi = np.asarray(mi)
+    cand = np.flatnonzero(mi > 1) if want == "multimodal" else np.flatnonzero(mi == 1)
+    prefix = ""
+    if len(cand) == 0:
+        cand = np.flatnonzero(mi > 0)
+        if len(cand) == 0:
+            return None, f"no {want} cell; no cell has a field (every MI = 0)"
+        prefix = f"no {want} cell; showing "
+    cell = int(cand[np.argmax((maps[:, cand] > 0).sum(axis=0))])
+    kind = modality_kind(int(mi[cell]))
+    return cell, f"{prefix}a {kind} one" if prefix else kind
+
+
 def fig_place_fields(folder, out):
-    """Example fields: a multimodal cell of the first model and a unimodal cell of the last model,
-    at the largest tilt."""
+    """Example fields at the largest tilt: a multimodal cell (MI > 1) of the first model and a
+    unimodal cell (MI == 1) of the last model. Each panel is titled by what it shows: a model
+    without a cell of the wanted kind gets its largest cell of another kind, said so in the title.
+    Returns the panel titles."""
     world = folder.worlds[-1]
-    picks = []
+    panels = []
     for model, want in ((folder.models[0], "multimodal"), (folder.models[-1], "unimodal")):
         path = folder.file(model, world)
         if not path:
@@ -158,23 +185,27 @@ def fig_place_fields(folder, out):
             mi = f["metrics/modality"][:]
             maps = f["metrics/rate_maps"][:]
             centers = f["metrics/bin_centers"][:]
-        cand = np.flatnonzero(mi > 1) if want == "multimodal" else np.flatnonzero(mi == 1)
-        if len(cand) == 0:
-            cand = np.flatnonzero(mi > 0)
-        if len(cand) == 0:
-            continue
-        # The candidate with the largest field (most active bins) shows the pattern best.
-        cell = cand[np.argmax((maps[:, cand] > 0).sum(axis=0))]
-        picks.append((model, want, cell, int(mi[cell]), centers, maps[:, cell]))
-    fig, axes = plt.subplots(1, max(len(picks), 1), figsize=(4.2 * max(len(picks), 1), 4))
+        cell, what = pick_example_cell(mi, maps, want)
+        where = f"{folder.world_label(world)} tilt"
+        if cell is None:
+            panels.append((f"{model}: {what}\n{where}", None, None))
+        else:
+            sep = "\n" if what.startswith("no ") else " "  # a fallback note gets a line of its own
+            panels.append((f"{what}:{sep}{model} cell {cell} (MI = {int(mi[cell])})\n{where}", centers, maps[:, cell]))
+    fig, axes = plt.subplots(1, max(len(panels), 1), figsize=(4.2 * max(len(panels), 1), 4))
     axes = np.atleast_1d(axes)
-    for ax, (model, want, cell, k, centers, values) in zip(axes, picks):
-        hexmap(ax, centers, values, cmap="viridis", vmin=0, vmax=1)
+    for ax, (title, centers, values) in zip(axes, panels):
+        if values is not None:
+            hexmap(ax, centers, values, cmap="viridis", vmin=0, vmax=1)
+        else:
+            ax.set_xticks([])
+            ax.set_yticks([])
         ax.set_aspect("equal")
-        ax.set_title(f"{want}: {model} cell {cell} (MI = {k})\n{folder.world_label(world)} tilt", fontsize=9)
+        ax.set_title(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=DPI)
     plt.close(fig)
+    return [p[0] for p in panels]
 
 
 def fig_trajectory(folder, out):
@@ -311,8 +342,9 @@ def make_report(path):
         "+x,+y corner by the given tilt while their footprint stays put.", lambda p: fig_environments(folder, p))
     add("trajectory.png", "The robot's random walk during the sampling phase of one trial: coverage of the arena.",
         lambda p: fig_trajectory(folder, p))
-    add("place_fields.png", "Rate maps of two example place cells at the largest tilt: a multimodal (aliased) cell "
-        "of the first model and a unimodal cell of the last model.", lambda p: fig_place_fields(folder, p))
+    add("place_fields.png", "Rate maps of two example place cells at the largest tilt: a multimodal (aliased, "
+        "MI > 1) cell of the first model and a unimodal (MI = 1) cell of the last model. A model without a cell of "
+        "that kind shows another cell, and the panel's title says so.", lambda p: fig_place_fields(folder, p))
     add("mi_active.png", "Fraction of place cells with at least one field (MI > 0), per model and tilt.",
         lambda p: fig_bars(folder, "frac_active", p))
     add("mi_mean.png", "Mean modality index of the active cells: fields per cell; 1 is a single place field.",

@@ -399,13 +399,28 @@ def test_sai_random_maps_with_zero_rows_and_negative_entries():
 # decoding
 
 
-def dense_decoder(x, y, rates, gridsize=50):
+def numpy_rate_maps(means, quantile):
+    """SPEC §8 maps from per-bin means, written out in numpy: per cell, values below
+    numpy.percentile(cell, 100 q) set to 0, then divided by the cell's maximum (silent: zeros)."""
+    maps = means.copy()
+    for k in range(maps.shape[1]):
+        col = maps[:, k]
+        col[col < np.percentile(col, 100 * quantile)] = 0
+        top = col.max()
+        maps[:, k] = col / top if top > 0 else 0.0
+    return maps
+
+
+def dense_decoder(x, y, rates, templates="rate_maps", quantile=0.1, gridsize=50):
+    """SPEC's decoder in plain numpy: templates from the first half on the whole trial's grid,
+    cosine similarity of every second-half sample with every template, argmax."""
     n = len(x)
     half = n // 2
     ext = (x.min(), x.max(), y.min(), y.max())
     centers, means, _ = A.hexbin(x[:half], y[:half], rates[:half].astype(np.float64), gridsize, ext)
-    norms = np.linalg.norm(means, axis=1, keepdims=True)
-    unit = np.divide(means, norms, out=np.zeros_like(means), where=norms > 0)
+    tmpl = numpy_rate_maps(means, quantile) if templates == "rate_maps" else means
+    norms = np.linalg.norm(tmpl, axis=1, keepdims=True)
+    unit = np.divide(tmpl, norms, out=np.zeros_like(tmpl), where=norms > 0)
     scores = rates[half:].astype(np.float64) @ unit.T
     best = scores.argmax(axis=1)
     ok = scores.max(axis=1) > 0
@@ -414,31 +429,55 @@ def dense_decoder(x, y, rates, gridsize=50):
     return np.median(err), err.mean(), ok.sum(), (~ok).sum()
 
 
-@pytest.mark.parametrize("floor", [0.05, 0.0])  # sparse rates, and dense ones (the blocked-product path)
-def test_decoding_matches_a_dense_numpy_decoder(floor):
+# sparse rates, and dense ones (the blocked-product path); a quantile that removes nothing (0.1,
+# sparse maps) and ones that cut real values of dense maps
+@pytest.mark.parametrize("floor,quantile", [(0.05, 0.1), (0.0, 0.1), (0.0, 0.6), (0.05, 0.95)])
+@pytest.mark.parametrize("templates", ["rate_maps", "means"])
+def test_decoding_matches_a_dense_numpy_decoder(floor, quantile, templates):
     x, y = walk(30, 1.0, 6)
     rates = place_population(x, y, 80, np.random.default_rng(6), sigma=0.7, floor=floor)
     if floor == 0:
         rates += np.float32(1e-3) * np.random.default_rng(7).random(rates.shape, dtype=np.float32)
     rates[len(x) // 2 + 5] = 0  # a silent sample is not decoded
-    d = A.decoding_error(x, y, rates)
-    med, mean, n_ok, n_bad = dense_decoder(x, y, rates)
+    d = A.decoding_error(x, y, rates, quantile=quantile, templates=templates)
+    med, mean, n_ok, n_bad = dense_decoder(x, y, rates, templates, quantile)
     assert d["n_decoded"] == n_ok and d["n_undecoded"] == n_bad and n_bad >= 1
-    assert d["median_m"] == pytest.approx(med, abs=1e-12)
-    assert d["mean_m"] == pytest.approx(mean, abs=1e-12)
+    assert d["median_m"] == pytest.approx(med, abs=1e-9)
+    assert d["mean_m"] == pytest.approx(mean, abs=1e-9)
 
 
-def test_decoding_gaussian_fields_is_accurate_and_shuffled_is_chance():
+def test_decoding_default_templates_are_the_spec_rate_maps():
+    """SPEC §8: the templates are the thresholded, max-normalised rate maps of the first half."""
+    x, y = walk(45, 1.0, 8)
+    rates = place_population(x, y, 120, np.random.default_rng(8), sigma=0.7)  # peak rates 0.3-1: scaling matters
+    d = A.decoding_error(x, y, rates)
+    med, mean, n_ok, n_bad = dense_decoder(x, y, rates, "rate_maps", 0.1)
+    assert (d["n_decoded"], d["n_undecoded"]) == (n_ok, n_bad)
+    assert abs(d["median_m"] - med) < 1e-9 and abs(d["mean_m"] - mean) < 1e-9
+    assert d == A.decoding_error(x, y, rates, templates="rate_maps", quantile=0.1)
+    # ... and not the raw means: the per-cell normalisation changes which bins win.
+    med_m, mean_m, _, _ = dense_decoder(x, y, rates, "means")
+    assert abs(mean - mean_m) > 1e-6
+    means = A.decoding_error(x, y, rates, templates="means")
+    assert abs(means["mean_m"] - mean_m) < 1e-9
+    # The quantile is the rate maps' quantile.
+    q = A.decoding_error(x, y, rates, quantile=0.97)
+    med_q, mean_q, _, _ = dense_decoder(x, y, rates, "rate_maps", 0.97)
+    assert abs(q["median_m"] - med_q) < 1e-9 and abs(q["mean_m"] - mean_q) < 1e-9 and abs(mean_q - mean) > 1e-6
+
+
+@pytest.mark.parametrize("templates", ["rate_maps", "means"])
+def test_decoding_gaussian_fields_is_accurate_and_shuffled_is_chance(templates):
     x, y = walk(0, 4.0, 12)
     rng = np.random.default_rng(12)
     n_cells = 250
     cx, cy = rng.uniform(-5, 5, n_cells), rng.uniform(-5, 5, n_cells)
     rates = np.exp(-((x[:, None] - cx) ** 2 + (y[:, None] - cy) ** 2) / (2 * 0.75**2)).astype(np.float32)
     rates[rates < 0.05] = 0
-    good = A.decoding_error(x, y, rates)
+    good = A.decoding_error(x, y, rates, templates=templates)
     assert good["median_m"] < 0.35 and good["mean_m"] < 0.5 and good["n_undecoded"] == 0
     shuffled = rates[rng.permutation(len(x))]
-    bad = A.decoding_error(x, y, shuffled)
+    bad = A.decoding_error(x, y, shuffled, templates=templates)
     # Chance: the distance from the true positions to the centres of random samples' positions.
     half = len(x) // 2
     pick = rng.integers(0, half, len(x) - half)
@@ -478,21 +517,60 @@ def test_cell_stats_match_numpy():
     assert np.all(st["spatial_info"][~active] == 0) and np.all(np.isnan(st["spatial_info_per_rate"][~active]))
 
 
-def test_analyze_equals_the_single_metrics():
+@pytest.mark.parametrize("quantile,templates", [(0.1, "rate_maps"), (0.1, "means"), (0.9, "rate_maps")])
+def test_analyze_equals_the_single_metrics(quantile, templates):
     x, y = walk(60, 1.0, 31)
-    rates = place_population(x, y, 50, np.random.default_rng(31))
-    out = A.analyze(x, y, rates)
-    centers, maps = A.rate_maps(x, y, rates)
+    rates = place_population(x, y, 50, np.random.default_rng(31), floor=0.0 if quantile > 0.5 else 0.05)
+    out = A.analyze(x, y, rates, quantile=quantile, decoding_templates=templates)
+    centers, maps = A.rate_maps(x, y, rates, quantile=quantile)
     assert np.array_equal(out["centers"], centers) and np.array_equal(out["maps"], maps)
     mi = A.modality(centers, maps)
     assert np.array_equal(out["modality"], mi)
     assert out["modality_summary"] == A.modality_summary(mi)
     sai, msai = A.aliasing(centers, maps)
     assert np.array_equal(out["sai"], sai) and out["msai"] == msai
-    assert out["decoding"] == A.decoding_error(x, y, rates)
-    st = A.cell_stats(x, y, rates)
+    assert out["decoding"] == A.decoding_error(x, y, rates, quantile=quantile, templates=templates)
+    st = A.cell_stats(x, y, rates, quantile=quantile)
     for k in st:
         np.testing.assert_array_equal(out["cells"][k], st[k])
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_analyze_zero_and_one_sample(dtype):
+    """A trial may record fewer than 2 samples: analyze reports it instead of raising."""
+    for n in (0, 1):
+        x, y = np.full(n, 1.5), np.full(n, -2.0)
+        rates = np.zeros((n, 4), dtype=dtype)
+        if n:
+            rates[0, 1] = 0.7
+        out = A.analyze(x, y, rates)
+        d = out["decoding"]
+        assert math.isnan(d["median_m"]) and math.isnan(d["mean_m"])
+        assert d["n_decoded"] == 0 and d["n_undecoded"] == n - n // 2
+        assert out["modality"].tolist() == [0, 0, 0, 0]
+        assert out["maps"].shape == (n, 4) and out["mean_maps"].shape == (n, 4) and out["centers"].shape == (n, 2)
+        assert out["counts"].tolist() == [1] * n and len(out["sai"]) == n
+        s = out["modality_summary"]
+        assert s["frac_active"] == 0 and s["frac_multimodal"] == 0 and math.isnan(s["mean_mi_active"])
+        if n == 0:
+            assert math.isnan(out["msai"])
+            assert all(np.all(np.isnan(out["cells"][k])) for k in ("peak_rate", "mean_rate", "spatial_info"))
+        else:
+            # One point is what matplotlib makes of it: one bin at the point's own (expanded) grid.
+            off, arr = mpl_hexbin(x, y, rates[:, 1].astype(np.float64))
+            assert np.array_equal(out["centers"], off) and out["mean_maps"][:, 1].tolist() == arr.tolist()
+            assert out["maps"].tolist() == [[0.0, 1.0, 0.0, 0.0]]
+            assert out["msai"] == 0.0 and out["sai"].tolist() == [0.0]
+            assert out["cells"]["peak_rate"][1] == pytest.approx(0.7)
+        # The single metrics agree where they are defined (decoding needs 2 samples).
+        centers, maps = A.rate_maps(x, y, rates)
+        assert np.array_equal(out["centers"], centers) and np.array_equal(out["maps"], maps)
+        with pytest.raises(ValueError, match="at least 2 samples"):
+            A.decoding_error(x, y, rates)
+    # Two samples are decoded: the second from the first one's template.
+    x, y = np.array([0.0, 0.0]), np.array([0.0, 1.0])
+    d = A.analyze(x, y, np.ones((2, 3), dtype=dtype))["decoding"]
+    assert d["n_decoded"] == 1 and d["n_undecoded"] == 0 and d["median_m"] == pytest.approx(1.0, abs=0.05)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -540,6 +618,14 @@ def test_bad_input_raises_value_error():
         A.hexbin(x, y, r, extent=(0.0, 1.0, 2.0))
     with pytest.raises(ValueError, match="at least 2 samples"):
         A.decoding_error(x[:1], y[:1], r[:1])
+    with pytest.raises(ValueError, match="templates"):
+        A.decoding_error(x, y, r, templates="maps")
+    with pytest.raises(ValueError, match="decoding_templates"):
+        A.analyze(x, y, r, decoding_templates="mean")
+    with pytest.raises(ValueError, match="quantile"):
+        A.decoding_error(x, y, r, quantile=2.0)
+    with pytest.raises(ValueError, match="templates"):
+        _core.decoding_error(x, y, r, 50, None, 0.1, "nope")
     # The compiled layer checks too (InputError is a ValueError).
     with pytest.raises(ValueError, match="gridsize"):
         _core.hexbin(x, y, r, 1, None)

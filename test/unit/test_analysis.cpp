@@ -218,11 +218,58 @@ TEST(AnalysisDecoding, GaussianPlaceFieldsDecodeWell) {
             rates(i, k) = v < 0.05 ? 0.f : static_cast<float>(v);
         }
     }
-    const DecodingResult d = decoding_error<float>(x, y, rates);
-    EXPECT_EQ(d.n_decoded + d.n_undecoded, static_cast<std::size_t>(n - n / 2));
-    EXPECT_EQ(d.n_undecoded, 0u);
-    EXPECT_LT(d.median_m, 0.35);
-    EXPECT_LT(d.mean_m, 0.5);
+    for (const auto templates : {DecodingTemplates::rate_maps, DecodingTemplates::means}) {
+        SCOPED_TRACE(decoding_templates_name(templates));
+        const DecodingResult d = decoding_error<float>(x, y, rates, {50, 0.1, {}, templates});
+        EXPECT_EQ(d.n_decoded + d.n_undecoded, static_cast<std::size_t>(n - n / 2));
+        EXPECT_EQ(d.n_undecoded, 0u);
+        EXPECT_LT(d.median_m, 0.35);
+        EXPECT_LT(d.mean_m, 0.5);
+    }
+}
+
+TEST(AnalysisDecoding, DefaultTemplatesAreTheNormalisedRateMaps) {
+    // First half: x = 0 with rates (10, 1), x = 1 with (1, 0.6), x = 2 silent (three bins; the 10 %
+    // quantile of each cell is then below its smaller rate and removes nothing). Raw means are the
+    // templates (10, 1) and (1, 0.6); the SPEC rate maps, normalised per cell, are (1, 1) and
+    // (0.1, 0.6). Second half, cosines with x = 0's and x = 1's template:
+    //   (10, 1) at x = 0:  means 1.00 / 0.90, maps 0.77 / 0.26: x = 0 either way;
+    //   (1, 1) at x = 1:   means 0.77 / 0.97, maps 1.00 / 0.81: the maps decode it 1 m off;
+    //   (0.1, 1) at x = 1: means 0.20 / 0.60, maps 0.77 / 1.00: x = 1 either way;
+    //   (0, 0) at x = 2:   not decoded.
+    // At quantile 0.9 only each cell's largest value survives: x = 1's map is all zero and the third
+    // sample goes to x = 0 as well.
+    const std::vector<double> x{0, 1, 2, 2, 0, 1, 1, 2}, y(8, 0.0);
+    RowMatrixXd r(8, 2);
+    r << 10, 1, 1, 0.6, 0, 0, 0, 0,  // first half
+        10, 1, 1, 1, 0.1, 1, 0, 0;   // second half
+    DecodingParams params;
+    params.gridsize = 4;  // bin centres at x = 0, 1, 2 (to 1e-9)
+    const DecodingResult by_default = decoding_error<double>(x, y, r, params);
+    params.templates = DecodingTemplates::means;
+    const DecodingResult means = decoding_error<double>(x, y, r, params);
+    params.templates = DecodingTemplates::rate_maps;
+    params.quantile = 0.9;
+    const DecodingResult q90 = decoding_error<double>(x, y, r, params);
+    for (const DecodingResult* d : {&by_default, &means, &q90}) {
+        EXPECT_EQ(d->n_decoded, 3u);
+        EXPECT_EQ(d->n_undecoded, 1u);
+    }
+    EXPECT_NEAR(by_default.mean_m, 1.0 / 3, 1e-8);
+    EXPECT_NEAR(by_default.median_m, 0.0, 1e-8);
+    EXPECT_NEAR(means.mean_m, 0.0, 1e-8);
+    EXPECT_NEAR(q90.mean_m, 2.0 / 3, 1e-8);
+    EXPECT_NEAR(q90.median_m, 1.0, 1e-8);
+    // The grid overload (analyze_trial's) is the same decoder, and analyze_trial passes its quantile.
+    const HexGrid g = HexGrid::fit(x, y, 4);
+    EXPECT_EQ(decoding_error<double>(g, x, y, r, DecodingTemplates::rate_maps, 0.1).mean_m, by_default.mean_m);
+    AnalysisParams ap;
+    ap.gridsize = 4;
+    EXPECT_EQ(analyze_trial<double>(x, y, r, ap).decoding.mean_m, by_default.mean_m);
+    ap.quantile = 0.9;
+    EXPECT_EQ(analyze_trial<double>(x, y, r, ap).decoding.mean_m, q90.mean_m);
+    ap.decoding_templates = DecodingTemplates::means;
+    EXPECT_EQ(analyze_trial<double>(x, y, r, ap).decoding.mean_m, means.mean_m);
 }
 
 TEST(AnalysisTrial, AllMetricsOfOneTrial) {
@@ -249,6 +296,38 @@ TEST(AnalysisTrial, AllMetricsOfOneTrial) {
     EXPECT_GT(m.decoding.n_decoded, 0u);
 }
 
+TEST(AnalysisTrial, ZeroAndOneSampleDoNotThrow) {
+    const std::vector<double> none;
+    const TrialMetrics m0 = analyze_trial<float>(none, none, RowMatrixXf(0, 3));
+    EXPECT_EQ(m0.maps.bins.size(), 0);
+    EXPECT_EQ(m0.maps.map.rows(), 0);
+    EXPECT_EQ(m0.maps.map.cols(), 3);
+    EXPECT_EQ(m0.modality, (std::vector<int>{0, 0, 0}));
+    EXPECT_EQ(m0.modality_summary.frac_active, 0.0);
+    EXPECT_TRUE(std::isnan(m0.modality_summary.mean_mi_active));
+    EXPECT_TRUE(std::isnan(m0.aliasing.msai));
+    EXPECT_TRUE(std::isnan(m0.decoding.median_m));
+    EXPECT_TRUE(std::isnan(m0.decoding.mean_m));
+    EXPECT_EQ(m0.decoding.n_decoded, 0u);
+    EXPECT_EQ(m0.decoding.n_undecoded, 0u);
+    EXPECT_EQ(m0.cells.peak_rate.size(), 3u);
+
+    const std::vector<double> x{2.0}, y{-1.0};
+    RowMatrixXf r = RowMatrixXf::Zero(1, 3);
+    r(0, 2) = 0.5f;
+    const TrialMetrics m1 = analyze_trial<float>(x, y, r);
+    ASSERT_EQ(m1.maps.bins.size(), 1);  // matplotlib: one bin, the grid expanded around the point
+    EXPECT_EQ(m1.maps.map(0, 2), 1.0);
+    EXPECT_EQ(m1.maps.map(0, 0), 0.0);
+    EXPECT_EQ(m1.modality, (std::vector<int>{0, 0, 0}));
+    EXPECT_EQ(m1.aliasing.msai, 0.0);
+    EXPECT_TRUE(std::isnan(m1.decoding.median_m));
+    EXPECT_EQ(m1.decoding.n_decoded, 0u);
+    EXPECT_EQ(m1.decoding.n_undecoded, 1u);  // the second half of 1 sample is that sample
+    EXPECT_DOUBLE_EQ(m1.cells.peak_rate[2], 0.5);
+    EXPECT_THROW(decoding_error<float>(x, y, r), InputError);  // called directly, decoding still needs 2
+}
+
 TEST(AnalysisInput, BadInputThrows) {
     const std::vector<double> x{0, 1, 2}, y{0, 1}, y3{0, 1, NAN};
     EXPECT_THROW(hexbin(x, y), InputError);
@@ -263,4 +342,8 @@ TEST(AnalysisInput, BadInputThrows) {
     const RowMatrixXd r = RowMatrixXd::Ones(3, 2);
     EXPECT_THROW(rate_maps<double>(x, x, r, {50, -0.5, {}}), InputError);
     EXPECT_THROW(decoding_error<double>(x, x, RowMatrixXd::Ones(2, 2)), InputError);
+    EXPECT_THROW(decoding_error<double>(x, x, r, {50, 1.5, {}, DecodingTemplates::rate_maps}), InputError);
+    EXPECT_THROW(parse_decoding_templates("maps"), InputError);
+    EXPECT_EQ(parse_decoding_templates("means"), DecodingTemplates::means);
+    EXPECT_EQ(parse_decoding_templates(decoding_templates_name(DecodingTemplates::rate_maps)), DecodingTemplates::rate_maps);
 }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/analysis/rate_maps.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::analysis {
@@ -91,17 +92,30 @@ double sparse_cost(const RowMatrixXd& unit, const Eigen::Ref<const RowMatrixX<T>
 
 }  // namespace
 
+std::string decoding_templates_name(DecodingTemplates t) { return t == DecodingTemplates::means ? "means" : "rate_maps"; }
+
+DecodingTemplates parse_decoding_templates(std::string_view name) {
+    if (name == "rate_maps") return DecodingTemplates::rate_maps;
+    if (name == "means") return DecodingTemplates::means;
+    throw InputError("decoding templates must be 'rate_maps' or 'means', got '" + std::string(name) + "'");
+}
+
 template <class T>
 DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, std::span<const double> y,
-                              const Eigen::Ref<const RowMatrixX<T>>& rates) {
+                              const Eigen::Ref<const RowMatrixX<T>>& rates, DecodingTemplates templates,
+                              double quantile) {
     check_positions(x, y);
     const std::size_t n = x.size();
     if (n < 2) throw InputError("decoding needs at least 2 samples, got " + std::to_string(n));
     check_values<T>(rates, n, "rates");
+    if (!(quantile >= 0.0 && quantile <= 1.0))
+        throw InputError("quantile must lie in [0, 1], got " + std::to_string(quantile));
     const std::size_t half = n / 2;
     const HexBins first = bin_samples(grid, x.first(half), y.first(half));
-    const RowMatrixXd mean = bin_means<T>(first, rates.topRows(static_cast<Eigen::Index>(half)));
-    const RowMatrixXd unit = unit_rows(mean);  // score_b = t̂_b · r: r's norm does not change the best bin
+    RowMatrixXd tmpl = bin_means<T>(first, rates.topRows(static_cast<Eigen::Index>(half)));
+    // SPEC §8: the first half's rate maps (threshold, then per-cell max-normalisation).
+    if (templates == DecodingTemplates::rate_maps) threshold_and_normalise(tmpl, quantile);
+    const RowMatrixXd unit = unit_rows(tmpl);  // score_b = t̂_b · r: r's norm does not change the best bin
     const auto second = rates.bottomRows(static_cast<Eigen::Index>(n - half));
     // The sparse path wins while the rates are sparse; a product in blocks runs ~4x faster per
     // multiply-add, so it takes over for dense rates (e.g. BVC rates).
@@ -134,13 +148,14 @@ DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, st
 template <class T>
 DecodingResult decoding_error(std::span<const double> x, std::span<const double> y,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, const DecodingParams& params) {
-    return decoding_error<T>(HexGrid::fit(x, y, params.gridsize, params.extent), x, y, rates);
+    return decoding_error<T>(HexGrid::fit(x, y, params.gridsize, params.extent), x, y, rates, params.templates,
+                             params.quantile);
 }
 
 template DecodingResult decoding_error<float>(const HexGrid&, std::span<const double>, std::span<const double>,
-                                              const Eigen::Ref<const RowMatrixXf>&);
+                                              const Eigen::Ref<const RowMatrixXf>&, DecodingTemplates, double);
 template DecodingResult decoding_error<double>(const HexGrid&, std::span<const double>, std::span<const double>,
-                                               const Eigen::Ref<const RowMatrixXd>&);
+                                               const Eigen::Ref<const RowMatrixXd>&, DecodingTemplates, double);
 template DecodingResult decoding_error<float>(std::span<const double>, std::span<const double>,
                                               const Eigen::Ref<const RowMatrixXf>&, const DecodingParams&);
 template DecodingResult decoding_error<double>(std::span<const double>, std::span<const double>,

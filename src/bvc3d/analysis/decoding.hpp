@@ -8,14 +8,27 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 
 #include "bvc3d/analysis/hexbin.hpp"
 
 namespace bvc3d::analysis {
 
+// What a bin's template is.
+enum class DecodingTemplates {
+    rate_maps,  // SPEC §8 (default): the first half's rate maps, thresholded at each cell's quantile
+                // and normalised to a maximum of 1 per cell
+    means,      // option: the first half's raw mean rates per bin (hexbin means), no threshold or scaling
+};
+std::string decoding_templates_name(DecodingTemplates t);  // "rate_maps" | "means"
+DecodingTemplates parse_decoding_templates(std::string_view name);  // throws InputError otherwise
+
 struct DecodingParams {
     int gridsize = 50;
+    double quantile = 0.1;         // rate-map threshold of the templates (unused for `means`)
     std::optional<Extent> extent;  // default: the min/max of all samples (the trial's grid)
+    DecodingTemplates templates = DecodingTemplates::rate_maps;
 };
 
 struct DecodingResult {
@@ -26,14 +39,13 @@ struct DecodingResult {
 };
 
 // Choices (docs/analysis.md):
-// - Templates are the raw mean rates per bin (matplotlib's hexbin means of the first half), not the
-//   thresholded, normalised maps: a template is then the expected population vector at that place,
-//   in the same units as the vector being decoded, and no cell's weight is rescaled.
 // - The grid is the one the whole trial's rate maps use (extent from all samples unless given);
-//   only bins visited in the first half have templates.
+//   only bins visited in the first half have templates, and with `rate_maps` the quantile is taken
+//   over those bins.
 // - A sample whose best cosine similarity is not positive (an all-zero population vector, or one
 //   that shares no active cell with any template) is not decoded; it is counted in n_undecoded and
 //   left out of the median and mean. Ties go to the first bin in matplotlib's order.
+// - Needs at least 2 samples (InputError otherwise); analyze_trial reports fewer as undecoded.
 template <class T>
 DecodingResult decoding_error(std::span<const double> x, std::span<const double> y,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, const DecodingParams& params = {});
@@ -41,6 +53,7 @@ DecodingResult decoding_error(std::span<const double> x, std::span<const double>
 // The same decoder with a given grid (analyze_trial shares the rate maps' grid).
 template <class T>
 DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, std::span<const double> y,
-                              const Eigen::Ref<const RowMatrixX<T>>& rates);
+                              const Eigen::Ref<const RowMatrixX<T>>& rates, DecodingTemplates templates,
+                              double quantile);
 
 }  // namespace bvc3d::analysis

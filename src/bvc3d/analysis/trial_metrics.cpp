@@ -23,7 +23,12 @@ TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
     m.modality = modality(m.maps.bins.centers, m.maps.map, params.dbscan);
     m.modality_summary = summarize_modality(m.modality);
     m.aliasing = spatial_aliasing(m.maps.bins.centers, m.maps.map, params.d_th);
-    m.decoding = decoding_error<T>(m.maps.bins.grid, x, y, rates);
+    if (x.size() >= 2) {
+        m.decoding = decoding_error<T>(m.maps.bins.grid, x, y, rates, params.decoding_templates, params.quantile);
+    } else {  // nothing to build templates from: every second-half sample (n - n/2) is undecoded
+        m.decoding.n_decoded = 0;
+        m.decoding.n_undecoded = x.size() - x.size() / 2;
+    }
     m.cells = cell_stats(m.maps);
     return m;
 }

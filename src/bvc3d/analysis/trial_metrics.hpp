@@ -22,6 +22,7 @@ struct AnalysisParams {
     DbscanParams dbscan;           // eps 1.0 m, min_samples 20
     double d_th = 2.0;             // m, SAI exclusion radius
     std::optional<Extent> extent;  // default: the trial's own trajectory; the arena's for a fixed grid
+    DecodingTemplates decoding_templates = DecodingTemplates::rate_maps;  // SPEC §8: the rate maps
     void validate() const;
 };
 
@@ -30,10 +31,12 @@ struct TrialMetrics {
     std::vector<int> modality;  // per cell
     ModalitySummary modality_summary;
     AliasingResult aliasing;
-    DecodingResult decoding;    // on the same grid as the maps
+    DecodingResult decoding;    // on the same grid as the maps, with the same quantile
     CellStats cells;
 };
 
+// Any number of samples: with none the maps have no bins (MI 0 for every cell, MSAI NaN); with
+// fewer than 2 nothing is decoded (NaN errors, n_undecoded = the second half's n − n/2 samples).
 template <class T>
 TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
                            const Eigen::Ref<const RowMatrixX<T>>& rates, const AnalysisParams& params = {});

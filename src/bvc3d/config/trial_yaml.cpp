@@ -86,13 +86,19 @@ RobotParams robot_from(const YamlView& v) {
 
 void analysis_from(const YamlView& v, TrialConfig& t) {
     auto& a = t.analysis;
-    std::string extent = "data";
+    std::string extent = "data", templates = analysis::decoding_templates_name(a.decoding_templates);
     read_fields(v, {{"gridsize", &a.gridsize},
                     {"quantile", &a.quantile},
                     {"eps", &a.dbscan.eps},
                     {"min_samples", &a.dbscan.min_samples},
                     {"d_th", &a.d_th},
-                    {"extent", &extent}});
+                    {"extent", &extent},
+                    {"decoding_templates", &templates}});
+    try {
+        a.decoding_templates = analysis::parse_decoding_templates(templates);
+    } catch (const InputError& e) {
+        v["decoding_templates"].fail(e.what());
+    }
     if (extent != "data" && extent != "arena") v["extent"].fail("must be 'data' or 'arena'");
     t.arena_extent = extent == "arena";
     if (a.gridsize < 2) v["gridsize"].fail("must be >= 2");

@@ -94,7 +94,8 @@ std::string TrialConfig::canonical() const {
     os << walk_key() << config::model_to_yaml(model) << "analysis:\n  gridsize: " << analysis.gridsize
        << "\n  quantile: " << format_number(analysis.quantile) << "\n  eps: " << format_number(analysis.dbscan.eps)
        << "\n  min_samples: " << analysis.dbscan.min_samples << "\n  d_th: " << format_number(analysis.d_th)
-       << "\n  extent: " << (arena_extent ? "arena" : "data") << "\n";
+       << "\n  extent: " << (arena_extent ? "arena" : "data")
+       << "\n  decoding_templates: " << analysis::decoding_templates_name(analysis.decoding_templates) << "\n";
     return os.str();
 }
 

@@ -24,6 +24,7 @@ void write_metrics(hid_t f, const analysis::TrialMetrics& m, const analysis::Ana
     h5::write_attr(g, "eps", p.dbscan.eps);
     h5::write_attr(g, "min_samples", static_cast<std::int64_t>(p.dbscan.min_samples));
     h5::write_attr(g, "d_th", p.d_th);
+    h5::write_attr(g, "decoding_templates", analysis::decoding_templates_name(p.decoding_templates));
     if (p.extent) h5::write(g, "extent", std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, {4}, false);
     const auto& bins = m.maps.bins;
     const std::size_t nb = static_cast<std::size_t>(bins.size()), nc = static_cast<std::size_t>(m.maps.map.cols());
@@ -173,6 +174,11 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
         d.analysis.dbscan.min_samples = static_cast<int>(h5::read_attr_int(g, "min_samples"));
         d.analysis.d_th = h5::read_attr_double(g, "d_th");
     }
+    // Files from before the template choice was recorded decoded with raw means.
+    d.analysis.decoding_templates =
+        h5::exists_attr(g, "decoding_templates")
+            ? analysis::parse_decoding_templates(h5::read_attr_string(g, "decoding_templates"))
+            : (h5::exists_attr(g, "gridsize") ? analysis::DecodingTemplates::rate_maps : analysis::DecodingTemplates::means);
     if (h5::exists(g, "extent")) {
         const auto e = h5::read_doubles(g, "extent");
         if (e.size() == 4) d.analysis.extent = analysis::Extent{e[0], e[1], e[2], e[3]};
