@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/robot/random_walk.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -34,6 +35,16 @@ const CLI::Validator non_negative_check(
                                                                                                   : "must be a number >= 0";
     },
     "NUMBER>=0");
+
+void warn_if_blocked(const World& world, const Pose& pose) {
+    const BodyCollider body(world.description(), RobotParams{}.radius, RobotParams{}.height);
+    const Vec2 p(pose.x, pose.y);
+    if (!world.description().walkable.contains(p))
+        std::fprintf(stderr, "bvc3d: warning: (%g, %g) lies outside the world's walkable region\n", pose.x, pose.y);
+    else if (body.clearance(p) < 0)
+        std::fprintf(stderr, "bvc3d: warning: at (%g, %g) the robot's body would overlap geometry by %.3f m\n", pose.x,
+                     pose.y, -body.clearance(p));
+}
 
 Pose parse_pose(const std::string& text) {
     std::vector<std::string> parts;

@@ -17,6 +17,10 @@ Pose parse_pose(const std::string& text);
 // Full-precision decimal text for numbers written to CSV.
 std::string num(double v);
 
+// Prints a warning when a pose puts the robot's body inside or against geometry, or outside the
+// walkable region: scans from there are legal but rarely what was meant.
+void warn_if_blocked(const World& world, const Pose& pose);
+
 // A finite number (std::from_chars: no spaces, no trailing text); `what` names it in the error.
 double parse_number(const std::string& text, const std::string& what);
 

@@ -46,6 +46,7 @@ void add_bvc(CLI::App& app) {
         const ModelSpec model = config::resolve_model(o->model);
         const World world(config::resolve_world(o->world, o->tilt, o->lean));
         const Pose pose = parse_pose(o->pose);
+        warn_if_blocked(world, pose);
         const Scan scan = Lidar(model.sensor).scan(world, pose);
         const BoundaryVectorLayer layer(model.bvc);
         std::vector<double> rates(layer.n_cells());

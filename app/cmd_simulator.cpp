@@ -58,6 +58,7 @@ void add_scan(CLI::App& app) {
         const World w = world->make();
         const Lidar lidar(config::resolve_sensor(*sensor));
         const Pose p = parse_pose(*pose);
+        warn_if_blocked(w, p);
         const Scan scan = lidar.scan(w, p);
         emit(*out, "range,azimuth,elevation", [&](std::ostream& os) {
             for (const auto& r : scan) os << num(r.range) << ',' << num(r.azimuth) << ',' << num(r.elevation) << '\n';

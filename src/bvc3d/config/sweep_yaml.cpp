@@ -158,9 +158,15 @@ Sweep load_sweep_file(const std::string& path) {
         try {
             t = trial_from_yaml(YamlView(tree, path, ""));
         } catch (const ConfigError& e) {
+            // The message's line refers to the assembled trial; point at the sweep file's instead.
+            std::string reason = e.reason();
+            if (const auto at = reason.rfind(" (line "); at != std::string::npos) reason.resize(at);
             std::string values;
             for (const auto& [k, val] : swept) values += (values.empty() ? "" : ", ") + k + "=" + val;
-            throw ConfigError(path, e.key(), e.reason() + " (in condition " + std::to_string(c) + ": " + values + ")");
+            const int line = condition_where[c].node().Mark().line;
+            throw ConfigError(path, e.key(),
+                              reason + " (in condition " + std::to_string(c) + ": " + values +
+                                  (line >= 0 ? ", line " + std::to_string(line + 1) : std::string()) + ")");
         }
         t.condition = label;
         t.swept = swept;

@@ -181,6 +181,21 @@ WorldDescription world_from_yaml(const YamlView& v) {
 
 WorldDescription load_world_file(const std::string& path) { return world_from_yaml(YamlView::load_file(path)); }
 
+std::vector<std::string> world_file_meshes(const std::string& path) {
+    std::vector<std::string> files;
+    const YamlView v = YamlView::load_file(path);
+    if (!v.has("objects") || !v["objects"].is_sequence()) return files;
+    const YamlView objects = v["objects"];
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const YamlView o = objects.at(i);
+        if (!o.has("mesh") || !o["mesh"].has("file")) continue;
+        const std::string rel = o["mesh"]["file"].as_string();
+        files.push_back(std::filesystem::path(rel).is_absolute() ? rel
+                                                                 : (std::filesystem::path(v.directory()) / rel).string());
+    }
+    return files;
+}
+
 WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
     const auto presets = world_preset_names();
     if (std::find(presets.begin(), presets.end(), name) != presets.end()) {

@@ -41,10 +41,16 @@ std::string WorldSpec::fingerprint() const {
     const auto presets = config::world_preset_names();
     if (std::find(presets.begin(), presets.end(), source) != presets.end())
         return "preset " + source + " tilt " + format_number(tilt_deg.value_or(0.0)) + " lean " + lean;
-    std::ifstream in(source);
-    std::stringstream text;
-    text << in.rdbuf();
-    return "file " + std::filesystem::path(source).filename().string() + " " + std::to_string(text_hash(text.str()));
+    // The world file's text and that of every mesh it loads: editing either makes a new world.
+    auto file_hash = [](const std::string& path) {
+        std::ifstream in(path, std::ios::binary);
+        std::stringstream text;
+        text << in.rdbuf();
+        return std::to_string(text_hash(text.str()));
+    };
+    std::string fp = "file " + std::filesystem::path(source).filename().string() + " " + file_hash(source);
+    for (const auto& mesh : config::world_file_meshes(source)) fp += " mesh " + file_hash(mesh);
+    return fp;
 }
 
 void Protocol::validate() const {
