@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
 namespace bvc3d::cli {
@@ -36,6 +37,9 @@ struct InterruptGuard {
     ~InterruptGuard();
 };
 [[noreturn]] void exit_interrupted();
+
+// "N trials in DIR (R run, S already complete) in T s, ... steps/s".
+void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome);
 
 // trials.csv, summary.csv/.md and (with `report`) the figures for a folder of trial files.
 void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report);

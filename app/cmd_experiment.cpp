@@ -82,6 +82,15 @@ void exit_interrupted() {
     std::exit(130);
 }
 
+void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome) {
+    std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", n_trials, out.c_str(), outcome.ran,
+                outcome.skipped, outcome.wall_seconds);
+    if (outcome.steps > 0)
+        std::printf(", %.0f walk steps/s, %.0f model steps/s", outcome.steps / outcome.wall_seconds,
+                    outcome.model_steps / outcome.wall_seconds);
+    std::printf("\n");
+}
+
 void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report) {
     const auto trials = read_summaries(files);
     const auto rows = summarize(trials);
@@ -242,12 +251,7 @@ void add_paper(CLI::App& app) {
         } catch (const Interrupted&) {
             exit_interrupted();
         }
-        std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", trials.size(), o->out.c_str(),
-                    outcome.ran, outcome.skipped, outcome.wall_seconds);
-        if (outcome.steps > 0)
-            std::printf(", %.0f walk steps/s, %.0f model steps/s", outcome.steps / outcome.wall_seconds,
-                        outcome.model_steps / outcome.wall_seconds);
-        std::printf("\n");
+        print_outcome(trials.size(), o->out, outcome);
         summarise(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
     });

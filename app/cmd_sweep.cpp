@@ -135,8 +135,7 @@ void add_sweep_command(CLI::App& app) {
             }
         }
         if (!root) return;
-        std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s\n", sweep.trials.size(), out.c_str(),
-                    outcome.ran, outcome.skipped, outcome.wall_seconds);
+        print_outcome(sweep.trials.size(), out, outcome);
         summarise(out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md\n", out.c_str());
     });
