@@ -64,6 +64,12 @@ CrossArenaParams cross_from_yaml(const YamlView& v) {
     return p;
 }
 
+// The file a `mesh:` object loads: its `file`, relative to the YAML file unless absolute.
+std::string mesh_path(const YamlView& mesh) {
+    const std::filesystem::path rel = mesh["file"].as_string();
+    return rel.is_absolute() ? rel.string() : (std::filesystem::path(mesh.directory()) / rel).string();
+}
+
 void check_mesh(const YamlView& v, const TriangleMesh& m) {
     if (m.empty()) v.fail("produces no triangles");
     for (std::size_t t = 0; t < m.size(); ++t) {
@@ -114,13 +120,9 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         part = tilted_wall_mesh(t);
     } else if (kind == "mesh") {
         v.expect_map({"file", "position", "yaw_deg", "rotation_deg", "scale"});
-        const std::string rel = v["file"].as_string();
-        const std::filesystem::path file = std::filesystem::path(rel).is_absolute()
-                                               ? std::filesystem::path(rel)
-                                               : std::filesystem::path(v.directory()) / rel;
         TriangleMesh loaded;
         try {
-            loaded = load_mesh_file(file.string());
+            loaded = load_mesh_file(mesh_path(v));
         } catch (const InputError& e) {
             v["file"].fail(e.what());
         }
@@ -189,9 +191,7 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
     for (std::size_t i = 0; i < objects.size(); ++i) {
         const YamlView o = objects.at(i);
         if (!o.has("mesh") || !o["mesh"].has("file")) continue;
-        const std::string rel = o["mesh"]["file"].as_string();
-        files.push_back(std::filesystem::path(rel).is_absolute() ? rel
-                                                                 : (std::filesystem::path(v.directory()) / rel).string());
+        files.push_back(mesh_path(o["mesh"]));
     }
     return files;
 }
