@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "bvc3d/core/angles.hpp"
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -55,7 +55,7 @@ Pose parse_pose(const std::string& text) {
             start = i + 1;
         }
     if (parts.size() != 3) throw InputError("--pose expects X,Y,HEADING (three comma-separated numbers), got '" + text + "'");
-    Pose p;
+    Pose p;  // on the floor, level
     p.x = parse_number(parts[0], "--pose: X");
     p.y = parse_number(parts[1], "--pose: Y");
     std::string h = parts[2];

@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/core/geometry.hpp"
 #include "bvc3d/experiment/experiment.hpp"
-#include "bvc3d/sensor/lidar.hpp"
 
 namespace bvc3d::cli {
 
-// "X,Y,HEADING": metres and radians; the heading may end in "deg" for degrees.
+// "X,Y,HEADING": meters and radians, a pose on the floor; the heading may end in "deg" for degrees.
 Pose parse_pose(const std::string& text);
 
 // Full-precision decimal text for numbers written to CSV.
@@ -42,7 +42,7 @@ struct InterruptGuard {
 void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome);
 
 // trials.csv, summary.csv/.md and (with `report`) the figures for a folder of trial files.
-void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report);
+void summarize(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report);
 
 void add_simulator_commands(CLI::App& app);
 void add_model_commands(CLI::App& app);

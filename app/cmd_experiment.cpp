@@ -9,13 +9,14 @@
 #include <memory>
 #include <sstream>
 
+#include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/experiment.hpp"
-#include "bvc3d/experiment/trial_runner.hpp"
-#include "bvc3d/recorder/checkpoint_file.hpp"
+#include "bvc3d/experiment/pipeline.hpp"
 #include "bvc3d/report/summary.hpp"
 #include "cli_common.hpp"
 
@@ -91,7 +92,7 @@ void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const
     std::printf("\n");
 }
 
-void summarise(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report) {
+void summarize(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report) {
     const auto trials = read_summaries(files);
     const auto rows = summarize(trials);
     write_trials_csv(out / "trials.csv", trials);
@@ -104,21 +105,78 @@ void summarise(const std::filesystem::path& out, const std::vector<std::filesyst
 
 namespace {
 
+struct RunOptions {
+    std::string config, world, lean, model, protocol, extent, out, trajectory;
+    std::optional<double> tilt, explore_hours, sample_hours, hours;
+    std::optional<std::uint64_t> seed;
+    bool record_bvc = false;
+    double checkpoint_minutes = 10;
+};
+
+// The trial `bvc3d run` runs: the YAML file's, with the flags on top.
+TrialConfig run_config(const RunOptions& o) {
+    TrialConfig t = o.config.empty() ? TrialConfig{} : config::load_trial_file(o.config);
+    if (!o.world.empty()) t.world = WorldSpec{o.world, std::nullopt, "+x+y"};
+    if (o.tilt) t.world.tilt_deg = o.tilt;
+    if (!o.lean.empty()) t.world.lean = o.lean;
+    if (!o.model.empty()) t.model = config::resolve_model(o.model);
+    if (!o.trajectory.empty()) t.agent = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory));
+    if (o.seed) t.seed = *o.seed;
+    if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
+    if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
+    if (o.explore_hours) t.protocol.explore_hours = *o.explore_hours;
+    if (o.sample_hours) t.protocol.sample_hours = *o.sample_hours;
+    if (o.record_bvc) t.protocol.record_bvc = true;
+    if (!o.extent.empty()) {
+        if (o.extent != "data" && o.extent != "arena") throw InputError("--extent must be 'data' or 'arena'");
+        t.arena_extent = o.extent == "arena";
+    }
+    if (o.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+    t.validate();
+    t.world.resolve();  // fail early on bad worlds
+    return t;
+}
+
+// Runs one trial into `out` through the trial pipeline, with a progress line on a terminal.
+void run_one(const TrialConfig& t, const std::filesystem::path& out, double checkpoint_minutes) {
+    const bool tty = ::isatty(STDERR_FILENO);
+    const double total = t.protocol.seconds();
+    InterruptGuard guard;
+    RunControl control;
+    control.stop = &stop_flag();
+    control.checkpoint = out.string() + ".ckpt";
+    control.checkpoint_minutes = checkpoint_minutes;
+    const auto start = std::chrono::steady_clock::now();
+    if (tty)
+        control.progress = [&](double s, std::int64_t) {
+            const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            std::fprintf(stderr, "\r  %.2f/%.2f simulated hours  ~%.0f s left   ", s / 3600, total / 3600,
+                         s > 0 ? wall * (total - s) / s : 0.0);
+        };
+    GroupOutcome done;
+    try {
+        done = run_analyze_write({t}, {out}, control);
+    } catch (const Interrupted&) {
+        exit_interrupted();
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (tty) std::fprintf(stderr, "\n");
+    const auto& r = done.result;
+    std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), r.t.size(),
+                (r.stats.explore_steps + r.stats.sample_steps) / wall);
+    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics)) std::printf("  %-16s %g\n", name.c_str(), v);
+}
+
 void add_run(CLI::App& app) {
-    auto* cmd = app.add_subcommand("run", "Run one trial (SPEC §7) and write its HDF5 file");
-    struct Options {
-        std::string config, world, lean, model, protocol, extent, out;
-        std::optional<double> tilt, explore_hours, sample_hours, hours;
-        std::optional<std::uint64_t> seed;
-        bool record_bvc = false;
-        double checkpoint_minutes = 10;
-    };
-    auto o = std::make_shared<Options>();
+    auto* cmd = app.add_subcommand("run", "Run one trial and write its HDF5 file");
+    auto o = std::make_shared<RunOptions>();
     cmd->add_option("--config", o->config, "Trial YAML file (docs/experiments.md); flags below override it");
     cmd->add_option("--world", o->world, "World preset or YAML file (default cross)");
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward (default +x+y)");
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
+    cmd->add_option("--trajectory", o->trajectory,
+                    "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
     cmd->add_option("--seed", o->seed, "Random seed (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
@@ -132,61 +190,15 @@ void add_run(CLI::App& app) {
         ->capture_default_str();
     cmd->footer("Ctrl-C checkpoints and stops; running the same command again resumes and gives the same file.");
     cmd->callback([o] {
-        TrialConfig t = o->config.empty() ? TrialConfig{} : config::load_trial_file(o->config);
-        if (o->config.empty()) t.model = model_preset("3d-0.2");
-        if (!o->world.empty()) t.world = WorldSpec{o->world, std::nullopt, "+x+y"};
-        if (o->tilt) t.world.tilt_deg = o->tilt;
-        if (!o->lean.empty()) t.world.lean = o->lean;
-        if (!o->model.empty()) t.model = config::resolve_model(o->model);
-        if (o->seed) t.seed = *o->seed;
-        if (!o->protocol.empty()) t.protocol.kind = parse_protocol(o->protocol);
-        if (o->hours) t.protocol.explore_hours = t.protocol.sample_hours = *o->hours;
-        if (o->explore_hours) t.protocol.explore_hours = *o->explore_hours;
-        if (o->sample_hours) t.protocol.sample_hours = *o->sample_hours;
-        if (o->record_bvc) t.protocol.record_bvc = true;
-        if (!o->extent.empty()) {
-            if (o->extent != "data" && o->extent != "arena") throw InputError("--extent must be 'data' or 'arena'");
-            t.arena_extent = o->extent == "arena";
-        }
-        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-        t.validate();
-        const WorldDescription world = t.world.resolve();
+        const TrialConfig t = run_config(*o);
         const std::filesystem::path out = o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
                                                          : std::filesystem::path(o->out);
         ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
-        if (trial_file_fingerprint(out) == t.fingerprint()) {
+        if (trial_file_complete(out, t)) {
             std::cerr << "bvc3d: " << out.string() << " is complete with this configuration; nothing to do\n";
             return;
         }
-        const bool tty = ::isatty(STDERR_FILENO);
-        const double total = 3600 * (t.protocol.kind == Protocol::Kind::online ? t.protocol.sample_hours
-                                                                                 : t.protocol.explore_hours + t.protocol.sample_hours);
-        InterruptGuard guard;
-        RunControl control;
-        control.stop = &stop_flag();
-        control.checkpoint = out.string() + ".ckpt";
-        control.checkpoint_minutes = o->checkpoint_minutes;
-        const auto start = std::chrono::steady_clock::now();
-        if (tty)
-            control.progress = [&](double s, std::int64_t) {
-                const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-                std::fprintf(stderr, "\r  %.2f/%.2f simulated hours  ~%.0f s left   ", s / 3600, total / 3600,
-                             s > 0 ? wall * (total - s) / s : 0.0);
-            };
-        GroupResult result;
-        try {
-            result = run_trial_group({t}, control);
-        } catch (const Interrupted&) {
-            exit_interrupted();
-        }
-        const auto metrics = analyze(t, world, result.x, result.y, result.models[0].rates, result.models[0].n_place);
-        write_trial_file(out, t, result, 0, metrics, analysis_params(t, world));
-        remove_checkpoint(control.checkpoint);
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (tty) std::fprintf(stderr, "\n");
-        std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), result.t.size(),
-                    (result.stats.explore_steps + result.stats.sample_steps) / wall);
-        for (const auto& [name, v] : scalar_metrics(metrics)) std::printf("  %-16s %g\n", name.c_str(), v);
+        run_one(t, out, o->checkpoint_minutes);
     });
 }
 
@@ -252,13 +264,13 @@ void add_paper(CLI::App& app) {
             exit_interrupted();
         }
         print_outcome(trials.size(), o->out, outcome);
-        summarise(o->out, outcome.files, !o->no_report);
+        summarize(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
     });
 }
 
 void add_analyze(CLI::App& app) {
-    auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files (SPEC §8), optionally with other parameters");
+    auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files, optionally with other parameters");
     struct Options {
         std::vector<std::string> files;
         std::optional<int> gridsize, min_samples;
@@ -274,11 +286,11 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
     cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX, or 'data' for the trajectory's own");
     cmd->add_option("--decoding-templates", o->templates,
-                    "Decoder templates: rate_maps (SPEC: thresholded, normalised maps) or means (raw mean rates)");
+                    "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
-    cmd->footer("Each file is analysed with the parameters its metrics were computed with; the options change only\n"
-                "what they name (SPEC §8 defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2,\n"
-                "decoding templates rate_maps).");
+    cmd->footer("Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
+                "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2,\n"
+                "decoding templates rate_maps; docs/analysis.md).");
     cmd->callback([o] {
         std::optional<analysis::Extent> extent;
         if (!o->extent.empty() && o->extent != "data") {
@@ -290,11 +302,11 @@ void add_analyze(CLI::App& app) {
         std::vector<TrialFileData> trials;
         for (const auto& f : o->files) trials.push_back(read_trial_samples(f));  // all readable before any output
         std::printf("%-40s", "trial");
-        for (const auto& n : scalar_metric_names()) std::printf(" %15s", n.c_str());
+        for (const auto& n : analysis::metric_names()) std::printf(" %15s", n.c_str());
         std::printf("\n");
         for (std::size_t i = 0; i < trials.size(); ++i) {
             const auto& d = trials[i];
-            analysis::AnalysisParams params = d.analysis;
+            analysis::AnalysisParams params = stored_analysis_params(d);
             if (o->gridsize) params.gridsize = *o->gridsize;
             if (o->quantile) params.quantile = *o->quantile;
             if (o->eps) params.dbscan.eps = *o->eps;
@@ -304,9 +316,11 @@ void add_analyze(CLI::App& app) {
             if (o->extent == "data") params.extent.reset();
             if (extent) params.extent = extent;
             params.validate();
-            const auto m = analysis::analyze_trial<float>(d.x, d.y, d.rates, params);
+            const Eigen::Map<const analysis::RowMatrixXf> rates(d.rates.data(), static_cast<Eigen::Index>(d.x.size()),
+                                                                static_cast<Eigen::Index>(d.n_place));
+            const auto m = analysis::analyze_trial<float>(d.x, d.y, rates, params);
             std::printf("%-40s", d.name.c_str());
-            for (const auto& [name, v] : scalar_metrics(m)) std::printf(" %15.6g", v);
+            for (const auto& [name, v] : analysis::scalar_metrics(m)) std::printf(" %15.6g", v);
             std::printf("\n");
             if (i == 0 && !o->cells.empty()) {
                 AtomicFile f(o->cells);
@@ -332,11 +346,11 @@ void add_summarize(CLI::App& app) {
         std::error_code ec;
         if (!std::filesystem::is_directory(*dir, ec)) throw InputError("'" + *dir + "' is not a folder");
         for (const auto& e : std::filesystem::directory_iterator(*dir))
-            if (e.path().extension() == ".h5" && trial_file_fingerprint(e.path())) files.push_back(e.path());
+            if (e.path().extension() == ".h5" && read_trial_stamp(e.path())) files.push_back(e.path());
         if (files.empty()) throw InputError("'" + *dir + "' holds no complete trial files");
         std::sort(files.begin(), files.end());
-        summarise(*dir, files, !*no_report);
-        std::printf("%zu trials summarised in %s/summary.md\n", files.size(), dir->c_str());
+        summarize(*dir, files, !*no_report);
+        std::printf("%zu trials summarized in %s/summary.md\n", files.size(), dir->c_str());
     });
 }
 

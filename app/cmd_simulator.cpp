@@ -5,7 +5,7 @@
 
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 #include "cli_common.hpp"
 
 namespace bvc3d::cli {
@@ -52,8 +52,8 @@ void add_scan(CLI::App& app) {
     cmd->add_option("--pose", *pose, "Robot pose X,Y,HEADING (m, m, rad; or e.g. 90deg)")->required();
     cmd->add_option("--out", *out, "CSV file to write (default: standard output)");
     cmd->footer(
-        "Ranges in metres from the sensor; azimuth is allocentric (0 = +x, counter-clockwise) and elevation\n"
-        "positive up, both in radians (SPEC §1). Beams with no hit within max_range are left out.");
+        "Ranges in meters from the sensor; azimuth is allocentric (0 = +x, counter-clockwise) and elevation\n"
+        "positive up, both in radians. Beams with no hit within max_range are left out.");
     cmd->callback([=] {
         const World w = world->make();
         const Lidar lidar(config::resolve_sensor(*sensor));
@@ -77,14 +77,14 @@ void add_walk(CLI::App& app) {
     cmd->add_option("--seed", *seed, "Random seed")->capture_default_str()->check(seed_check);
     cmd->add_option("--out", *out, "CSV file to write (default: standard output)");
     cmd->footer(
-        "One row per model step (SPEC §4): t in simulated seconds, position in metres, heading in radians,\n"
+        "One row per model step: t in simulated seconds, position in meters, heading in radians,\n"
         "bumped = 1 when the step ended against an obstacle.");
     cmd->callback([=] {
         const World w = world->make();
         const auto steps = random_walk(w, *hours, *seed);
         emit(*out, "t,x,y,heading,bumped", [&](std::ostream& os) {
             for (const auto& s : steps)
-                os << num(s.t) << ',' << num(s.x) << ',' << num(s.y) << ',' << num(s.heading) << ','
+                os << num(s.t) << ',' << num(s.pose.x) << ',' << num(s.pose.y) << ',' << num(s.pose.heading) << ','
                    << (s.bumped ? 1 : 0) << '\n';
         });
     });

@@ -136,7 +136,7 @@ void add_sweep_command(CLI::App& app) {
         }
         if (!root) return;
         print_outcome(sweep.trials.size(), out, outcome);
-        summarise(out, outcome.files, !o->no_report);
+        summarize(out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md\n", out.c_str());
     });
 }

@@ -9,7 +9,7 @@
 int main(int argc, char** argv) {
     CLI::App app{
         "bvc3d: boundary vector cells and place cells in simulated 3-D worlds.\n"
-        "Reproduces Gerstenslager, Dukenbaev & Minai (IJCNN 2025); see README.md and SPEC."};
+        "Reproduces Gerstenslager, Dukenbaev & Minai (IJCNN 2025) and goes beyond it; see README.md and docs/."};
     app.require_subcommand(1);
     app.set_version_flag("--version", "bvc3d 0.1.0");
     bvc3d::cli::add_simulator_commands(app);

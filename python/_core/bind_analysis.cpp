@@ -34,13 +34,13 @@ Eigen::Map<const an::RowMatrixX<T>> matrix(const Array<T>& a, const char* name) 
     return {a.data(), a.shape(0), a.shape(1)};
 }
 
-Eigen::Map<const an::Centers> centers_of(const ArrayD& a) {
-    if (a.ndim() != 2 || a.shape(1) != 2) throw InputError("centers/points must be an (N, 2) array");
-    return {a.data(), a.shape(0), 2};
+Eigen::Map<const an::Points> centers_of(const ArrayD& a) {
+    if (a.ndim() != 2 || a.shape(1) < 1 || a.shape(1) > 3)
+        throw InputError("centers/points must be an (N, D) array with D = 2 or 3");
+    return {a.data(), a.shape(0), a.shape(1)};
 }
 
 pyb::array_t<double> numpy_of(const an::RowMatrixXd& m) { return to_numpy(m.data(), {m.rows(), m.cols()}); }
-pyb::array_t<double> numpy_of(const an::Centers& c) { return to_numpy(c.data(), {c.rows(), pyb::ssize_t{2}}); }
 template <class T>
 pyb::array_t<T> numpy_of(const std::vector<T>& v) { return to_numpy(v.data(), {static_cast<pyb::ssize_t>(v.size())}); }
 
@@ -158,7 +158,7 @@ void bind_sample_functions(pyb::module_& a) {
             d["counts"] = numpy_of(m.maps.bins.counts);
             d["mean_maps"] = numpy_of(m.maps.mean);
             d["maps"] = numpy_of(m.maps.map);
-            d["bin_area_m2"] = m.maps.bins.grid.bin_area();
+            d["bin_area_m2"] = m.maps.grid->bin_measure();
             d["modality"] = numpy_of(m.modality);
             d["modality_summary"] = summary_dict(m.modality_summary);
             d["sai"] = to_numpy(m.aliasing.sai.data(), {m.aliasing.sai.size()});

@@ -1,8 +1,9 @@
-// World, Sensor and random walk.
+// World, Sensor, agents (random walk, trajectories).
 #include "bindings.hpp"
 
+#include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
-#include "bvc3d/robot/random_walk.hpp"
 
 namespace bvc3d::py {
 
@@ -18,49 +19,55 @@ pyb::array_t<double> scan_to_numpy(const Scan& s) {
     return to_numpy(reinterpret_cast<const double*>(s.data()), {static_cast<pyb::ssize_t>(s.size()), 3});
 }
 
-}  // namespace
+// Model steps as a dict of arrays t, x, y, z, heading, bumped.
+pyb::dict steps_to_dict(const std::vector<ModelStep>& steps) {
+    const auto n = static_cast<pyb::ssize_t>(steps.size());
+    pyb::array_t<double> t(n), x(n), y(n), z(n), h(n);
+    pyb::array_t<bool> bumped(n);
+    for (pyb::ssize_t i = 0; i < n; ++i) {
+        const auto& s = steps[static_cast<std::size_t>(i)];
+        t.mutable_at(i) = s.t;
+        x.mutable_at(i) = s.pose.x;
+        y.mutable_at(i) = s.pose.y;
+        z.mutable_at(i) = s.pose.z;
+        h.mutable_at(i) = s.pose.heading;
+        bumped.mutable_at(i) = s.bumped;
+    }
+    pyb::dict d;
+    d["t"] = t;
+    d["x"] = x;
+    d["y"] = y;
+    d["z"] = z;
+    d["heading"] = h;
+    d["bumped"] = bumped;
+    return d;
+}
 
-void bind_simulator(pyb::module_& m) {
-    pyb::class_<LidarSpec>(m, "Sensor", R"doc(
-A range scanner: a table of beam elevations (rows) × azimuth_count columns (SPEC §3).
-Use Sensor.horizontal() or Sensor.spherical() for the paper's two scanners.)doc")
-        .def(pyb::init([](std::vector<double> elevations, int azimuth_count, double height, double max_range,
-                          double range_noise_sd, double dropout, double azimuth_offset, std::string name) {
-                 LidarSpec s;
-                 s.elevations = std::move(elevations);
-                 s.azimuth_count = azimuth_count;
-                 s.height = height;
-                 s.max_range = max_range;
-                 s.range_noise_sd = range_noise_sd;
-                 s.dropout = dropout;
-                 s.azimuth_offset = azimuth_offset;
-                 s.name = std::move(name);
-                 s.validate();
-                 return s;
-             }),
-             pyb::arg("elevations"), pyb::arg("azimuth_count"), pyb::arg("height") = 0.18,
-             pyb::arg("max_range") = 20.0, pyb::arg("range_noise_sd") = 0.0, pyb::arg("dropout") = 0.0,
-             pyb::arg("azimuth_offset") = 0.0, pyb::arg("name") = "custom",
-             "elevations in radians (rows, top first); azimuth_offset in radians")
+void bind_sensor(pyb::module_& m) {
+    auto cls = pyb::class_<LidarSpec>(m, "Sensor", (R"doc(
+A range scanner: a table of beam elevations (rows) × azimuth_count columns (docs/worlds.md#sensors).
+Sensor.horizontal() and Sensor.spherical() are the paper's two scanners; Sensor(**keys) any other:
+)doc" + describe(LidarSpec::table(), LidarSpec{})).c_str());
+    cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
+                LidarSpec s;
+                s.name = "custom";
+                apply_args(s, LidarSpec::table(), args, kwargs);
+                return s;
+            }))
         .def_static("horizontal", &LidarSpec::horizontal, "The paper's 2-D scanner: 720 beams at 0.08 m")
         .def_static("spherical", &LidarSpec::spherical, pyb::arg("upper_only") = true,
                     "The paper's 90×180 range image at 0.18 m; upper_only keeps rows 0-44 (elevation > 0)")
         .def_static("from_yaml", &config::resolve_sensor, pyb::arg("path"))
-        .def_readwrite("name", &LidarSpec::name)
-        .def_readwrite("elevations", &LidarSpec::elevations)
-        .def_readwrite("azimuth_count", &LidarSpec::azimuth_count)
-        .def_readwrite("azimuth_offset", &LidarSpec::azimuth_offset)
-        .def_readwrite("height", &LidarSpec::height)
-        .def_readwrite("max_range", &LidarSpec::max_range)
-        .def_readwrite("range_noise_sd", &LidarSpec::range_noise_sd)
-        .def_readwrite("dropout", &LidarSpec::dropout)
         .def_property_readonly("beam_count", &LidarSpec::beam_count)
         .def("__repr__", [](const LidarSpec& s) {
             return "Sensor('" + s.name + "', rows=" + std::to_string(s.elevations.size()) +
                    ", azimuth_count=" + std::to_string(s.azimuth_count) + ")";
         });
+    def_fields<LidarSpec>(cls);
+}
 
-    pyb::class_<World>(m, "World", "A 3-D world: triangles, a walkable floor region and a start region (SPEC §2)")
+void bind_world(pyb::module_& m) {
+    pyb::class_<World>(m, "World", "A 3-D world: triangles, a walkable floor region and a start region (docs/worlds.md)")
         .def_static(
             "cross",
             [](double tilt_deg, const std::string& lean) {
@@ -69,7 +76,8 @@ Use Sensor.horizontal() or Sensor.spherical() for the paper's two scanners.)doc"
                 p.lean = lean;
                 return World::cross(p);
             },
-            pyb::arg("tilt_deg") = 0.0, pyb::arg("lean") = "+x+y", "The paper's cross arena (SPEC §2.1)")
+            pyb::arg("tilt_deg") = CrossArenaParams{}.tilt_deg, pyb::arg("lean") = CrossArenaParams{}.lean,
+            "The paper's cross arena")
         .def_static(
             "from_yaml", [](const std::string& path) { return World(config::load_world_file(path)); },
             pyb::arg("path"))
@@ -101,49 +109,46 @@ Use Sensor.horizontal() or Sensor.spherical() for the paper's two scanners.)doc"
                                "(K, 2) polygon the robot's body stays inside")
         .def(
             "scan",
-            [](const World& w, const pyb::object& sensor, double x, double y, double heading,
-               std::uint64_t noise_seed, std::uint64_t scan_index) {
+            [](const World& w, const pyb::object& sensor, double x, double y, double heading, std::uint64_t noise_seed,
+               std::uint64_t scan_index, double z, double pitch, double roll) {
                 const Lidar lidar(sensor_of(sensor));
                 Scan s;
                 {
                     pyb::gil_scoped_release release;
-                    lidar.scan(w, Pose{x, y, heading}, s, NoiseKey{noise_seed, scan_index});
+                    lidar.scan(w, Pose{x, y, z, heading, pitch, roll}, s, NoiseKey{noise_seed, scan_index});
                 }
                 return scan_to_numpy(s);
             },
             pyb::arg("sensor"), pyb::arg("x"), pyb::arg("y"), pyb::arg("heading"), pyb::arg("noise_seed") = 0,
-            pyb::arg("scan_index") = 0,
-            R"doc(Cast a scan from pose (x, y, heading [rad]). sensor: "horizontal", "spherical" or a Sensor.
-Returns a float64 (N, 3) array: range [m], allocentric azimuth [rad], elevation [rad].)doc");
+            pyb::arg("scan_index") = 0, pyb::arg("z") = 0.0, pyb::arg("pitch") = 0.0, pyb::arg("roll") = 0.0,
+            R"doc(Cast a scan from the pose (x, y, z; heading, pitch, roll in rad). z is the agent's base above the
+floor; the sensor sits its own height above it and tilts with pitch (nose up) and roll. sensor:
+"horizontal", "spherical" or a Sensor. Returns a float64 (N, 3) array: range [m], allocentric azimuth
+[rad], elevation [rad], both in the world frame.)doc");
+}
 
+}  // namespace
+
+void bind_simulator(pyb::module_& m) {
+    bind_sensor(m);
+    bind_world(m);
     m.def(
         "random_walk",
         [](const World& w, double hours, std::uint64_t seed) {
-            std::vector<WalkStep> steps;
+            std::vector<ModelStep> steps;
             {
                 pyb::gil_scoped_release release;
                 steps = random_walk(w, hours, seed);
             }
-            const auto n = static_cast<pyb::ssize_t>(steps.size());
-            pyb::array_t<double> t(n), x(n), y(n), h(n);
-            pyb::array_t<bool> bumped(n);
-            for (pyb::ssize_t i = 0; i < n; ++i) {
-                t.mutable_at(i) = steps[i].t;
-                x.mutable_at(i) = steps[i].x;
-                y.mutable_at(i) = steps[i].y;
-                h.mutable_at(i) = steps[i].heading;
-                bumped.mutable_at(i) = steps[i].bumped;
-            }
-            pyb::dict d;
-            d["t"] = t;
-            d["x"] = x;
-            d["y"] = y;
-            d["heading"] = h;
-            d["bumped"] = bumped;
-            return d;
+            return steps_to_dict(steps);
         },
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
-        "The paper's random walk (SPEC §4): dict of arrays t, x, y, heading, bumped, one entry per model step");
+        "The paper's random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step");
+    m.def(
+        "read_trajectory", [](const std::string& path) { return steps_to_dict(read_trajectory_file(path)); },
+        pyb::arg("path"),
+        R"doc(A trajectory file (rows t, x, y, [z], heading; docs/experiments.md#user-trajectories) as a dict of
+arrays t (shifted to start at 0), x, y, z, heading, bumped.)doc");
 }
 
 }  // namespace bvc3d::py

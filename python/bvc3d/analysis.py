@@ -1,5 +1,5 @@
-"""Analysis of recorded samples (SPEC §8): rate maps, modality index, spatial aliasing,
-localisation error and per-cell statistics. numpy in, numpy out; the work is done in C++.
+"""Analysis of recorded samples (docs/analysis.md): rate maps, modality index, spatial aliasing,
+localization error and per-cell statistics. numpy in, numpy out; the work is done in C++.
 
 Conventions (docs/analysis.md has the details):
 
@@ -104,8 +104,8 @@ def _templates(templates, name="templates"):
 
 def _centers_maps(centers, maps):
     c = np.ascontiguousarray(centers, dtype=np.float64)
-    if c.ndim != 2 or c.shape[1] != 2:
-        raise ValueError(f"centers must be an (N, 2) array, got shape {c.shape}")
+    if c.ndim != 2 or c.shape[1] not in (2, 3):
+        raise ValueError(f"centers must be an (N, 2) or (N, 3) array, got shape {c.shape}")
     m = np.ascontiguousarray(maps, dtype=np.float64)
     was_1d = m.ndim == 1
     if was_1d:
@@ -135,7 +135,7 @@ def hexbin(x, y, values, gridsize=50, extent=None):
 
 
 def rate_maps(x, y, rates, gridsize=50, quantile=0.1, extent=None):
-    """Thresholded, normalised rate maps (SPEC §8).
+    """Thresholded, normalized rate maps (docs/analysis.md).
 
     Per cell (column of ``rates``): the mean rate per visited bin (``hexbin``), then values below
     ``numpy.percentile(cell_map, 100 * quantile)`` (linear) set to 0, then the map divided by its
@@ -151,11 +151,11 @@ def rate_maps(x, y, rates, gridsize=50, quantile=0.1, extent=None):
 
 def dbscan_cluster_count(points, eps=1.0, min_samples=20):
     """Number of clusters ``sklearn.cluster.DBSCAN(eps, min_samples).fit(points)`` finds
-    (labels >= 0), for (N, 2) points; identical to scikit-learn 1.2.1 for any input, including
-    points at exactly ``eps`` from each other. 0 for no points."""
+    (labels >= 0), for (N, 2) or (N, 3) points; identical to scikit-learn 1.2.1 for any input,
+    including points at exactly ``eps`` from each other. 0 for no points."""
     p = np.ascontiguousarray(points, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 2:
-        raise ValueError(f"points must be an (N, 2) array, got shape {p.shape}")
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise ValueError(f"points must be an (N, 2) or (N, 3) array, got shape {p.shape}")
     eps, min_samples = _dbscan_params(eps, min_samples)
     return int(_an.dbscan_cluster_count(p, eps, min_samples))
 
@@ -185,11 +185,11 @@ def modality_summary(counts):
 
 
 def aliasing(centers, maps, d_th=2.0):
-    """Spatial aliasing (SPEC §8).
+    """Spatial aliasing (docs/analysis.md).
 
     ``SAI_i = (1/N) * sum over j != i with |c_i - c_j| > d_th of cos(a_i, a_j)`` where a_i is row i
     of ``maps`` (the population vector of bin i), cos = 0 when either vector is zero and N is the
-    number of bins; distances are ``sqrt(dx**2 + dy**2)``. Returns ``(sai (B,), msai)``, msai = mean
+    number of bins; distances are Euclidean over the centers' 2 or 3 coordinates. Returns ``(sai (B,), msai)``, msai = mean
     SAI (NaN for no bins).
     """
     c, m, _ = _centers_maps(centers, maps)
@@ -198,7 +198,7 @@ def aliasing(centers, maps, d_th=2.0):
 
 
 def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, templates="rate_maps"):
-    """Localisation error of a population-vector decoder (SPEC §8).
+    """Localization error of a population-vector decoder (docs/analysis.md).
 
     Templates (``templates="rate_maps"``, SPEC's decoder): the rate maps of the first ``n // 2``
     samples, i.e. the mean rate of every cell in every bin they visit, thresholded at the cell's

@@ -1,4 +1,4 @@
-"""Figures and report.md for a folder of bvc3d trial files (SPEC §9).
+"""Figures and report.md for a folder of bvc3d trial files.
 
     /usr/bin/python3 -m bvc3d.report DIR
 
@@ -22,14 +22,11 @@ try:
 except ImportError:  # pragma: no cover - Debian's python3-h5py is a dependency
     h5py = None
 
+from ._core import metric_table
+
 DPI = 120
-METRICS = {
-    "frac_active": ("fraction of cells with MI > 0", "Fraction of place cells with a field (MI > 0)"),
-    "mean_mi_active": ("mean MI of cells with MI > 0", "Mean modality index of active cells"),
-    "frac_multimodal": ("fraction of cells with MI > 1", "Fraction of multimodal place cells (MI > 1)"),
-    "msai": ("MSAI", "Mean spatial aliasing index"),
-    "decode_median_m": ("median decoding error (m)", "Localisation error (median)"),
-}
+# Metrics with a figure of their own: (axis label, title), from the analysis stage's one table.
+METRICS = {m["name"]: (m["label"], m["title"]) for m in metric_table if m["title"]}
 
 
 def read_csv(path):

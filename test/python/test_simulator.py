@@ -43,7 +43,8 @@ def test_random_walk_dict_and_determinism():
     a = bvc3d.random_walk(w, 0.25, 5)
     b = bvc3d.random_walk(w, 0.25, 5)
     c = bvc3d.random_walk(w, 0.25, 6)
-    assert set(a) == {"t", "x", "y", "heading", "bumped"}
+    assert set(a) == {"t", "x", "y", "z", "heading", "bumped"}
+    assert not a["z"].any()  # a ground robot stays on the floor
     for k in a:
         np.testing.assert_array_equal(a[k], b[k])
     assert a["bumped"].dtype == np.bool_

@@ -3,8 +3,8 @@
 #include <benchmark/benchmark.h>
 
 #include "../support/bvc_reference.hpp"
-#include "bvc3d/experiment/model_spec.hpp"
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 
 using namespace bvc3d;
 
@@ -22,7 +22,7 @@ Inputs inputs(const std::string& preset) {
     const Lidar lidar(in.model.sensor);
     const auto walk = random_walk(world, 0.05, 1);
     for (std::size_t i = 0; i < walk.size(); i += walk.size() / 16)
-        in.scans.push_back(lidar.scan(world, Pose{walk[i].x, walk[i].y, walk[i].heading}));
+        in.scans.push_back(lidar.scan(world, walk[i].pose));
     return in;
 }
 
@@ -52,7 +52,7 @@ void BM_FullStep(benchmark::State& state, std::string preset) {
     std::size_t i = 0;
     for (auto _ : state) {
         const auto& s = walk[i++ % walk.size()];
-        lidar.scan(world, Pose{s.x, s.y, s.heading}, scan, {}, plan.rows);
+        lidar.scan(world, s.pose, scan, {}, plan.rows);
         if (!layer.rates_pruned(scan, plan, rates)) state.SkipWithError("pruning bound failed");
         benchmark::DoNotOptimize(net.step(rates, true).data());
     }

@@ -1,7 +1,7 @@
 // Simulator stage: scans (rays per second) and random-walk steps in the paper's 45° arena.
 #include <benchmark/benchmark.h>
 
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
 using namespace bvc3d;
@@ -9,7 +9,7 @@ using namespace bvc3d;
 namespace {
 
 // Poses along a real walk, so the rays see the arena from typical places.
-const std::vector<WalkStep>& poses(const World& w) {
+const std::vector<ModelStep>& poses(const World& w) {
     static const auto steps = random_walk(w, 0.2, 1);
     return steps;
 }
@@ -22,7 +22,7 @@ void scan_benchmark(benchmark::State& state, LidarSpec spec) {
     std::size_t i = 0, rays = 0;
     for (auto _ : state) {
         const auto& s = walk[i++ % walk.size()];
-        lidar.scan(world, Pose{s.x, s.y, s.heading}, scan);
+        lidar.scan(world, s.pose, scan);
         benchmark::DoNotOptimize(scan.data());
         rays += lidar.spec().beam_count();
     }
@@ -32,7 +32,7 @@ void scan_benchmark(benchmark::State& state, LidarSpec spec) {
 void BM_ScanHorizontal(benchmark::State& state) { scan_benchmark(state, LidarSpec::horizontal()); }
 void BM_ScanSpherical(benchmark::State& state) { scan_benchmark(state, LidarSpec::spherical()); }
 
-void BM_RandomWalkStep(benchmark::State& state) {
+void BM_RandomModelStep(benchmark::State& state) {
     const World world = World::cross({.tilt_deg = 45});
     auto body = std::make_shared<const BodyCollider>(world.description(), 0.25, 0.1);
     Rng rng(1, Stream::walk);
@@ -45,4 +45,4 @@ void BM_RandomWalkStep(benchmark::State& state) {
 
 BENCHMARK(BM_ScanHorizontal);
 BENCHMARK(BM_ScanSpherical)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_RandomWalkStep);
+BENCHMARK(BM_RandomModelStep);

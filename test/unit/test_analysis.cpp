@@ -78,7 +78,7 @@ TEST(AnalysisHexbin, VisitedBinsInGridOrderWithMeans) {
     const HexGrid g = unit_grid(4, 2);
     const std::vector<double> x{3.5, 0.0, 0.1, 9.0, 2.0}, y{1.5, 0.0, 0.1, 9.0, 1.0};
     const HexBins b = bin_samples(g, x, y);
-    ASSERT_EQ(b.bins, (std::vector<int>{0, 7, 22}));
+    ASSERT_EQ(b.ids, (std::vector<int>{0, 7, 22}));
     EXPECT_EQ(b.counts, (std::vector<std::int64_t>{2, 1, 1}));
     EXPECT_EQ(b.sample_bin, (std::vector<int>{2, 0, 0, -1, 1}));
     EXPECT_EQ(b.centers(2, 0), 3.5);
@@ -120,14 +120,14 @@ TEST(AnalysisRateMaps, ThresholdThenNormalise) {
         0, 3, 0,   //
         2, 4, 0,   //
         4, 5, 0;
-    threshold_and_normalise(m, 0.1);
+    threshold_and_normalize(m, 0.1);
     EXPECT_EQ(m(3, 0), 0.5);  // the 10 % quantile of a mostly silent cell is 0: nothing removed
     EXPECT_EQ(m(4, 0), 1.0);
     EXPECT_EQ(m(0, 1), 0.0);  // 1 < 1.4
     EXPECT_EQ(m(1, 1), 0.4);
     EXPECT_EQ(m.col(2).cwiseAbs().maxCoeff(), 0.0);  // silent cell: zeros, not NaN
     RowMatrixXd m2 = RowMatrixXd::Ones(3, 1);
-    EXPECT_THROW(threshold_and_normalise(m2, 1.5), InputError);
+    EXPECT_THROW(threshold_and_normalize(m2, 1.5), InputError);
 }
 
 TEST(AnalysisModality, ClustersChainsAndNoise) {
@@ -262,7 +262,8 @@ TEST(AnalysisDecoding, DefaultTemplatesAreTheNormalisedRateMaps) {
     EXPECT_NEAR(q90.median_m, 1.0, 1e-8);
     // The grid overload (analyze_trial's) is the same decoder, and analyze_trial passes its quantile.
     const HexGrid g = HexGrid::fit(x, y, 4);
-    EXPECT_EQ(decoding_error<double>(g, x, y, r, DecodingTemplates::rate_maps, 0.1).mean_m, by_default.mean_m);
+    EXPECT_EQ(decoding_error<double>(g, positions_2d(x, y), r, DecodingTemplates::rate_maps, 0.1).mean_m,
+              by_default.mean_m);
     AnalysisParams ap;
     ap.gridsize = 4;
     EXPECT_EQ(analyze_trial<double>(x, y, r, ap).decoding.mean_m, by_default.mean_m);

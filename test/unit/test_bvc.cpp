@@ -7,8 +7,8 @@
 #include "../support/bvc_reference.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/experiment/model_spec.hpp"
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 
 using namespace bvc3d;
 
@@ -89,7 +89,7 @@ TEST(BoundaryVectorLayer, MatchesTheEquationsOnRealScansOfEveryPaperWorld) {
             const ModelSpec m = model_preset(name);
             const Lidar lidar(m.sensor);
             for (std::size_t i : {walk.size() / 3, walk.size() - 1}) {
-                const Scan scan = lidar.scan(world, Pose{walk[i].x, walk[i].y, walk[i].heading});
+                const Scan scan = lidar.scan(world, walk[i].pose);
                 expect_matches_reference(m.bvc, scan, name + " in cross-" + std::to_string(int(tilt)));
             }
         }
@@ -107,7 +107,7 @@ TEST(BoundaryVectorLayer, PrunedScanningGivesTheSameRates) {
         int cast = 0;
         for (char r : rows) cast += r;
         EXPECT_LE(cast, 7) << name << " should need only the rows near its layers";
-        for (const Pose pose : {Pose{4, 4, 0.2}, Pose{0.7, -0.9, -1}}) {
+        for (const Pose pose : {Pose::on_floor(4, 4, 0.2), Pose::on_floor(0.7, -0.9, -1)}) {
             Scan full, pruned;
             lidar.scan(world, pose, full);
             lidar.scan(world, pose, pruned, {}, rows);
@@ -186,7 +186,7 @@ TEST(BoundaryVectorLayer, ElevationFactorSelectsTheLayer) {
 TEST(BoundaryVectorLayer, NormalisationModes) {
     const World world = World::cross({.tilt_deg = 30});
     const ModelSpec m = model_preset("3d-3l");
-    const Scan scan = Lidar(m.sensor).scan(world, Pose{1, 1, 0});
+    const Scan scan = Lidar(m.sensor).scan(world, Pose::on_floor(1, 1, 0));
     const BoundaryVectorLayer layer(m.bvc);
     std::vector<double> v(layer.n_cells()), raw(layer.n_cells());
     layer.rates(scan, v);

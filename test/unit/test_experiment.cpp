@@ -8,6 +8,8 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"
+#include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/experiment/pipeline.hpp"
 #include "bvc3d/recorder/trial_file.hpp"
 
 using namespace bvc3d;
@@ -114,7 +116,8 @@ TEST(TrialFiles, SameConfigurationGivesAByteIdenticalFile) {
     const auto b = run_experiment({t}, opts);
     ASSERT_EQ(a.files.size(), 1u);
     EXPECT_EQ(bytes(a.files[0]), bytes(b.files[0]));
-    EXPECT_EQ(trial_file_fingerprint(a.files[0]), t.fingerprint());
+    EXPECT_EQ(read_trial_stamp(a.files[0])->fingerprint, t.fingerprint());
+    EXPECT_TRUE(trial_file_complete(a.files[0], t));
     // A rerun skips the complete trial; a changed configuration reruns it.
     opts.out_dir = dir / "a";
     EXPECT_EQ(run_experiment({t}, opts).skipped, 1);
@@ -126,18 +129,18 @@ TEST(TrialFiles, SameConfigurationGivesAByteIdenticalFile) {
     EXPECT_EQ(d.model, "3d-0.2");
     EXPECT_EQ(d.world, "cross-45");
     EXPECT_EQ(d.tilt_deg, 45.0);
-    EXPECT_EQ(d.rates.cols(), 250);
-    EXPECT_EQ(static_cast<std::size_t>(d.rates.rows()), d.x.size());
-    const auto s = read_trial_summary(a.files[0]);
-    EXPECT_EQ(s.metrics.size(), scalar_metric_names().size());
+    EXPECT_EQ(d.n_place, 250u);
+    EXPECT_EQ(d.rates.size(), d.x.size() * 250);
+    const auto s = read_trial_summary(a.files[0], analysis::metric_names());
+    EXPECT_EQ(s.metrics.size(), analysis::metric_names().size());
     fs::remove_all(dir);
 }
 
 TEST(TrialFiles, BrokenFilesAreNotComplete) {
     const auto dir = temp_dir("broken");
     std::ofstream(dir / "x.h5") << "not hdf5";
-    EXPECT_FALSE(trial_file_fingerprint(dir / "x.h5"));
-    EXPECT_FALSE(trial_file_fingerprint(dir / "missing.h5"));
+    EXPECT_FALSE(read_trial_stamp(dir / "x.h5"));
+    EXPECT_FALSE(read_trial_stamp(dir / "missing.h5"));
     EXPECT_THROW(read_trial_samples(dir / "x.h5"), InputError);
     fs::remove_all(dir);
 }

@@ -27,7 +27,7 @@ TEST(BeamLayout, HorizontalScanner) {
     EXPECT_EQ(s.elevations, std::vector<double>{0.0});
     EXPECT_DOUBLE_EQ(s.height, 0.08);
     EXPECT_DOUBLE_EQ(s.max_range, 20.0);
-    const Scan scan = Lidar(s).scan(box_world(), Pose{0, 0, 0});
+    const Scan scan = Lidar(s).scan(box_world(), Pose::on_floor(0, 0, 0));
     ASSERT_EQ(scan.size(), 720u);
     for (int k : {0, 1, 90, 359, 360, 719}) {
         EXPECT_NEAR(scan[k].azimuth, wrap_pi(deg_to_rad(0.5 * k)), 1e-15) << k;
@@ -55,7 +55,7 @@ TEST(BeamLayout, SphericalScannerKeepsTheUpperHalf) {
         EXPECT_GT(upper.elevations[i], 0.0);
     }
 
-    const Scan scan = Lidar(upper).scan(box_world(), Pose{0, 0, 0});
+    const Scan scan = Lidar(upper).scan(box_world(), Pose::on_floor(0, 0, 0));
     ASSERT_EQ(scan.size(), 8100u);
     // Beam index = row·180 + column; column j at azimuth 2j degrees.
     const auto& b = scan[44 * 180 + 45];
@@ -70,7 +70,7 @@ TEST(BeamLayout, AzimuthsAreAllocentricAndTurnWithHeading) {
     const World w = box_world();
     const Lidar lidar(LidarSpec::horizontal());
     for (double heading : {0.0, 0.7, -2.0, pi, 3.0 * pi}) {
-        const Scan scan = lidar.scan(w, Pose{1.0, -2.0, heading});
+        const Scan scan = lidar.scan(w, Pose::on_floor(1.0, -2.0, heading));
         ASSERT_EQ(scan.size(), 720u);
         for (int k : {0, 100, 500}) {
             const double expected = wrap_pi(heading + deg_to_rad(0.5 * k));
@@ -85,8 +85,8 @@ TEST(BeamLayout, AzimuthsAreAllocentricAndTurnWithHeading) {
         EXPECT_NEAR(scan[0].range, std::min(tx, ty), 1e-9) << heading;
     }
     // The same allocentric direction gives the same range whatever the heading.
-    const Scan a = lidar.scan(w, Pose{1.0, -2.0, 0.0});
-    const Scan b = lidar.scan(w, Pose{1.0, -2.0, deg_to_rad(90.0)});
+    const Scan a = lidar.scan(w, Pose::on_floor(1.0, -2.0, 0.0));
+    const Scan b = lidar.scan(w, Pose::on_floor(1.0, -2.0, deg_to_rad(90.0)));
     EXPECT_NEAR(a[180].range, b[0].range, 1e-12);
     EXPECT_NEAR(a[180].azimuth, b[0].azimuth, 1e-12);
 }
@@ -98,7 +98,7 @@ TEST(BeamLayout, GenericBeamTable) {
     for (int i = 0; i < 64; ++i) s.elevations.push_back(deg_to_rad(2.0 - i * 26.8 / 63));
     s.azimuth_count = 1024;
     s.height = 0.3;
-    const Scan scan = Lidar(s).scan(box_world(), Pose{0, 0, 0.5});
+    const Scan scan = Lidar(s).scan(box_world(), Pose::on_floor(0, 0, 0.5));
     ASSERT_EQ(scan.size(), 64u * 1024u);
     EXPECT_NEAR(scan[5 * 1024 + 256].elevation, s.elevations[5], 0);
     EXPECT_NEAR(scan[5 * 1024 + 256].azimuth, wrap_pi(0.5 + pi / 2), 1e-12);
@@ -108,13 +108,13 @@ TEST(BeamLayout, MaxRangeDropsFarBeamsAndRowMaskSelectsRows) {
     LidarSpec s = LidarSpec::spherical();
     s.max_range = 10.5;
     const World w = box_world();
-    const Scan scan = Lidar(s).scan(w, Pose{0, 0, 0});
+    const Scan scan = Lidar(s).scan(w, Pose::on_floor(0, 0, 0));
     for (const auto& r : scan) EXPECT_LE(r.range, 10.5);
     EXPECT_LT(scan.size(), 8100u);
     std::vector<char> rows(45, 0);
     rows[44] = 1;
     Scan one_row;
-    Lidar(LidarSpec::spherical()).scan(w, Pose{0, 0, 0}, one_row, {}, rows);
+    Lidar(LidarSpec::spherical()).scan(w, Pose::on_floor(0, 0, 0), one_row, {}, rows);
     ASSERT_EQ(one_row.size(), 180u);
     for (const auto& r : one_row) EXPECT_NEAR(rad_to_deg(r.elevation), 1.0, 1e-12);
 }
@@ -125,15 +125,15 @@ TEST(SensorNoise, SeededNoiseAndDropout) {
     s.dropout = 0.2;
     const World w = box_world();
     const Lidar lidar(s), clean(LidarSpec::horizontal());
-    const Scan a = lidar.scan(w, Pose{0, 0, 0}, NoiseKey{7, 3});
-    const Scan b = lidar.scan(w, Pose{0, 0, 0}, NoiseKey{7, 3});
-    const Scan c = lidar.scan(w, Pose{0, 0, 0}, NoiseKey{7, 4});
+    const Scan a = lidar.scan(w, Pose::on_floor(0, 0, 0), NoiseKey{7, 3});
+    const Scan b = lidar.scan(w, Pose::on_floor(0, 0, 0), NoiseKey{7, 3});
+    const Scan c = lidar.scan(w, Pose::on_floor(0, 0, 0), NoiseKey{7, 4});
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].range, b[i].range);
     EXPECT_NE(a.size() == c.size() && a[0].range == c[0].range, true);
     // About 20 % of the beams dropped, and range errors with sd ≈ 0.05 m.
     EXPECT_NEAR(static_cast<double>(a.size()) / 720.0, 0.8, 0.06);
-    const Scan exact = clean.scan(w, Pose{0, 0, 0});
+    const Scan exact = clean.scan(w, Pose::on_floor(0, 0, 0));
     double sum = 0, sum2 = 0;
     int n = 0;
     for (const auto& r : a) {
@@ -165,8 +165,8 @@ TEST(SensorSpec, RejectsImpossibleValues) {
 TEST(SensorSpec, RejectsPosesOutsideAnyWorld) {
     const World w = box_world();
     const Lidar lidar(LidarSpec::horizontal());
-    EXPECT_THROW(lidar.scan(w, Pose{NAN, 0, 0}), InputError);
-    EXPECT_THROW(lidar.scan(w, Pose{0, 0, INFINITY}), InputError);
-    EXPECT_THROW(lidar.scan(w, Pose{1e30, 0, 0}), InputError);
-    EXPECT_NO_THROW(lidar.scan(w, Pose{0, 0, 100.0}));  // a heading of many turns is fine
+    EXPECT_THROW(lidar.scan(w, Pose::on_floor(NAN, 0, 0)), InputError);
+    EXPECT_THROW(lidar.scan(w, Pose::on_floor(0, 0, INFINITY)), InputError);
+    EXPECT_THROW(lidar.scan(w, Pose::on_floor(1e30, 0, 0)), InputError);
+    EXPECT_NO_THROW(lidar.scan(w, Pose::on_floor(0, 0, 100.0)));  // a heading of many turns is fine
 }

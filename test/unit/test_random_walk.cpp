@@ -8,7 +8,7 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 
 using namespace bvc3d;
 
@@ -61,14 +61,14 @@ TEST_P(PaperWorldWalk, TwentyFourHoursNeverLeaveNorOverlap) {
     double worst = INFINITY;
     for (std::size_t i = 0; i < steps.size(); ++i) {
         const auto& s = steps[i];
-        ASSERT_LE(std::max(std::abs(s.x), std::abs(s.y)), 5.0 - R + 1e-9) << "left the arena at step " << i;
-        worst = std::min(worst, oracle_clearance(s.x, s.y, tilt));
+        ASSERT_LE(std::max(std::abs(s.pose.x), std::abs(s.pose.y)), 5.0 - R + 1e-9) << "left the arena at step " << i;
+        worst = std::min(worst, oracle_clearance(s.pose.x, s.pose.y, tilt));
         // Along the straight path from the previous step (a step moves at most 0.144 m).
-        if (i > 0 && steps[i - 1].heading == s.heading)
+        if (i > 0 && steps[i - 1].pose.heading == s.pose.heading)
             for (int k = 1; k < 15; ++k) {
                 const double f = k / 15.0;
-                worst = std::min(worst, oracle_clearance(steps[i - 1].x + f * (s.x - steps[i - 1].x),
-                                                         steps[i - 1].y + f * (s.y - steps[i - 1].y), tilt));
+                worst = std::min(worst, oracle_clearance(steps[i - 1].pose.x + f * (s.pose.x - steps[i - 1].pose.x),
+                                                         steps[i - 1].pose.y + f * (s.pose.y - steps[i - 1].pose.y), tilt));
             }
     }
     EXPECT_GE(worst, -1e-3) << "the body overlapped a wall by " << -worst << " m";
@@ -84,7 +84,7 @@ TEST_P(PaperWorldWalk, FourHoursCoverEveryReachableHalfMetreCell) {
     EXPECT_GT(steps.size(), 30000u);
     EXPECT_LT(steps.size(), 50000u);
     std::set<std::pair<int, int>> visited;
-    for (const auto& s : steps) visited.insert({static_cast<int>(std::floor(s.x / 0.5)), static_cast<int>(std::floor(s.y / 0.5))});
+    for (const auto& s : steps) visited.insert({static_cast<int>(std::floor(s.pose.x / 0.5)), static_cast<int>(std::floor(s.pose.y / 0.5))});
     // A cell is reachable if the body fits somewhere in it with 2 cm to spare (a sliver thinner than
     // that is visited only by grazing contacts, which a finite walk need not make).
     int reachable = 0;
@@ -111,14 +111,14 @@ TEST(RandomWalk, TurnsFollowTheirDistributions) {
     RandomWalk walk(body, RobotParams{}, rng, start);
     std::vector<TurnEvent> log;
     walk.log_turns(&log);
-    std::vector<WalkStep> steps;
+    std::vector<ModelStep> steps;
     while (auto s = walk.next(8 * 3600.0)) steps.push_back(*s);
 
     // Realised turns after tau_w uninterrupted steps, read off the trajectory: N(0, (pi/6)^2).
     std::vector<double> gaussian_turns;
     for (std::size_t i = 0; i + 1 < steps.size(); ++i)
-        if (!steps[i].bumped && steps[i + 1].heading != steps[i].heading)
-            gaussian_turns.push_back(wrap_pi(steps[i + 1].heading - steps[i].heading));
+        if (!steps[i].bumped && steps[i + 1].pose.heading != steps[i].pose.heading)
+            gaussian_turns.push_back(wrap_pi(steps[i + 1].pose.heading - steps[i].pose.heading));
     ASSERT_GT(gaussian_turns.size(), 5000u);
     const double d_gauss = ks_statistic(gaussian_turns, [](double x) { return normal_cdf(x, pi / 6); });
     EXPECT_LT(d_gauss, ks_critical_1pct(gaussian_turns.size()));
@@ -147,15 +147,15 @@ TEST(RandomWalk, SimulatedTimeCountsMotionAndTurns) {
         const auto &a = steps[i], &b = steps[i + 1];
         since_turn = a.bumped ? 0 : since_turn + 1;
         if (a.bumped || b.bumped) continue;
-        const bool turn = a.heading != b.heading;
-        const double expect = p.model_dt + std::abs(wrap_pi(b.heading - a.heading)) / p.turn_rate;
+        const bool turn = a.pose.heading != b.pose.heading;
+        const double expect = p.model_dt + std::abs(wrap_pi(b.pose.heading - a.pose.heading)) / p.turn_rate;
         // A turn comes exactly after n_walk uninterrupted steps, and its duration is |angle| / 2.1 rad/s.
         // (A turn that runs into a wall at once adds an unrecorded bump in between: rare.)
         if (std::abs((b.t - a.t) - expect) > 1e-9 || turn != (since_turn == p.n_walk)) {
             ++mismatched;
         } else {
             turned += turn;
-            EXPECT_NEAR(std::hypot(b.x - a.x, b.y - a.y), 0.144, 1e-12);
+            EXPECT_NEAR(std::hypot(b.pose.x - a.pose.x, b.pose.y - a.pose.y), 0.144, 1e-12);
         }
         if (turn) since_turn = 0;
     }
@@ -165,9 +165,9 @@ TEST(RandomWalk, SimulatedTimeCountsMotionAndTurns) {
     std::size_t bumps = 0;
     for (std::size_t i = 0; i + 1 < steps.size(); ++i) {
         const auto &a = steps[i], &b = steps[i + 1];
-        if (!b.bumped || a.bumped || a.heading != b.heading) continue;
+        if (!b.bumped || a.bumped || a.pose.heading != b.pose.heading) continue;
         ++bumps;
-        const double moved = std::hypot(b.x - a.x, b.y - a.y);
+        const double moved = std::hypot(b.pose.x - a.pose.x, b.pose.y - a.pose.y);
         EXPECT_GT(moved, 1e-3);
         EXPECT_LT(moved, 0.144);
         EXPECT_NEAR(b.t - a.t, moved / p.speed, 1e-9);
@@ -181,8 +181,8 @@ TEST(RandomWalk, StartsAtARandomCornerWithARandomHeading) {
     for (std::uint64_t seed = 0; seed < 40; ++seed) {
         const auto s = random_walk(world, 0.001, seed);
         ASSERT_FALSE(s.empty());
-        corners.insert({s[0].x > 0 ? 1 : -1, s[0].y > 0 ? 1 : -1});
-        EXPECT_LT(std::hypot(std::abs(s[0].x) - 4.0, std::abs(s[0].y) - 4.0), 0.15);
+        corners.insert({s[0].pose.x > 0 ? 1 : -1, s[0].pose.y > 0 ? 1 : -1});
+        EXPECT_LT(std::hypot(std::abs(s[0].pose.x) - 4.0, std::abs(s[0].pose.y) - 4.0), 0.15);
     }
     EXPECT_EQ(corners.size(), 4u);
 }
@@ -193,12 +193,12 @@ TEST(RandomWalk, SameSeedSameTrajectoryDifferentSeedDifferent) {
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
         ASSERT_EQ(a[i].t, b[i].t);
-        ASSERT_EQ(a[i].x, b[i].x);
-        ASSERT_EQ(a[i].y, b[i].y);
-        ASSERT_EQ(a[i].heading, b[i].heading);
+        ASSERT_EQ(a[i].pose.x, b[i].pose.x);
+        ASSERT_EQ(a[i].pose.y, b[i].pose.y);
+        ASSERT_EQ(a[i].pose.heading, b[i].pose.heading);
         ASSERT_EQ(a[i].bumped, b[i].bumped);
     }
-    EXPECT_TRUE(a.size() != c.size() || a[5].x != c[5].x);
+    EXPECT_TRUE(a.size() != c.size() || a[5].pose.x != c[5].pose.x);
 }
 
 TEST(RandomWalk, ResumesExactlyFromItsState) {
@@ -207,15 +207,21 @@ TEST(RandomWalk, ResumesExactlyFromItsState) {
     Rng rng(9, Stream::walk);
     const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
     RandomWalk full(body, RobotParams{}, rng, start), part(body, RobotParams{}, rng, start);
-    std::vector<WalkStep> a, b;
+    std::vector<ModelStep> a, b;
     while (auto s = full.next(1800)) a.push_back(*s);
     while (auto s = part.next(900)) b.push_back(*s);
-    const WalkState saved = part.state();
+    // Through the Agent interface's text state, as checkpoints save it.
+    const std::string saved = part.save_state();
     RandomWalk resumed(body, RobotParams{}, Rng(0, Stream::walk), Pose{});
-    resumed.restore(saved);
+    resumed.restore_state(saved);
     while (auto s = resumed.next(1800)) b.push_back(*s);
     ASSERT_EQ(a.size(), b.size());
-    for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i].x, b[i].x) << i;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        ASSERT_EQ(a[i].pose.x, b[i].pose.x) << i;
+        ASSERT_EQ(a[i].pose.heading, b[i].pose.heading) << i;
+        ASSERT_EQ(a[i].t, b[i].t) << i;
+    }
+    EXPECT_THROW(resumed.restore_state("trajectory 3"), InputError);
 }
 
 TEST(BodyCollider, ExactContactDistances) {
@@ -259,7 +265,7 @@ TEST(RandomWalk, NeverStartsInsideASolidObstacle) {
         const auto s = random_walk(world, 0.002, seed);
         ASSERT_FALSE(s.empty());
         // Outside the box's footprint grown by the body radius (the box spans |x|, |y| <= 1).
-        EXPECT_GT(std::max(std::abs(s[0].x), std::abs(s[0].y)), 1.0 + R - 1e-6) << "seed " << seed;
+        EXPECT_GT(std::max(std::abs(s[0].pose.x), std::abs(s[0].pose.y)), 1.0 + R - 1e-6) << "seed " << seed;
     }
     const BodyCollider body(box_world(), R, 0.1);
     EXPECT_TRUE(body.is_free(Vec2(0, 0)));  // far from every wall, yet inside the box:

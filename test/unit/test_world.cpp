@@ -121,7 +121,7 @@ TEST_P(CrossArenaRays, EveryBeamOfBothScannersMatchesTheAnalyticArena) {
     const World world = World::cross({.tilt_deg = tilt});
     const Lidar spherical(LidarSpec::spherical(false)), horizontal(LidarSpec::horizontal());
     int walls_seen = 0;
-    for (const Pose pose : {Pose{4, 4, 0.3}, Pose{-1.2, 0.7, 2.0}, Pose{1.0, -2.5, -1.0}, Pose{0.6, 4.6, 3.0}}) {
+    for (const Pose pose : {Pose::on_floor(4, 4, 0.3), Pose::on_floor(-1.2, 0.7, 2.0), Pose::on_floor(1.0, -2.5, -1.0), Pose::on_floor(0.6, 4.6, 3.0)}) {
         for (const Lidar* lidar : {&spherical, &horizontal}) {
             const Scan scan = lidar->scan(world, pose);
             ASSERT_EQ(scan.size(), lidar->spec().beam_count()) << "a closed arena returns every beam";

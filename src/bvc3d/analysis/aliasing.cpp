@@ -15,9 +15,11 @@ AliasingResult spatial_aliasing(const Eigen::Ref<const Centers>& centers, const 
     if (!(d_th >= 0) || !std::isfinite(d_th))
         throw InputError("d_th must be a finite distance >= 0, got " + std::to_string(d_th));
     if (maps.rows() != centers.rows())
-        throw InputError("maps must have one row per bin centre: " + std::to_string(maps.rows()) + " rows for " +
-                         std::to_string(centers.rows()) + " centres");
-    if (!centers.allFinite() || !maps.allFinite()) throw InputError("centres and maps must be finite");
+        throw InputError("maps must have one row per bin center: " + std::to_string(maps.rows()) + " rows for " +
+                         std::to_string(centers.rows()) + " centers");
+    if (centers.cols() < 1 || centers.cols() > 3)
+        throw InputError("centers must have 1 to 3 coordinates, got " + std::to_string(centers.cols()));
+    if (!centers.allFinite() || !maps.allFinite()) throw InputError("centers and maps must be finite");
 
     AliasingResult out;
     const Eigen::Index n_bins = maps.rows();
@@ -44,9 +46,13 @@ AliasingResult spatial_aliasing(const Eigen::Ref<const Centers>& centers, const 
         double all = 0;
         for (const int c : nz) all += ai(c) * total(c);
         double near = 0;
-        grid.for_each_candidate(centers(i, 0), centers(i, 1), [&](int j) {
-            const double dx = centers(i, 0) - centers(j, 0), dy = centers(i, 1) - centers(j, 1);
-            if (std::sqrt(dx * dx + dy * dy) > d_th) return;
+        grid.for_each_candidate(centers.row(i).data(), [&](int j) {
+            double d2 = 0;
+            for (Eigen::Index d = 0; d < centers.cols(); ++d) {
+                const double diff = centers(i, d) - centers(j, d);
+                d2 += diff * diff;
+            }
+            if (std::sqrt(d2) > d_th) return;
             const auto aj = unit.row(j);
             for (const int c : nz) near += ai(c) * aj(c);
         });

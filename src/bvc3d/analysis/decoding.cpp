@@ -101,20 +101,20 @@ DecodingTemplates parse_decoding_templates(std::string_view name) {
 }
 
 template <class T>
-DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, std::span<const double> y,
+DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& positions,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, DecodingTemplates templates,
                               double quantile) {
-    check_positions(x, y);
-    const std::size_t n = x.size();
+    check_positions(positions, grid.dims());
+    const std::size_t n = static_cast<std::size_t>(positions.rows());
     if (n < 2) throw InputError("decoding needs at least 2 samples, got " + std::to_string(n));
     check_values<T>(rates, n, "rates");
     if (!(quantile >= 0.0 && quantile <= 1.0))
         throw InputError("quantile must lie in [0, 1], got " + std::to_string(quantile));
     const std::size_t half = n / 2;
-    const HexBins first = bin_samples(grid, x.first(half), y.first(half));
+    const Bins first = bin_positions(grid, positions.topRows(static_cast<Eigen::Index>(half)));
     RowMatrixXd tmpl = bin_means<T>(first, rates.topRows(static_cast<Eigen::Index>(half)));
     // SPEC §8: the first half's rate maps (threshold, then per-cell max-normalisation).
-    if (templates == DecodingTemplates::rate_maps) threshold_and_normalise(tmpl, quantile);
+    if (templates == DecodingTemplates::rate_maps) threshold_and_normalize(tmpl, quantile);
     const RowMatrixXd unit = unit_rows(tmpl);  // score_b = t̂_b · r: r's norm does not change the best bin
     const auto second = rates.bottomRows(static_cast<Eigen::Index>(n - half));
     // The sparse path wins while the rates are sparse; a product in blocks runs ~4x faster per
@@ -131,9 +131,13 @@ DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, st
             ++out.n_undecoded;
             continue;
         }
-        const std::size_t s = half + i;
-        const double dx = x[s] - first.centers(best[i], 0), dy = y[s] - first.centers(best[i], 1);
-        errors.push_back(std::sqrt(dx * dx + dy * dy));
+        const auto s = static_cast<Eigen::Index>(half + i);
+        double d2 = 0;
+        for (Eigen::Index d = 0; d < positions.cols(); ++d) {
+            const double diff = positions(s, d) - first.centers(best[i], d);
+            d2 += diff * diff;
+        }
+        errors.push_back(std::sqrt(d2));
     }
     out.n_decoded = errors.size();
     if (!errors.empty()) {
@@ -148,13 +152,13 @@ DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, st
 template <class T>
 DecodingResult decoding_error(std::span<const double> x, std::span<const double> y,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, const DecodingParams& params) {
-    return decoding_error<T>(HexGrid::fit(x, y, params.gridsize, params.extent), x, y, rates, params.templates,
-                             params.quantile);
+    return decoding_error<T>(HexGrid::fit(x, y, params.gridsize, params.extent), positions_2d(x, y), rates,
+                             params.templates, params.quantile);
 }
 
-template DecodingResult decoding_error<float>(const HexGrid&, std::span<const double>, std::span<const double>,
+template DecodingResult decoding_error<float>(const Grid&, const Eigen::Ref<const Points>&,
                                               const Eigen::Ref<const RowMatrixXf>&, DecodingTemplates, double);
-template DecodingResult decoding_error<double>(const HexGrid&, std::span<const double>, std::span<const double>,
+template DecodingResult decoding_error<double>(const Grid&, const Eigen::Ref<const Points>&,
                                                const Eigen::Ref<const RowMatrixXd>&, DecodingTemplates, double);
 template DecodingResult decoding_error<float>(std::span<const double>, std::span<const double>,
                                               const Eigen::Ref<const RowMatrixXf>&, const DecodingParams&);

@@ -1,9 +1,9 @@
 #pragma once
-// Localisation error (SPEC §8): rate maps from the first half of the samples are the templates;
-// each sample of the second half is decoded to the bin whose template is most cosine-similar to
-// the sample's population vector, and the error is the distance from the sample's true position to
-// that bin's centre.
-// Takes: positions and rates (one row per sample). Gives: median and mean error in metres.
+// Localization error (docs/analysis.md): rate maps from the first half of the samples are the
+// templates; each sample of the second half is decoded to the bin whose template is most
+// cosine-similar to the sample's population vector, and the error is the distance from the
+// sample's true position to that bin's center.
+// Takes: positions (N × D, or x and y) and rates (one row per sample). Gives: median and mean error in meters.
 #include <cstddef>
 #include <limits>
 #include <optional>
@@ -50,9 +50,10 @@ template <class T>
 DecodingResult decoding_error(std::span<const double> x, std::span<const double> y,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, const DecodingParams& params = {});
 
-// The same decoder with a given grid (analyze_trial shares the rate maps' grid).
+// The same decoder on any grid (analyze_trial shares the rate maps' grid); positions have
+// grid.dims() columns and errors are Euclidean distances in that many dimensions.
 template <class T>
-DecodingResult decoding_error(const HexGrid& grid, std::span<const double> x, std::span<const double> y,
+DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& positions,
                               const Eigen::Ref<const RowMatrixX<T>>& rates, DecodingTemplates templates,
                               double quantile);
 

@@ -37,34 +37,12 @@ std::array<double, 2> nonsingular(double vmin, double vmax, double expander) {
     return {vmin, vmax};
 }
 
-void check_positions(std::span<const double> x, std::span<const double> y) {
-    if (x.size() != y.size())
-        throw InputError("x and y must have the same length, got " + std::to_string(x.size()) + " and " +
-                         std::to_string(y.size()));
-    for (std::size_t i = 0; i < x.size(); ++i)
-        if (!std::isfinite(x[i]) || !std::isfinite(y[i]))
-            throw InputError("positions must be finite: sample " + std::to_string(i) + " is (" +
-                             std::to_string(x[i]) + ", " + std::to_string(y[i]) + ")");
-}
-
-template <class T>
-void check_values(const Eigen::Ref<const RowMatrixX<T>>& values, std::size_t n, const char* what) {
-    if (static_cast<std::size_t>(values.rows()) != n)
-        throw InputError(std::string(what) + " must have one row per sample: " + std::to_string(values.rows()) +
-                         " rows for " + std::to_string(n) + " samples");
-    for (Eigen::Index i = 0; i < values.rows(); ++i)
-        for (Eigen::Index c = 0; c < values.cols(); ++c)
-            if (!std::isfinite(values(i, c)))
-                throw InputError(std::string(what) + " must be finite: row " + std::to_string(i) + ", column " +
-                                 std::to_string(c) + " is " + std::to_string(values(i, c)));
-}
-
 HexGrid HexGrid::fit(std::span<const double> x, std::span<const double> y, int gridsize,
                      const std::optional<Extent>& extent) {
     if (gridsize < 2)
         throw InputError("gridsize must be >= 2 (matplotlib's grid has int(gridsize / sqrt(3)) rows), got " +
                          std::to_string(gridsize));
-    check_positions(x, y);
+    check_positions(positions_2d(x, y));
     HexGrid g;
     g.nx = gridsize;
     g.ny = static_cast<int>(gridsize / std::sqrt(3.0));
@@ -127,54 +105,14 @@ std::array<double, 2> HexGrid::center(int bin) const {
 }
 
 HexBins bin_samples(const HexGrid& grid, std::span<const double> x, std::span<const double> y) {
-    check_positions(x, y);
     HexBins out;
+    static_cast<Bins&>(out) = bin_positions(grid, positions_2d(x, y));
     out.grid = grid;
-    const std::size_t n = x.size();
-    std::vector<int> flat(n);
-    std::vector<std::int64_t> count(static_cast<std::size_t>(grid.size()), 0);
-    for (std::size_t i = 0; i < n; ++i) {
-        flat[i] = grid.bin_of(x[i], y[i]);
-        if (flat[i] >= 0) ++count[static_cast<std::size_t>(flat[i])];
-    }
-    // Only visited bins exist (matplotlib turns empty bins into NaN and removes them).
-    std::vector<int> row_of(count.size(), -1);
-    for (int b = 0; b < grid.size(); ++b)
-        if (count[static_cast<std::size_t>(b)] > 0) {
-            row_of[static_cast<std::size_t>(b)] = static_cast<int>(out.bins.size());
-            out.bins.push_back(b);
-            out.counts.push_back(count[static_cast<std::size_t>(b)]);
-        }
-    out.centers.resize(static_cast<Eigen::Index>(out.bins.size()), 2);
-    for (std::size_t r = 0; r < out.bins.size(); ++r) {
-        const auto c = grid.center(out.bins[r]);
-        out.centers(static_cast<Eigen::Index>(r), 0) = c[0];
-        out.centers(static_cast<Eigen::Index>(r), 1) = c[1];
-    }
-    out.sample_bin.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-        out.sample_bin[i] = flat[i] < 0 ? -1 : row_of[static_cast<std::size_t>(flat[i])];
     return out;
 }
 
 HexBins hexbin(std::span<const double> x, std::span<const double> y, int gridsize, const std::optional<Extent>& extent) {
     return bin_samples(HexGrid::fit(x, y, gridsize, extent), x, y);
 }
-
-template <class T>
-RowMatrixXd bin_means(const HexBins& bins, const Eigen::Ref<const RowMatrixX<T>>& values) {
-    check_values<T>(values, bins.sample_bin.size(), "values");
-    RowMatrixXd sum = RowMatrixXd::Zero(bins.size(), values.cols());
-    for (std::size_t i = 0; i < bins.sample_bin.size(); ++i)
-        if (const int b = bins.sample_bin[i]; b >= 0)
-            sum.row(b) += values.row(static_cast<Eigen::Index>(i)).template cast<double>();
-    for (int b = 0; b < bins.size(); ++b) sum.row(b) /= static_cast<double>(bins.counts[static_cast<std::size_t>(b)]);
-    return sum;
-}
-
-template RowMatrixXd bin_means<float>(const HexBins&, const Eigen::Ref<const RowMatrixXf>&);
-template RowMatrixXd bin_means<double>(const HexBins&, const Eigen::Ref<const RowMatrixXd>&);
-template void check_values<float>(const Eigen::Ref<const RowMatrixXf>&, std::size_t, const char*);
-template void check_values<double>(const Eigen::Ref<const RowMatrixXd>&, std::size_t, const char*);
 
 }  // namespace bvc3d::analysis

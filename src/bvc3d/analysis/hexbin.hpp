@@ -1,6 +1,7 @@
 #pragma once
 // Hexagonal binning exactly as matplotlib 3.6.3's Axes.hexbin(x, y, C, gridsize, extent,
-// reduce_C_function=numpy.mean) does it (SPEC §8), for many value columns in one pass.
+// reduce_C_function=numpy.mean) does it (docs/analysis.md), for many value columns in one pass:
+// the 2-D Grid.
 // Takes: sample positions (x, y) and values (one row per sample). Gives: the visited bins in
 // matplotlib's order, their centres, sample counts and per-column means.
 #include <array>
@@ -9,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "bvc3d/analysis/types.hpp"
+#include "bvc3d/analysis/binning.hpp"
 
 namespace bvc3d::analysis {
 
@@ -20,7 +21,7 @@ std::array<double, 2> nonsingular(double vmin, double vmax, double expander);
 // (i·sx + xmin, j·sy + ymin); lattice 2 has nx·ny centres offset by half a step in x and y.
 // A flat bin index runs over lattice 1 (i·(ny+1) + j) and then lattice 2 (offset + i·ny + j):
 // matplotlib's order of bins.
-struct HexGrid {
+struct HexGrid : Grid {
     int nx = 0, ny = 0;         // nx = gridsize, ny = int(gridsize / sqrt(3))
     double xmin = 0, ymin = 0;  // lower-left lattice point (xmin includes matplotlib's padding)
     double sx = 0, sy = 0;      // lattice steps: hexagons are sx wide, rows sy apart
@@ -31,40 +32,32 @@ struct HexGrid {
     static HexGrid fit(std::span<const double> x, std::span<const double> y, int gridsize,
                        const std::optional<Extent>& extent = {});
 
-    int size() const { return (nx + 1) * (ny + 1) + nx * ny; }
+    int dims() const override { return 2; }
+    int size() const override { return (nx + 1) * (ny + 1) + nx * ny; }
     int lattice1_size() const { return (nx + 1) * (ny + 1); }
     // Flat index of the bin holding (x, y), -1 if that bin lies outside the grid (matplotlib drops
-    // such points). Nearest centre in the metric dx² + 3·dy² of lattice units; a tie goes to lattice 2.
+    // such points). Nearest center in the metric dx² + 3·dy² of lattice units; a tie goes to lattice 2.
     int bin_of(double x, double y) const;
+    int bin_of(const double* p) const override { return bin_of(p[0], p[1]); }
     std::array<double, 2> center(int bin) const;
-    // Area of one hexagon, m² when x, y are in metres: the two lattices tile each sx × sy cell twice.
+    void center(int bin, double* out) const override {
+        const auto c = center(bin);
+        out[0] = c[0];
+        out[1] = c[1];
+    }
+    // Area of one hexagon, m² when x, y are in meters: the two lattices tile each sx × sy cell twice.
     double bin_area() const { return 0.5 * sx * sy; }
+    double bin_measure() const override { return bin_area(); }
 };
 
-// Samples assigned to the visited bins of a grid.
-struct HexBins {
+// Samples in the visited bins of a hexagonal grid.
+struct HexBins : Bins {
     HexGrid grid;
-    std::vector<int> bins;              // flat grid index of each visited bin, ascending
-    Centers centers;                    // centre of each visited bin
-    std::vector<std::int64_t> counts;   // samples in each visited bin
-    std::vector<int> sample_bin;        // per sample: row in `bins`, or -1 outside the grid
-    int size() const { return static_cast<int>(bins.size()); }
 };
 
 // Coordinates must have equal lengths and be finite (InputError otherwise).
 HexBins bin_samples(const HexGrid& grid, std::span<const double> x, std::span<const double> y);
 HexBins hexbin(std::span<const double> x, std::span<const double> y, int gridsize = 50,
                const std::optional<Extent>& extent = {});
-
-// Per visited bin, the mean of each column of `values` (one row per sample, finite) over the
-// bin's samples: numpy.mean for every column at once, summed in double.
-template <class T>
-RowMatrixXd bin_means(const HexBins& bins, const Eigen::Ref<const RowMatrixX<T>>& values);
-
-// Throws InputError unless x and y have equal lengths and finite entries.
-void check_positions(std::span<const double> x, std::span<const double> y);
-// Throws InputError unless `values` has `n` rows and only finite entries.
-template <class T>
-void check_values(const Eigen::Ref<const RowMatrixX<T>>& values, std::size_t n, const char* what);
 
 }  // namespace bvc3d::analysis

@@ -11,7 +11,15 @@ namespace bvc3d::analysis {
 
 namespace {
 
-using P = std::array<double, 2>;
+constexpr int max_dims = 16;
+
+// Points of up to max_dims dimensions, row-major.
+struct PointSet {
+    int dims = 2;
+    std::vector<double> coords;
+    std::size_t size() const { return dims ? coords.size() / static_cast<std::size_t>(dims) : 0; }
+    const double* operator[](std::size_t i) const { return coords.data() + i * static_cast<std::size_t>(dims); }
+};
 
 // scikit-learn's KDTree (sklearn/neighbors/_binary_tree.pxi, _kd_tree.pyx) restricted to what
 // query_radius(X, r) needs with the Euclidean metric. The tree has 2^levels − 1 nodes; a node is
@@ -20,7 +28,7 @@ using P = std::array<double, 2>;
 // sklearn's (the order inside a node differs, which no result depends on).
 class SklearnKdTree {
 public:
-    explicit SklearnKdTree(const std::vector<P>& pts, int leaf_size = 30) : pts_(pts), idx_(pts.size()) {
+    explicit SklearnKdTree(const PointSet& pts, int leaf_size = 30) : pts_(pts), idx_(pts.size()) {
         const auto n = static_cast<double>(pts.size());
         const int levels = static_cast<int>(std::log2(std::fmax(1.0, (n - 1) / leaf_size)) + 1);
         nodes_.resize((std::size_t{1} << levels) - 1);
@@ -29,7 +37,7 @@ public:
     }
 
     // Appends the indices of the points within r of pt, as _query_radius_single selects them.
-    void query_radius(const P& pt, double r, std::vector<int>& out) const {
+    void query_radius(const double* pt, double r, std::vector<int>& out) const {
         Query q{pt, r, r * r, exponent_, 1. / exponent_, out};
         visit(0, q);
     }
@@ -38,22 +46,23 @@ private:
     struct Node {
         int start = 0, end = 0;
         bool leaf = true;
-        P lo{}, hi{};
+        std::vector<double> lo, hi;  // bounding box
     };
     struct Query {
-        const P& pt;
+        const double* pt;
         double r, reduced_r, p, inv_p;
         std::vector<int>& out;
     };
 
     void build(std::size_t i, int start, int end) {
+        const int D = pts_.dims;
         Node& nd = nodes_[i];
         nd.start = start;
         nd.end = end;
-        nd.lo = {INFINITY, INFINITY};
-        nd.hi = {-INFINITY, -INFINITY};
+        nd.lo.assign(D, INFINITY);
+        nd.hi.assign(D, -INFINITY);
         for (int k = start; k < end; ++k)
-            for (int j = 0; j < 2; ++j) {
+            for (int j = 0; j < D; ++j) {
                 nd.lo[j] = std::fmin(nd.lo[j], pts_[static_cast<std::size_t>(idx_[k])][j]);
                 nd.hi[j] = std::fmax(nd.hi[j], pts_[static_cast<std::size_t>(idx_[k])][j]);
             }
@@ -62,7 +71,7 @@ private:
         // find_node_split_dim: first dimension with the strictly largest spread.
         int dim = 0;
         double max_spread = 0;
-        for (int j = 0; j < 2; ++j)
+        for (int j = 0; j < D; ++j)
             if (nd.hi[j] - nd.lo[j] > max_spread) {
                 max_spread = nd.hi[j] - nd.lo[j];
                 dim = j;
@@ -80,18 +89,19 @@ private:
     // differently in about 1 case in 1000, and sklearn's decisions follow pow). Most nodes are
     // decided by the cheap bounds; pow runs only within a relative 1e-9 of the radius.
     bool node_beyond(const Node& nd, const Query& q, bool upper) const {
+        const int D = pts_.dims;
         double fast = 0, exact = 0;
-        std::array<double, 2> t{};
-        for (int j = 0; j < 2; ++j) {
+        double tv[max_dims];
+        for (int j = 0; j < D; ++j) {
             const double d_lo = nd.lo[j] - q.pt[j], d_hi = q.pt[j] - nd.hi[j];
-            t[j] = upper ? std::fmax(std::fabs(d_lo), std::fabs(d_hi))
-                         : 0.5 * ((d_lo + std::fabs(d_lo)) + (d_hi + std::fabs(d_hi)));
-            fast += t[j] * t[j];
+            tv[j] = upper ? std::fmax(std::fabs(d_lo), std::fabs(d_hi))
+                          : 0.5 * ((d_lo + std::fabs(d_lo)) + (d_hi + std::fabs(d_hi)));
+            fast += tv[j] * tv[j];
         }
         fast = std::sqrt(fast);
         if (fast > q.r * (1 + 1e-9)) return true;
         if (fast < q.r * (1 - 1e-9)) return false;
-        for (int j = 0; j < 2; ++j) exact += std::pow(t[j], q.p);
+        for (int j = 0; j < D; ++j) exact += std::pow(tv[j], q.p);
         return std::pow(exact, q.inv_p) > q.r;
     }
 
@@ -104,9 +114,13 @@ private:
         }
         if (nd.leaf) {  // case 3: euclidean_rdist(pt, x) <= r*r, point by point
             for (int k = nd.start; k < nd.end; ++k) {
-                const P& x = pts_[static_cast<std::size_t>(idx_[k])];
-                const double t0 = q.pt[0] - x[0], t1 = q.pt[1] - x[1];
-                if (t0 * t0 + t1 * t1 <= q.reduced_r) q.out.push_back(idx_[k]);
+                const double* x = pts_[static_cast<std::size_t>(idx_[k])];
+                double rdist = 0;
+                for (int j = 0; j < pts_.dims; ++j) {
+                    const double t = q.pt[j] - x[j];
+                    rdist += t * t;
+                }
+                if (rdist <= q.reduced_r) q.out.push_back(idx_[k]);
             }
             return;
         }
@@ -114,23 +128,29 @@ private:
         visit(2 * i + 2, q);
     }
 
-    const std::vector<P>& pts_;
+    const PointSet& pts_;
     std::vector<int> idx_;
     std::vector<Node> nodes_;
     // The Minkowski exponent, read at run time so that the compiler cannot turn pow(x, 2) into x*x.
     static inline volatile double exponent_ = 2.0;
 };
 
-// scikit-learn's brute-force radius neighbours for float64 Euclidean data (EuclideanRadiusNeighbors64
+// scikit-learn's brute-force radius neighbors for float64 Euclidean data (EuclideanRadiusNeighbors64
 // with reference BLAS): |x_i|² + (−2·x_i·x_j) + |x_j|², clipped at 0, compared with eps².
-Neighborhoods brute_neighbors(const std::vector<P>& pts, double eps) {
+Neighborhoods brute_neighbors(const PointSet& pts, double eps) {
     Neighborhoods nb;
     const double rr = eps * eps;
+    const int D = pts.dims;
+    auto dot = [&](const double* a, const double* b) {
+        double s = 0;
+        for (int j = 0; j < D; ++j) s += a[j] * b[j];
+        return s;
+    };
     std::vector<double> norm(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) norm[i] = pts[i][0] * pts[i][0] + pts[i][1] * pts[i][1];
+    for (std::size_t i = 0; i < pts.size(); ++i) norm[i] = dot(pts[i], pts[i]);
     for (std::size_t i = 0; i < pts.size(); ++i) {
         for (std::size_t j = 0; j < pts.size(); ++j) {
-            const double middle = -2.0 * (pts[i][0] * pts[j][0] + pts[i][1] * pts[j][1]);
+            const double middle = -2.0 * dot(pts[i], pts[j]);
             if (std::max(norm[i] + middle + norm[j], 0.0) <= rr) nb.indices.push_back(static_cast<int>(j));
         }
         nb.offsets.push_back(static_cast<int>(nb.indices.size()));
@@ -138,28 +158,28 @@ Neighborhoods brute_neighbors(const std::vector<P>& pts, double eps) {
     return nb;
 }
 
-Neighborhoods neighbors(const std::vector<P>& pts, double eps) {
+Neighborhoods neighbors(const PointSet& pts, double eps) {
     // NearestNeighbors' default n_neighbors = 5 makes 'auto' choose brute force when 5 >= n // 2.
     if (pts.size() / 2 <= 5) return brute_neighbors(pts, eps);
     Neighborhoods nb;
     const SklearnKdTree tree(pts);
-    for (const P& p : pts) {
-        tree.query_radius(p, eps, nb.indices);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        tree.query_radius(pts[i], eps, nb.indices);
         nb.offsets.push_back(static_cast<int>(nb.indices.size()));
     }
     return nb;
 }
 
-int cluster_count(const std::vector<P>& pts, const DbscanParams& params) {
-    // A core point needs min_samples neighbours (itself included): none with fewer points.
-    if (pts.size() < static_cast<std::size_t>(params.min_samples) || pts.empty()) return 0;
+int cluster_count(const PointSet& pts, const DbscanParams& params) {
+    // A core point needs min_samples neighbors (itself included): none with fewer points.
+    if (pts.size() < static_cast<std::size_t>(params.min_samples) || pts.size() == 0) return 0;
     const Neighborhoods nb = neighbors(pts, params.eps);
     const std::size_t n = pts.size();
     std::vector<char> core(n);
     for (std::size_t i = 0; i < n; ++i) core[i] = nb.offsets[i + 1] - nb.offsets[i] >= params.min_samples;
-    // sklearn's dbscan_inner. Its neighbourhoods need not be symmetric (see the KD-tree), so the
-    // count follows the same expansion: a new cluster at each unlabelled core point in index order,
-    // grown through the neighbourhoods of core points only.
+    // sklearn's dbscan_inner. Its neighborhoods need not be symmetric (see the KD-tree), so the
+    // count follows the same expansion: a new cluster at each unlabeled core point in index order,
+    // grown through the neighborhoods of core points only.
     std::vector<char> labelled(n, 0);
     std::vector<int> stack;
     int clusters = 0;
@@ -181,15 +201,20 @@ int cluster_count(const std::vector<P>& pts, const DbscanParams& params) {
     return clusters;
 }
 
-void check_points(const Eigen::Ref<const Centers>& points) {
+void check_points(const Eigen::Ref<const Points>& points) {
+    if (points.cols() < 1 || points.cols() > max_dims)
+        throw InputError("points need 1 to " + std::to_string(max_dims) + " coordinates, got " +
+                         std::to_string(points.cols()));
     for (Eigen::Index i = 0; i < points.rows(); ++i)
-        if (!std::isfinite(points(i, 0)) || !std::isfinite(points(i, 1)))
-            throw InputError("points must be finite: row " + std::to_string(i) + " is not");
+        if (!points.row(i).allFinite()) throw InputError("points must be finite: row " + std::to_string(i) + " is not");
 }
 
-std::vector<P> to_points(const Eigen::Ref<const Centers>& points) {
-    std::vector<P> pts(static_cast<std::size_t>(points.rows()));
-    for (Eigen::Index i = 0; i < points.rows(); ++i) pts[static_cast<std::size_t>(i)] = {points(i, 0), points(i, 1)};
+PointSet to_points(const Eigen::Ref<const Points>& points) {
+    PointSet pts;
+    pts.dims = static_cast<int>(points.cols());
+    pts.coords.reserve(static_cast<std::size_t>(points.size()));
+    for (Eigen::Index i = 0; i < points.rows(); ++i)
+        for (Eigen::Index d = 0; d < points.cols(); ++d) pts.coords.push_back(points(i, d));
     return pts;
 }
 
@@ -217,15 +242,17 @@ std::vector<int> modality(const Eigen::Ref<const Centers>& centers, const Eigen:
     params.validate();
     check_points(centers);
     if (maps.rows() != centers.rows())
-        throw InputError("maps must have one row per bin centre: " + std::to_string(maps.rows()) + " rows for " +
-                         std::to_string(centers.rows()) + " centres");
+        throw InputError("maps must have one row per bin center: " + std::to_string(maps.rows()) + " rows for " +
+                         std::to_string(centers.rows()) + " centers");
     std::vector<int> mi(static_cast<std::size_t>(maps.cols()));
-    std::vector<P> pts;
+    PointSet pts;
+    pts.dims = static_cast<int>(centers.cols());
     for (Eigen::Index c = 0; c < maps.cols(); ++c) {
-        pts.clear();
+        pts.coords.clear();
         for (Eigen::Index b = 0; b < maps.rows(); ++b) {
             if (std::isnan(maps(b, c))) throw InputError("maps must not contain NaN (column " + std::to_string(c) + ")");
-            if (maps(b, c) > 0) pts.push_back({centers(b, 0), centers(b, 1)});
+            if (maps(b, c) > 0)
+                for (Eigen::Index d = 0; d < centers.cols(); ++d) pts.coords.push_back(centers(b, d));
         }
         mi[static_cast<std::size_t>(c)] = cluster_count(pts, params);
     }

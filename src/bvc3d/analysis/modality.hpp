@@ -1,7 +1,8 @@
 #pragma once
-// Modality index (SPEC §8): per cell, the number of clusters DBSCAN(eps, min_samples) finds among
-// the centres of the bins where the cell's map is > 0, exactly as scikit-learn 1.2.1 finds them.
-// Takes: bin centres and rate maps (bins × cells). Gives: one cluster count per cell and the
+// Modality index (docs/analysis.md): per cell, the number of clusters DBSCAN(eps, min_samples)
+// finds among the centers of the bins where the cell's map is > 0, exactly as scikit-learn 1.2.1
+// finds them, in any dimension.
+// Takes: bin centers (N × D) and rate maps (bins × cells). Gives: one cluster count per cell and the
 // paper's three summary figures.
 #include <limits>
 #include <span>

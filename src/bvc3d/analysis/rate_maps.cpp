@@ -40,7 +40,7 @@ double percentile_linear(std::span<double> v, double percent) {
     return gamma >= 0.5 ? b - d * (1 - gamma) : a + d * gamma;
 }
 
-void threshold_and_normalise(RowMatrixXd& maps, double quantile) {
+void threshold_and_normalize(RowMatrixXd& maps, double quantile) {
     check_quantile(quantile);
     if (maps.rows() == 0) return;
     const double percent = 100 * quantile;
@@ -67,17 +67,30 @@ void RateMapParams::validate() const {
 }
 
 template <class T>
-RateMaps rate_maps(std::span<const double> x, std::span<const double> y, const Eigen::Ref<const RowMatrixX<T>>& rates,
-                   const RateMapParams& params) {
-    params.validate();
+RateMaps rate_maps(std::shared_ptr<const Grid> grid, const Eigen::Ref<const Points>& positions,
+                   const Eigen::Ref<const RowMatrixX<T>>& rates, double quantile) {
+    check_quantile(quantile);
     RateMaps out;
-    out.bins = hexbin(x, y, params.gridsize, params.extent);
+    out.bins = bin_positions(*grid, positions);
+    out.grid = std::move(grid);
     out.mean = bin_means<T>(out.bins, rates);
     out.map = out.mean;
-    threshold_and_normalise(out.map, params.quantile);
+    threshold_and_normalize(out.map, quantile);
     return out;
 }
 
+template <class T>
+RateMaps rate_maps(std::span<const double> x, std::span<const double> y, const Eigen::Ref<const RowMatrixX<T>>& rates,
+                   const RateMapParams& params) {
+    params.validate();
+    return rate_maps<T>(std::make_shared<HexGrid>(HexGrid::fit(x, y, params.gridsize, params.extent)), positions_2d(x, y),
+                        rates, params.quantile);
+}
+
+template RateMaps rate_maps<float>(std::shared_ptr<const Grid>, const Eigen::Ref<const Points>&,
+                                   const Eigen::Ref<const RowMatrixXf>&, double);
+template RateMaps rate_maps<double>(std::shared_ptr<const Grid>, const Eigen::Ref<const Points>&,
+                                    const Eigen::Ref<const RowMatrixXd>&, double);
 template RateMaps rate_maps<float>(std::span<const double>, std::span<const double>, const Eigen::Ref<const RowMatrixXf>&,
                                    const RateMapParams&);
 template RateMaps rate_maps<double>(std::span<const double>, std::span<const double>,

@@ -7,32 +7,72 @@
 
 namespace bvc3d::analysis {
 
+const params::Table<AnalysisParams>& AnalysisParams::table() {
+    using namespace params;
+    using A = AnalysisParams;
+    static const Table<A> t(
+        "analysis",
+        {integer("gridsize", &A::gridsize, closed(2, 2000), "hexagons across x (matplotlib's gridsize)"),
+         real("quantile", &A::quantile, closed(0, 1), "rate-map threshold: values below this quantile become 0"),
+         Field<A>{"eps", "m, DBSCAN neighborhood radius", Kind::real, open_closed(0, 1e6), {}, false, 0, 0,
+                  [](const A& a) { return Value(a.dbscan.eps); },
+                  [](A& a, const Value& v) { a.dbscan.eps = std::get<double>(v); }},
+         Field<A>{"min_samples", "DBSCAN neighbors (the point included) of a core point", Kind::integer,
+                  closed(1, 1e9), {}, false, 0, 0,
+                  [](const A& a) { return Value(static_cast<long long>(a.dbscan.min_samples)); },
+                  [](A& a, const Value& v) { a.dbscan.min_samples = static_cast<int>(std::get<long long>(v)); }},
+         real("d_th", &A::d_th, closed(0, 1e6), "m, bins nearer than this do not count as aliased"),
+         choice("decoding_templates", &A::decoding_templates,
+                {{DecodingTemplates::rate_maps, "rate_maps"}, {DecodingTemplates::means, "means"}},
+                "rate_maps (thresholded, normalized maps of the first half) or means (raw mean rates)")});
+    return t;
+}
+
 void AnalysisParams::validate() const {
-    RateMapParams{gridsize, quantile, extent}.validate();
-    dbscan.validate();
-    if (!(d_th >= 0) || !std::isfinite(d_th))
-        throw InputError("d_th must be a finite distance >= 0, got " + std::to_string(d_th));
+    table().check(*this);
+    if (extent) extent->validate();
+}
+
+std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, const AnalysisParams& params) {
+    if (positions.cols() != 2)
+        throw InputError("positions with " + std::to_string(positions.cols()) +
+                         " coordinates: only 2-D (hexagonal) binning is available");
+    const Eigen::VectorXd x = positions.col(0), y = positions.col(1);
+    return std::make_shared<HexGrid>(HexGrid::fit({x.data(), static_cast<std::size_t>(x.size())},
+                                                  {y.data(), static_cast<std::size_t>(y.size())}, params.gridsize,
+                                                  params.extent));
 }
 
 template <class T>
-TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
-                           const Eigen::Ref<const RowMatrixX<T>>& rates, const AnalysisParams& params) {
+TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eigen::Ref<const RowMatrixX<T>>& rates,
+                           const AnalysisParams& params) {
     params.validate();
     TrialMetrics m;
-    m.maps = rate_maps<T>(x, y, rates, {params.gridsize, params.quantile, params.extent});
+    m.maps = rate_maps<T>(fit_grid(positions, params), positions, rates, params.quantile);
     m.modality = modality(m.maps.bins.centers, m.maps.map, params.dbscan);
     m.modality_summary = summarize_modality(m.modality);
     m.aliasing = spatial_aliasing(m.maps.bins.centers, m.maps.map, params.d_th);
-    if (x.size() >= 2) {
-        m.decoding = decoding_error<T>(m.maps.bins.grid, x, y, rates, params.decoding_templates, params.quantile);
+    const auto n = static_cast<std::size_t>(positions.rows());
+    if (n >= 2) {
+        m.decoding = decoding_error<T>(*m.maps.grid, positions, rates, params.decoding_templates, params.quantile);
     } else {  // nothing to build templates from: every second-half sample (n - n/2) is undecoded
         m.decoding.n_decoded = 0;
-        m.decoding.n_undecoded = x.size() - x.size() / 2;
+        m.decoding.n_undecoded = n - n / 2;
     }
     m.cells = cell_stats(m.maps);
     return m;
 }
 
+template <class T>
+TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
+                           const Eigen::Ref<const RowMatrixX<T>>& rates, const AnalysisParams& params) {
+    return analyze_trial<T>(positions_2d(x, y), rates, params);
+}
+
+template TrialMetrics analyze_trial<float>(const Eigen::Ref<const Points>&, const Eigen::Ref<const RowMatrixXf>&,
+                                           const AnalysisParams&);
+template TrialMetrics analyze_trial<double>(const Eigen::Ref<const Points>&, const Eigen::Ref<const RowMatrixXd>&,
+                                            const AnalysisParams&);
 template TrialMetrics analyze_trial<float>(std::span<const double>, std::span<const double>,
                                            const Eigen::Ref<const RowMatrixXf>&, const AnalysisParams&);
 template TrialMetrics analyze_trial<double>(std::span<const double>, std::span<const double>,

@@ -1,9 +1,10 @@
 #pragma once
-// Everything SPEC §8 reports for one trial, from its recorded arrays: the entry point for the
-// experiment stage and `bvc3d analyze`.
-// Takes: positions (x, y) and place-cell rates (samples × cells, float32 as recorded).
-// Gives: rate maps, modality per cell and its summary, SAI per bin and MSAI, localisation error,
-// per-cell statistics.
+// Everything the analysis reports for one trial (docs/analysis.md), from its recorded arrays: the
+// entry point for the experiment stage and `bvc3d analyze`.
+// Takes: positions (N × D: x, y for ground agents) and place-cell rates (samples × cells, float32
+// as recorded). Gives: rate maps, modality per cell and its summary, SAI per bin and MSAI,
+// localization error, per-cell statistics; metrics.hpp names the scalar metrics.
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "bvc3d/analysis/decoding.hpp"
 #include "bvc3d/analysis/modality.hpp"
 #include "bvc3d/analysis/rate_maps.hpp"
+#include "bvc3d/core/params.hpp"
 
 namespace bvc3d::analysis {
 
@@ -22,7 +24,11 @@ struct AnalysisParams {
     DbscanParams dbscan;           // eps 1.0 m, min_samples 20
     double d_th = 2.0;             // m, SAI exclusion radius
     std::optional<Extent> extent;  // default: the trial's own trajectory; the arena's for a fixed grid
-    DecodingTemplates decoding_templates = DecodingTemplates::rate_maps;  // SPEC §8: the rate maps
+    DecodingTemplates decoding_templates = DecodingTemplates::rate_maps;  // the paper's: the rate maps
+
+    // The keys (extent aside, which is a rectangle): gridsize, quantile, eps, min_samples, d_th,
+    // decoding_templates.
+    static const params::Table<AnalysisParams>& table();
     void validate() const;
 };
 
@@ -35,8 +41,15 @@ struct TrialMetrics {
     CellStats cells;
 };
 
+// The grid a trial's positions are binned on: hexagons for 2-D positions (gridsize, extent).
+// 3-D positions need a voxel grid, which arrives with flying agents (InputError until then).
+std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, const AnalysisParams& params);
+
 // Any number of samples: with none the maps have no bins (MI 0 for every cell, MSAI NaN); with
 // fewer than 2 nothing is decoded (NaN errors, n_undecoded = the second half's n − n/2 samples).
+template <class T>
+TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eigen::Ref<const RowMatrixX<T>>& rates,
+                           const AnalysisParams& params = {});
 template <class T>
 TrialMetrics analyze_trial(std::span<const double> x, std::span<const double> y,
                            const Eigen::Ref<const RowMatrixX<T>>& rates, const AnalysisParams& params = {});

@@ -1,6 +1,7 @@
 #pragma once
 // Array types shared by the analysis stage. Samples are rows: a trial's rates are n_samples × n_cells,
 // a rate map is n_bins × n_cells (row b = the population vector of bin b), as numpy lays them out.
+// Positions and bin centers are rows of D coordinates (D = 2 for ground agents, 3 for flying ones).
 #include <Eigen/Core>
 
 namespace bvc3d::analysis {
@@ -10,8 +11,9 @@ using RowMatrixX = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMa
 using RowMatrixXd = RowMatrixX<double>;
 using RowMatrixXf = RowMatrixX<float>;
 
-// Bin centres, one (x, y) row per bin.
-using Centers = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
+// Positions or bin centers: one row of D coordinates (x, y[, z]) per sample or bin.
+using Points = RowMatrixXd;
+using Centers = Points;
 
 // The rectangle a hexagonal grid covers (matplotlib's `extent`).
 struct Extent {

@@ -28,47 +28,37 @@ double gauss_norm(double sigma) { return 1.0 / std::sqrt(two_pi * sigma * sigma)
 
 }  // namespace
 
+const params::Table<BvcParams>& BvcParams::table() {
+    using namespace params;
+    static const Table<BvcParams> t(
+        "BVC layer",
+        {reals("elevations", &BvcParams::elevations, closed(-pi / 2, pi / 2),
+               "rad, the layers' preferred elevations; [] is the 2-D model")
+             .in_radians()
+             .sizes(0, 1024),
+         integer("n_dir", &BvcParams::n_dir, closed(1, 4096), "preferred azimuths, 2π/n_dir apart"),
+         integer("n_per_axis", &BvcParams::n_per_axis, closed(1, 100000), "preferred distances per direction"),
+         real("max_dist", &BvcParams::max_dist, above(0), "m, the largest preferred distance"),
+         real("sigma_r", &BvcParams::sigma_r, above(0), "m, distance tuning width"),
+         real("sigma_theta", &BvcParams::sigma_theta, above(0), "rad, azimuth tuning width"),
+         real("sigma_phi", &BvcParams::sigma_phi, above(0), "rad, elevation tuning width"),
+         choice("normalization", &BvcParams::normalization,
+                {{BvcNormalization::per_step_max, "per_step_max"},
+                 {BvcNormalization::none, "none"},
+                 {BvcNormalization::fixed, "fixed"}},
+                "per_step_max: raw / (2·max raw); none; fixed: raw / norm_constant"),
+         real("norm_constant", &BvcParams::norm_constant, above(0), "the divisor of `fixed` normalization"),
+         choice("reading", &BvcParams::reading,
+                {{BvcReading::gaussian, "gaussian"}, {BvcReading::nearest_beam, "nearest_beam"}},
+                "gaussian (the paper's equations) or nearest_beam (one return per direction, 2-D only)")});
+    return t;
+}
+
 void BvcParams::validate() const {
-    auto fail = [](const std::string& what) { throw InputError("BVC layer: " + what); };
-    for (double e : elevations)
-        if (!std::isfinite(e) || std::abs(e) > pi / 2) fail("every elevation must be finite and within ±π/2 rad");
-    if (n_dir < 1 || n_dir > 4096) fail("n_dir must be in [1, 4096]");
-    if (n_per_axis < 1 || n_per_axis > 100000) fail("n_per_axis must be in [1, 100000]");
-    if (elevations.size() > 1024) fail("at most 1024 elevation layers");
-    if (!std::isfinite(max_dist) || max_dist < 0 || (n_per_axis > 1 && max_dist == 0))
-        fail("max_dist must be > 0");
-    if (!std::isfinite(sigma_r) || sigma_r <= 0) fail("sigma_r must be > 0");
-    if (!std::isfinite(sigma_theta) || sigma_theta <= 0) fail("sigma_theta must be > 0");
-    if (!std::isfinite(sigma_phi) || sigma_phi <= 0) fail("sigma_phi must be > 0");
-    if (normalization == BvcNormalization::fixed && !(std::isfinite(norm_constant) && norm_constant > 0))
-        fail("norm_constant must be > 0 for fixed normalisation");
+    table().check(*this);
     if (reading == BvcReading::nearest_beam && !elevations.empty())
-        fail("the nearest_beam reading is a 2-D model: it takes no elevations");
+        table().fail("reading", "cannot be nearest_beam with elevation layers (the nearest_beam reading is a 2-D model)");
 }
-
-BvcNormalization parse_bvc_normalization(const std::string& name) {
-    if (name == "per_step_max") return BvcNormalization::per_step_max;
-    if (name == "none") return BvcNormalization::none;
-    if (name == "fixed") return BvcNormalization::fixed;
-    throw InputError("normalization '" + name + "' is not one of per_step_max, none, fixed");
-}
-
-std::string to_string(BvcNormalization n) {
-    switch (n) {
-        case BvcNormalization::per_step_max: return "per_step_max";
-        case BvcNormalization::none: return "none";
-        case BvcNormalization::fixed: return "fixed";
-    }
-    return "?";
-}
-
-BvcReading parse_bvc_reading(const std::string& name) {
-    if (name == "gaussian") return BvcReading::gaussian;
-    if (name == "nearest_beam") return BvcReading::nearest_beam;
-    throw InputError("reading '" + name + "' is not one of gaussian, nearest_beam");
-}
-
-std::string to_string(BvcReading r) { return r == BvcReading::gaussian ? "gaussian" : "nearest_beam"; }
 
 BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params)) {
     p_.validate();
@@ -99,6 +89,8 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     cache_count_.assign(cache_slots, 0);
     cache_dir_.assign(cache_slots * p_.n_dir, 0);
     cache_weight_.assign(cache_slots * p_.n_dir, 0.0);
+    direct_dir_.assign(p_.n_dir, 0);
+    direct_weight_.assign(p_.n_dir, 0.0);
 }
 
 void BoundaryVectorLayer::check_return(const LidarReturn& r, std::size_t index) {
@@ -137,7 +129,8 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
     std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
     std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
-    std::size_t valid = 0;
+    std::size_t valid = 0, lookups = 0, misses = 0;
+    const bool use_memo = memo_useful_ || ++memo_probe_ % 16 == 0;
     double last_phi = NAN;
     bool any_kept = true, any_dropped = false, skipped_row = false;
 
@@ -167,10 +160,23 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
         ++valid;
         if (!any_kept && !any_dropped) continue;
-        const std::size_t slot = angular(wrap_pi(ret.azimuth));  // any azimuth, however many turns
-        const int* dir = cache_dir_.data() + slot * K;
-        const double* ang = cache_weight_.data() + slot * K;
-        const int n_dirs = cache_count_[slot];
+        const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
+        const int* dir = direct_dir_.data();
+        const double* ang = direct_weight_.data();
+        int n_dirs;
+        if (use_memo) {
+            ++lookups;
+            const std::size_t slot = slot_of(azimuth);
+            if (!(cache_key_[slot] == azimuth)) {
+                ++misses;
+                fill_angular(slot, azimuth);
+            }
+            dir = cache_dir_.data() + slot * K;
+            ang = cache_weight_.data() + slot * K;
+            n_dirs = cache_count_[slot];
+        } else {
+            n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
+        }
         for (int l = 0; l < L; ++l) {
             layer_weight_[l] += elev[l] + dropped_e[l];
             if (dropped_e[l] > 0.0)
@@ -223,6 +229,7 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             }
         }
     }
+    if (use_memo && lookups > 0) memo_useful_ = misses * 4 < lookups * 3;
     for (int axis = 0; axis < L * K; ++axis)
         std::copy(out_data + static_cast<std::size_t>(axis) * stride, out_data + static_cast<std::size_t>(axis) * stride + M,
                   result.begin() + static_cast<std::ptrdiff_t>(axis) * M);
@@ -248,15 +255,13 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     return bound <= pruned_tolerance * max_raw;
 }
 
-std::size_t BoundaryVectorLayer::fill_angular(std::size_t slot, double azimuth) const {
+int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weight) const {
     const int K = p_.n_dir;
     const double dtheta = two_pi / K, h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta);
     const bool all_dirs = 2.0 * cut_theta_ >= two_pi;
     const int k_first = all_dirs ? 0 : static_cast<int>(std::ceil((azimuth - cut_theta_) / dtheta));
     const int k_last = all_dirs ? K - 1 : static_cast<int>(std::floor((azimuth + cut_theta_) / dtheta));
     int count = 0;
-    int* dir = cache_dir_.data() + slot * K;
-    double* weight = cache_weight_.data() + slot * K;
     for (int ki = k_first; ki <= k_last; ++ki) {
         const double x = all_dirs ? wrap_pi(azimuth - ki * dtheta) : azimuth - ki * dtheta;
         if (std::abs(x) > cut_theta_) continue;
@@ -264,9 +269,13 @@ std::size_t BoundaryVectorLayer::fill_angular(std::size_t slot, double azimuth) 
         weight[count] = c_theta_ * std::exp(-x * x * h_t);
         ++count;
     }
-    cache_count_[slot] = count;
+    return count;
+}
+
+void BoundaryVectorLayer::fill_angular(std::size_t slot, double azimuth) const {
+    const int K = p_.n_dir;
+    cache_count_[slot] = angular_weights(azimuth, cache_dir_.data() + slot * K, cache_weight_.data() + slot * K);
     cache_key_[slot] = azimuth;
-    return slot;
 }
 
 void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const {
@@ -338,7 +347,7 @@ void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<do
     }
 }
 
-void BoundaryVectorLayer::normalise(std::span<double> out) const {
+void BoundaryVectorLayer::normalize(std::span<double> out) const {
     if (p_.normalization == BvcNormalization::per_step_max) {
         const double mx = out.empty() ? 0.0 : *std::max_element(out.begin(), out.end());
         if (mx > 0) {
@@ -354,7 +363,7 @@ void BoundaryVectorLayer::normalise(std::span<double> out) const {
 
 void BoundaryVectorLayer::rates(std::span<const LidarReturn> returns, std::span<double> out) const {
     raw(returns, out);
-    normalise(out);
+    normalize(out);
 }
 
 bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan,
@@ -365,7 +374,7 @@ bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, con
         return true;
     }
     if (!raw_pruned(returns, &plan, out)) return false;
-    normalise(out);
+    normalize(out);
     return true;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
-// BVC stage (SPEC §5): boundary vector cells tuned to distance, allocentric azimuth and elevation.
-// Takes: LiDAR returns (range, azimuth, elevation). Gives: one rate per cell, cell i = (l, k, m) at
-// index (l·n_dir + k)·n_per_axis + m, for preferred elevation psi_l, azimuth theta_k = 2πk/n_dir and
-// distance d_m = m·max_dist/(n_per_axis - 1).
+// BVC stage (docs/model-reference.md#boundary-vector-cells): boundary vector cells tuned to
+// distance, allocentric azimuth and elevation.
+// Takes: LiDAR returns (range, azimuth, elevation), from a beam table or any point set. Gives: one
+// rate per cell, cell i = (l, k, m) at index (l·n_dir + k)·n_per_axis + m, for preferred elevation
+// psi_l, azimuth theta_k = 2πk/n_dir and distance d_m = m·max_dist/(n_per_axis - 1).
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/core/params.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
 namespace bvc3d {
@@ -20,8 +22,9 @@ enum class BvcNormalization { per_step_max, none, fixed };
 // return nearest to theta_k with no angular or elevation factor (the authors' code; `2d-8beam`).
 enum class BvcReading { gaussian, nearest_beam };
 
+// Defaults: the paper's σs and spacing; the layers of its `3d-0.2` model (the default model).
 struct BvcParams {
-    std::vector<double> elevations;  // psi_l in radians; empty: the 2-D model (no elevation factor)
+    std::vector<double> elevations{0.0, 0.2};  // psi_l in radians; empty: the 2-D model (no elevation factor)
     int n_dir = 8;
     int n_per_axis = 60;
     double max_dist = 12.0;     // m
@@ -35,13 +38,9 @@ struct BvcParams {
     int n_layers() const { return elevations.empty() ? 1 : static_cast<int>(elevations.size()); }
     int n_cells() const { return n_layers() * n_dir * n_per_axis; }
     double spacing() const { return n_per_axis > 1 ? max_dist / (n_per_axis - 1) : 0.0; }
-    void validate() const;  // throws InputError naming the bad parameter
+    static const params::Table<BvcParams>& table();
+    void validate() const;  // throws params::ParamError naming the bad parameter
 };
-
-BvcNormalization parse_bvc_normalization(const std::string& name);  // throws InputError
-std::string to_string(BvcNormalization n);
-BvcReading parse_bvc_reading(const std::string& name);
-std::string to_string(BvcReading r);
 
 class BoundaryVectorLayer {
 public:
@@ -57,7 +56,7 @@ public:
     // are all but zero are pruned, and a per-step bound on what was pruned is checked; when it is
     // not small enough the full sum is computed instead.
     void raw(std::span<const LidarReturn> returns, std::span<double> out) const;
-    // Normalised rates (per_step_max: raw / (2·max raw), so the largest is exactly 0.5).
+    // Normalized rates (per_step_max: raw / (2·max raw), so the largest is exactly 0.5).
     void rates(std::span<const LidarReturn> returns, std::span<double> out) const;
 
     // Which rows of a scanner's beam table this layer needs: rows[i] = 0 for a row whose weight is
@@ -82,7 +81,7 @@ private:
     // Returns false if the pruning bound is not met (out then holds the pruned sums).
     bool raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out) const;
     void raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out) const;
-    void normalise(std::span<double> out) const;
+    void normalize(std::span<double> out) const;
     static void check_return(const LidarReturn& r, std::size_t index);
 
     BvcParams p_;
@@ -94,16 +93,24 @@ private:
     // (scanners repeat the same azimuths row after row). Slot s holds count_[s] directions at
     // dir_/weight_[s·n_dir ...]; a NaN key never matches.
     static constexpr std::size_t cache_slots = 1024;
-    // The slot holding `azimuth`: a hit is a multiply, a shift and a compare; a miss fills the slot.
-    std::size_t angular(double azimuth) const {
+    // The slot for `azimuth`: a hit is a multiply, a shift and a compare; a miss fills the slot.
+    static std::size_t slot_of(double azimuth) {
         std::uint64_t bits;
         std::memcpy(&bits, &azimuth, sizeof bits);
-        const std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 54);
-        return cache_key_[slot] == azimuth ? slot : fill_angular(slot, azimuth);
+        return static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 54);
     }
-    std::size_t fill_angular(std::size_t slot, double azimuth) const;
+    void fill_angular(std::size_t slot, double azimuth) const;
+    // The directions `azimuth` reaches and their angular factors; returns how many.
+    int angular_weights(double azimuth, int* dir, double* weight) const;
     mutable std::vector<double> cache_key_, cache_weight_;
     mutable std::vector<int> cache_count_, cache_dir_;
+    // Irregular point sets (real LiDAR) repeat no azimuth: the memo then only evicts useful cache
+    // lines, so a step whose memo mostly missed makes the next steps compute the factors directly
+    // (into direct_*), checking again every 16th step. Either way the numbers are the same.
+    mutable bool memo_useful_ = true;
+    mutable unsigned memo_probe_ = 0;
+    mutable std::vector<int> direct_dir_;
+    mutable std::vector<double> direct_weight_;
 
     // Scratch for one step (a layer is not shared between threads): a return's distance profile,
     // the (layer, direction) rows it feeds with their weights, the elevation factors of its row.

@@ -1,9 +1,10 @@
 #pragma once
-// YAML <-> models (sensor + BVC layer + place cells). Schema in docs/model.md.
+// YAML <-> models (sensor + BVC layer + place cells). Schema in docs/model.md; every key, default
+// and check comes from the parameter structs' tables.
 #include <string>
 
+#include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/config/yaml_reader.hpp"
-#include "bvc3d/experiment/model_spec.hpp"
 
 namespace bvc3d::config {
 

@@ -65,6 +65,111 @@ std::string yaml_text(const YAML::Node& v) {
     return e.c_str();
 }
 
+// One condition: the swept keys and their values, and where in the file it was written.
+struct Condition {
+    std::vector<std::pair<std::string, YAML::Node>> values;
+    YamlView where;
+};
+
+// Every combination of the grid's values, first key slowest.
+std::vector<Condition> grid_conditions(const YamlView& grid, std::vector<std::string>& keys) {
+    std::vector<std::pair<std::string, YamlView>> axes;
+    for (const auto& key : grid.keys()) {
+        if (key == "seed") grid.fail_key(key, "seeds are not a grid key: list them under 'seeds:'");
+        const YamlView values = grid[key];
+        if (!values.is_sequence()) values.fail("expected a list of values to sweep");
+        if (values.size() == 0) values.fail("lists no values: an empty grid runs nothing");
+        axes.emplace_back(key, values);
+        keys.push_back(key);
+    }
+    if (axes.empty()) grid.fail("has no keys");
+    std::vector<Condition> conditions;
+    std::vector<std::size_t> idx(axes.size(), 0);
+    for (bool more = true; more;) {
+        Condition c{{}, axes.back().second.at(idx.back())};
+        for (std::size_t a = 0; a < axes.size(); ++a) c.values.emplace_back(axes[a].first, axes[a].second.at(idx[a]).node());
+        conditions.push_back(c);
+        more = false;
+        for (std::size_t a = axes.size(); a-- > 0;) {
+            if (++idx[a] < axes[a].second.size()) {
+                more = true;
+                break;
+            }
+            idx[a] = 0;
+        }
+    }
+    return conditions;
+}
+
+// The explicit list of conditions, each a mapping of keys to values.
+std::vector<Condition> list_conditions(const YamlView& list, std::vector<std::string>& keys) {
+    if (list.size() == 0) list.fail("is empty");
+    std::vector<Condition> conditions;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        const YamlView item = list.at(i);
+        if (!item.is_map() || item.keys().empty()) item.fail("each condition is a mapping of keys to values");
+        Condition c{{}, item};
+        for (const auto& key : item.keys()) {
+            if (key == "seed") item.fail_key(key, "seeds are not a condition key: list them under 'seeds:'");
+            c.values.emplace_back(key, item[key].node());
+            if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+        }
+        conditions.push_back(c);
+    }
+    return conditions;
+}
+
+// `seeds: N` (0 .. N-1) or a list; default: seed 0.
+std::vector<std::uint64_t> read_seeds(const YamlView& v) {
+    if (!v.has("seeds")) return {0};
+    const YamlView s = v["seeds"];
+    std::vector<std::uint64_t> seeds;
+    if (s.is_scalar()) {
+        const long long n = s.as_int();
+        if (n < 1) s.fail("must be >= 1 (a number of seeds) or a list of seeds");
+        for (long long i = 0; i < n; ++i) seeds.push_back(static_cast<std::uint64_t>(i));
+        return seeds;
+    }
+    if (s.size() == 0) s.fail("lists no seeds");
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const long long x = s.at(i).as_int();
+        if (x < 0) s.at(i).fail("seeds must be >= 0");
+        seeds.push_back(static_cast<std::uint64_t>(x));
+    }
+    return seeds;
+}
+
+// The base trial with one condition's values set, checked as a trial file would be.
+TrialConfig condition_trial(const std::string& path, const YAML::Node& base, const Condition& c, std::size_t index) {
+    YAML::Node tree = YAML::Clone(base);
+    if (!tree.IsMap()) tree = YAML::Node(YAML::NodeType::Map);
+    std::string label = std::to_string(index);
+    label = "c" + std::string(label.size() < 3 ? 3 - label.size() : 0, '0') + label;
+    std::vector<std::pair<std::string, std::string>> swept;
+    for (const auto& [key, value] : c.values) {
+        set_key(tree, key, value, c.where);
+        label += "_" + sanitize(split_key(key).back()) + "=" + sanitize(value_text(value));
+        swept.emplace_back(key, yaml_text(value));
+    }
+    TrialConfig t;
+    try {
+        t = trial_from_yaml(YamlView(tree, path, ""));
+    } catch (const ConfigError& e) {
+        // The message's line refers to the assembled trial; point at the sweep file's instead.
+        std::string reason = e.reason();
+        if (const auto at = reason.rfind(" (line "); at != std::string::npos) reason.resize(at);
+        std::string values;
+        for (const auto& [k, val] : swept) values += (values.empty() ? "" : ", ") + k + "=" + val;
+        const int line = c.where.node().Mark().line;
+        throw ConfigError(path, e.key(),
+                          reason + " (in condition " + std::to_string(index) + ": " + values +
+                              (line >= 0 ? ", line " + std::to_string(line + 1) : std::string()) + ")");
+    }
+    t.condition = label;
+    t.swept = swept;
+    return t;
+}
+
 }  // namespace
 
 Sweep load_sweep_file(const std::string& path) {
@@ -75,101 +180,15 @@ Sweep load_sweep_file(const std::string& path) {
     const YAML::Node base = v.has("base") ? v["base"].node() : YAML::Node(YAML::NodeType::Map);
     if (v.has("base")) v["base"].expect_map(trial_keys());
     if (!v.has("grid") && !v.has("list")) v.fail("a sweep needs a 'grid' and/or a 'list' of conditions");
-
-    // Conditions: every combination of the grid (first key slowest), then the explicit list.
-    std::vector<std::vector<std::pair<std::string, YAML::Node>>> conditions;
-    std::vector<YamlView> condition_where;
-    if (v.has("grid")) {
-        const YamlView grid = v["grid"];
-        std::vector<std::pair<std::string, YamlView>> axes;
-        for (const auto& key : grid.keys()) {
-            if (key == "seed") grid.fail_key(key, "seeds are not a grid key: list them under 'seeds:'");
-            const YamlView values = grid[key];
-            if (!values.is_sequence()) values.fail("expected a list of values to sweep");
-            if (values.size() == 0) values.fail("lists no values: an empty grid runs nothing");
-            axes.emplace_back(key, values);
-            sweep.keys.push_back(key);
-        }
-        if (axes.empty()) grid.fail("has no keys");
-        std::vector<std::size_t> idx(axes.size(), 0);
-        for (bool more = true; more;) {
-            std::vector<std::pair<std::string, YAML::Node>> c;
-            for (std::size_t a = 0; a < axes.size(); ++a) c.emplace_back(axes[a].first, axes[a].second.at(idx[a]).node());
-            conditions.push_back(c);
-            condition_where.push_back(axes.back().second.at(idx.back()));
-            more = false;
-            for (std::size_t a = axes.size(); a-- > 0;) {
-                if (++idx[a] < axes[a].second.size()) {
-                    more = true;
-                    break;
-                }
-                idx[a] = 0;
-            }
-        }
-    }
+    std::vector<Condition> conditions;
+    if (v.has("grid")) conditions = grid_conditions(v["grid"], sweep.keys);
     if (v.has("list")) {
-        const YamlView list = v["list"];
-        if (list.size() == 0) list.fail("is empty");
-        for (std::size_t i = 0; i < list.size(); ++i) {
-            const YamlView item = list.at(i);
-            if (!item.is_map() || item.keys().empty()) item.fail("each condition is a mapping of keys to values");
-            std::vector<std::pair<std::string, YAML::Node>> c;
-            for (const auto& key : item.keys()) {
-                if (key == "seed") item.fail_key(key, "seeds are not a condition key: list them under 'seeds:'");
-                c.emplace_back(key, item[key].node());
-                if (std::find(sweep.keys.begin(), sweep.keys.end(), key) == sweep.keys.end()) sweep.keys.push_back(key);
-            }
-            conditions.push_back(c);
-            condition_where.push_back(item);
-        }
+        auto listed = list_conditions(v["list"], sweep.keys);
+        conditions.insert(conditions.end(), listed.begin(), listed.end());
     }
-
-    std::vector<std::uint64_t> seeds{0};
-    if (v.has("seeds")) {
-        const YamlView s = v["seeds"];
-        seeds.clear();
-        if (s.is_scalar()) {
-            const long long n = s.as_int();
-            if (n < 1) s.fail("must be >= 1 (a number of seeds) or a list of seeds");
-            for (long long i = 0; i < n; ++i) seeds.push_back(static_cast<std::uint64_t>(i));
-        } else {
-            if (s.size() == 0) s.fail("lists no seeds");
-            for (std::size_t i = 0; i < s.size(); ++i) {
-                const long long x = s.at(i).as_int();
-                if (x < 0) s.at(i).fail("seeds must be >= 0");
-                seeds.push_back(static_cast<std::uint64_t>(x));
-            }
-        }
-    }
-
+    const auto seeds = read_seeds(v);
     for (std::size_t c = 0; c < conditions.size(); ++c) {
-        YAML::Node tree = YAML::Clone(base);
-        if (!tree.IsMap()) tree = YAML::Node(YAML::NodeType::Map);
-        std::string label = std::to_string(c);
-        label = "c" + std::string(label.size() < 3 ? 3 - label.size() : 0, '0') + label;
-        std::vector<std::pair<std::string, std::string>> swept;
-        for (const auto& [key, value] : conditions[c]) {
-            set_key(tree, key, value, condition_where[c]);
-            const auto parts = split_key(key);
-            label += "_" + sanitize(parts.back()) + "=" + sanitize(value_text(value));
-            swept.emplace_back(key, yaml_text(value));
-        }
-        TrialConfig t;
-        try {
-            t = trial_from_yaml(YamlView(tree, path, ""));
-        } catch (const ConfigError& e) {
-            // The message's line refers to the assembled trial; point at the sweep file's instead.
-            std::string reason = e.reason();
-            if (const auto at = reason.rfind(" (line "); at != std::string::npos) reason.resize(at);
-            std::string values;
-            for (const auto& [k, val] : swept) values += (values.empty() ? "" : ", ") + k + "=" + val;
-            const int line = condition_where[c].node().Mark().line;
-            throw ConfigError(path, e.key(),
-                              reason + " (in condition " + std::to_string(c) + ": " + values +
-                                  (line >= 0 ? ", line " + std::to_string(line + 1) : std::string()) + ")");
-        }
-        t.condition = label;
-        t.swept = swept;
+        TrialConfig t = condition_trial(path, base, conditions[c], c);
         for (auto s : seeds) {
             t.seed = s;
             sweep.trials.push_back(t);

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "bvc3d/experiment/trial_config.hpp"
+#include "bvc3d/config/trial_config.hpp"
 
 namespace bvc3d::config {
 

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 
 namespace bvc3d::config {
@@ -49,81 +50,49 @@ ModelSpec model_from(const YamlView& v) {
     }
 }
 
-Protocol protocol_from(const YamlView& v) {
-    Protocol p;
-    read_fields(v,
-                {{"explore_hours", &p.explore_hours}, {"sample_hours", &p.sample_hours}, {"record_bvc", &p.record_bvc}},
-                {"kind"});
-    if (v.has("kind")) {
-        try {
-            p.kind = parse_protocol(v["kind"].as_string());
-        } catch (const InputError& e) {
-            v["kind"].fail(e.what());
-        }
-    }
-    require_range(v, "explore_hours", p.explore_hours, 0.0, 1e6);
-    if (!(p.sample_hours > 0)) v.fail_key("sample_hours", "must be > 0");
-    return p;
-}
-
-RobotParams robot_from(const YamlView& v) {
-    RobotParams r;
-    read_fields(v, {{"radius", &r.radius},
-                    {"height", &r.height},
-                    {"speed", &r.speed},
-                    {"turn_rate", &r.turn_rate},
-                    {"model_dt", &r.model_dt},
-                    {"n_walk", &r.n_walk},
-                    {"turn_sd", &r.turn_sd},
-                    {"min_update_move", &r.min_update_move}});
-    for (const char* k : {"radius", "height", "speed", "turn_rate", "model_dt"})
-        if (v.has(k)) require_positive(v, k, v[k].as_double());
-    if (r.n_walk < 1) v["n_walk"].fail("must be >= 1");
-    require_range(v, "turn_sd", r.turn_sd, 0.0, 100.0);
-    require_range(v, "min_update_move", r.min_update_move, 0.0, 1.0);
-    return r;
-}
-
 void analysis_from(const YamlView& v, TrialConfig& t) {
-    auto& a = t.analysis;
-    std::string extent = "data", templates = analysis::decoding_templates_name(a.decoding_templates);
-    read_fields(v, {{"gridsize", &a.gridsize},
-                    {"quantile", &a.quantile},
-                    {"eps", &a.dbscan.eps},
-                    {"min_samples", &a.dbscan.min_samples},
-                    {"d_th", &a.d_th},
-                    {"extent", &extent},
-                    {"decoding_templates", &templates}});
-    try {
-        a.decoding_templates = analysis::parse_decoding_templates(templates);
-    } catch (const InputError& e) {
-        v["decoding_templates"].fail(e.what());
-    }
+    read_table(v, t.analysis, analysis::AnalysisParams::table(), {"extent"});
+    const std::string extent = v.get("extent", "data");
     if (extent != "data" && extent != "arena") v["extent"].fail("must be 'data' or 'arena'");
     t.arena_extent = extent == "arena";
-    if (a.gridsize < 2) v["gridsize"].fail("must be >= 2");
-    require_range(v, "quantile", a.quantile, 0.0, 1.0);
-    require_positive(v, "eps", a.dbscan.eps);
-    if (a.dbscan.min_samples < 1) v["min_samples"].fail("must be >= 1");
-    require_range(v, "d_th", a.d_th, 0.0, 1e6);
+}
+
+std::shared_ptr<const AgentSpec> agent_from(const YamlView& v) {
+    if (v.has("robot") && v.has("trajectory"))
+        v.fail("give 'robot' (the random walk's robot) or 'trajectory' (a given path), not both");
+    if (v.has("trajectory")) {
+        const YamlView file = v["trajectory"];
+        try {
+            return std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(relative_to(file, file.as_string())));
+        } catch (const ConfigError&) {
+            throw;
+        } catch (const InputError& e) {
+            file.fail(e.what());
+        }
+    }
+    RobotParams robot;
+    if (v.has("robot")) read_table(v["robot"], robot, RobotParams::table());
+    return std::make_shared<RandomWalkSpec>(robot);
 }
 
 }  // namespace
 
-std::vector<std::string> trial_keys() { return {"world", "model", "seed", "protocol", "robot", "analysis"}; }
+std::vector<std::string> trial_keys() {
+    return {"world", "model", "seed", "protocol", "robot", "trajectory", "analysis"};
+}
 
 TrialConfig trial_from_yaml(const YamlView& v) {
     v.expect_map(trial_keys());
     TrialConfig t;
     if (v.has("world")) t.world = world_from(v["world"]);
-    t.model = v.has("model") ? model_from(v["model"]) : model_preset("3d-0.2");
+    if (v.has("model")) t.model = model_from(v["model"]);
     if (v.has("seed")) {
         const long long s = v["seed"].as_int();
         if (s < 0) v["seed"].fail("must be >= 0");
         t.seed = static_cast<std::uint64_t>(s);
     }
-    if (v.has("protocol")) t.protocol = protocol_from(v["protocol"]);
-    if (v.has("robot")) t.robot = robot_from(v["robot"]);
+    if (v.has("protocol")) read_table(v["protocol"], t.protocol, Protocol::table());
+    t.agent = agent_from(v);
     if (v.has("analysis")) analysis_from(v["analysis"], t);
     return t;
 }

@@ -1,16 +1,17 @@
 #pragma once
-// YAML <-> trial configurations (SPEC §7). Schema in docs/experiments.md. A sweep edits keys of
-// this tree (e.g. model.bvc.elevations) and parses it again, so every value meets the same checks.
+// YAML <-> trial configurations. Schema in docs/experiments.md. A sweep edits keys of this tree
+// (e.g. model.bvc.elevations) and parses it again, so every value meets the same checks.
 #include <string>
 
 #include "bvc3d/config/yaml_reader.hpp"
-#include "bvc3d/experiment/trial_config.hpp"
+#include "bvc3d/config/trial_config.hpp"
 
 namespace bvc3d::config {
 
 // world: preset name / YAML path, or {source, tilt_deg, lean}; model: preset name / YAML path, or a
-// model mapping; seed; protocol: {kind, explore_hours, sample_hours, record_bvc}; robot: {...};
-// analysis: {gridsize, quantile, eps, min_samples, d_th, extent: data | arena}.
+// model mapping; seed; protocol: {kind, explore_hours, sample_hours, record_bvc}; the agent — robot:
+// {...} for the random walk (default), or trajectory: FILE; analysis: {gridsize, quantile, eps,
+// min_samples, d_th, decoding_templates, extent: data | arena}.
 TrialConfig trial_from_yaml(const YamlView& v);
 TrialConfig load_trial_file(const std::string& path);
 

@@ -110,7 +110,7 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
                     {{"length", &t.length}, {"thickness", &t.thickness}, {"height", &t.height}, {"yaw_deg", &yaw},
                      {"tilt_deg", &tilt}},
                     {"center"});
-        t.centre = vec2(v["center"]);
+        t.center = vec2(v["center"]);
         t.yaw = deg_to_rad(yaw);
         require_positive(v, "length", t.length);
         require_positive(v, "thickness", t.thickness);
@@ -220,10 +220,14 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
 }
 
 LidarSpec sensor_from_yaml(const YamlView& v) {
-    if (v.has("elevations") && v.has("elevations_deg")) v.fail("give 'elevations' (rad) or 'elevations_deg', not both");
-    if (v.has("azimuth_offset") && v.has("azimuth_offset_deg"))
-        v.fail("give 'azimuth_offset' (rad) or 'azimuth_offset_deg', not both");
+    if (v.is_scalar()) {
+        const std::string name = v.as_string();
+        if (name == "horizontal") return LidarSpec::horizontal();
+        if (name == "spherical") return LidarSpec::spherical();
+        v.fail("expected horizontal, spherical, or a sensor mapping");
+    }
     const std::string preset = v.get("preset", "");
+    const bool own_rows = v.has("elevations") || v.has("elevations_deg");
     LidarSpec s;
     if (preset == "horizontal") {
         s = LidarSpec::horizontal();
@@ -231,39 +235,16 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
     } else if (preset == "spherical") {
         const std::string rows = v.get("keep_rows", "upper");
         if (rows != "upper" && rows != "all") v["keep_rows"].fail("must be 'upper' or 'all'");
+        if (own_rows && v.has("keep_rows")) v.fail_key("keep_rows", "cannot be combined with elevations");
         s = LidarSpec::spherical(rows == "upper");
     } else if (!preset.empty()) {
         v["preset"].fail("unknown sensor preset '" + preset + "' (expected horizontal or spherical)");
-    } else if (!v.has("elevations_deg") && !v.has("elevations")) {
+    } else if (!own_rows) {
         v.fail("a custom sensor needs 'elevations_deg' (or a 'preset')");
+    } else {
+        s.name = "custom";
     }
-    s.name = v.get("name", preset.empty() ? std::string("custom") : preset);
-    for (const char* key : {"elevations_deg", "elevations"}) {
-        if (!v.has(key)) continue;
-        if (v.has("keep_rows")) v.fail_key("keep_rows", std::string("cannot be combined with ") + key);
-        const bool degrees = std::string(key) == "elevations_deg";
-        const auto e = v[key].as_doubles();
-        if (e.empty()) v[key].fail("must list at least one elevation");
-        s.elevations.clear();
-        for (double d : e) {
-            if (std::abs(degrees ? d : rad_to_deg(d)) > 90) v[key].fail("elevations must lie within ±90°");
-            s.elevations.push_back(degrees ? deg_to_rad(d) : d);
-        }
-    }
-    if (v.has("azimuth_offset_deg")) s.azimuth_offset = deg_to_rad(v["azimuth_offset_deg"].as_double());
-    read_fields(v,
-                {{"azimuth_count", &s.azimuth_count},
-                 {"azimuth_offset", &s.azimuth_offset},
-                 {"height", &s.height},
-                 {"max_range", &s.max_range},
-                 {"range_noise_sd", &s.range_noise_sd},
-                 {"dropout", &s.dropout}},
-                {"preset", "name", "elevations", "elevations_deg", "keep_rows", "azimuth_offset_deg"});
-    if (s.azimuth_count < 1) v["azimuth_count"].fail("must be >= 1");
-    require_range(v, "height", s.height, 0.0, 1e3);
-    require_positive(v, "max_range", s.max_range);
-    require_range(v, "range_noise_sd", s.range_noise_sd, 0.0, 1e3);
-    require_range(v, "dropout", s.dropout, 0.0, 0.999999);
+    read_table(v, s, LidarSpec::table(), {"preset", "keep_rows"});
     return s;
 }
 

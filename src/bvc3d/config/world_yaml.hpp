@@ -1,5 +1,5 @@
 #pragma once
-// YAML <-> worlds (SPEC §2.2). The schema is documented in docs/worlds.md.
+// YAML <-> worlds and sensors. The schemas are documented in docs/worlds.md.
 #include <optional>
 #include <string>
 
@@ -22,7 +22,8 @@ std::vector<std::string> world_file_meshes(const std::string& path);
 WorldDescription resolve_world(const std::string& name_or_file, std::optional<double> tilt_deg = std::nullopt,
                                const std::string& lean = "+x+y");
 
-// Sensors: "horizontal", "spherical", or a YAML mapping / file describing a beam table.
+// Sensors: "horizontal", "spherical", or a YAML mapping / file describing a beam table (keys from
+// LidarSpec's table, plus `preset` and `keep_rows`).
 LidarSpec sensor_from_yaml(const YamlView& v);
 LidarSpec resolve_sensor(const std::string& name_or_file);
 

@@ -191,4 +191,23 @@ void require_range(const YamlView& v, const std::string& key, double value, doub
         fail_at(v, key, "must be in [" + format_number(lo) + ", " + format_number(hi) + "], got " + format_number(value));
 }
 
+params::Value read_value(const YamlView& v, params::Kind kind, bool degrees) {
+    using params::Kind;
+    switch (kind) {
+        case Kind::real: return degrees ? deg_to_rad(v.as_double()) : v.as_double();
+        case Kind::integer: return v.as_int();
+        case Kind::flag: return v.as_bool();
+        case Kind::text:
+        case Kind::choice: return v.as_string();
+        case Kind::reals: {
+            if (v.node().IsNull()) return std::vector<double>{};  // `key:` with nothing: an empty list
+            std::vector<double> xs = v.as_doubles();
+            if (degrees)
+                for (double& x : xs) x = deg_to_rad(x);
+            return xs;
+        }
+    }
+    v.fail("unsupported value");
+}
+
 }  // namespace bvc3d::config

@@ -10,7 +10,9 @@
 #include <variant>
 #include <vector>
 
+#include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/params.hpp"
 
 namespace bvc3d::config {
 
@@ -79,5 +81,47 @@ void read_fields(const YamlView& v, std::initializer_list<Field> fields, std::in
 // Number checks with the standard message.
 void require_positive(const YamlView& v, const std::string& key, double value);
 void require_range(const YamlView& v, const std::string& key, double value, double lo, double hi);
+
+// The value of a table field at `v` (the field's own key, or `<key>_deg` in degrees for angles).
+params::Value read_value(const YamlView& v, params::Kind kind, bool degrees);
+
+// Runs `check` (a struct's validate()) and reports a ParamError at the line of the key it names.
+template <class F>
+void check_at(const YamlView& v, F&& check) {
+    try {
+        check();
+    } catch (const params::ParamError& e) {
+        if (v.has(e.key())) v[e.key()].fail(e.reason());
+        if (v.has(e.key() + "_deg")) v[e.key() + "_deg"].fail(e.reason());
+        v.fail(e.what());
+    }
+}
+
+// Fills `s` from the keys of mapping `v` that name fields of `table` (each value checked against the
+// field's kind and limits; angles also as `<key>_deg`), then validates the whole struct. Keys in
+// `also` are the caller's to read; any other key is an error.
+template <class S>
+void read_table(const YamlView& v, S& s, const params::Table<S>& table, std::initializer_list<const char*> also = {}) {
+    std::vector<std::string> allowed;
+    for (const auto& f : table.fields()) {
+        allowed.push_back(f.key);
+        if (f.radians) allowed.push_back(f.key + "_deg");
+    }
+    for (const char* k : also) allowed.emplace_back(k);
+    v.expect_map(allowed);
+    for (const auto& f : table.fields()) {
+        const std::string deg = f.key + "_deg";
+        if (f.radians && v.has(f.key) && v.has(deg)) v.fail("give '" + f.key + "' (rad) or '" + deg + "', not both");
+        const bool in_degrees = f.radians && v.has(deg);
+        if (!v.has(f.key) && !in_degrees) continue;
+        const YamlView at = v[in_degrees ? deg : f.key];
+        try {
+            table.set(s, f, read_value(at, f.kind, in_degrees));
+        } catch (const params::ParamError& e) {
+            at.fail(e.reason());
+        }
+    }
+    check_at(v, [&] { s.validate(); });
+}
 
 }  // namespace bvc3d::config

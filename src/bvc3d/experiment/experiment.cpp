@@ -11,9 +11,7 @@
 
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/experiment/trial_runner.hpp"
-#include "bvc3d/recorder/checkpoint_file.hpp"
-#include "bvc3d/recorder/trial_file.hpp"
+#include "bvc3d/experiment/pipeline.hpp"
 
 namespace bvc3d {
 
@@ -93,22 +91,6 @@ std::filesystem::path trial_path(const std::filesystem::path& out_dir, const Tri
     return out_dir / (t.name() + ".h5");
 }
 
-analysis::AnalysisParams analysis_params(const TrialConfig& t, const WorldDescription& world) {
-    analysis::AnalysisParams params = t.analysis;
-    if (t.arena_extent) {
-        const auto box = world.walkable.bounds();
-        params.extent = analysis::Extent{box.min().x(), box.max().x(), box.min().y(), box.max().y()};
-    }
-    return params;
-}
-
-analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& world, const std::vector<double>& x,
-                               const std::vector<double>& y, const std::vector<float>& rates, int n_place) {
-    const analysis::AnalysisParams params = analysis_params(t, world);
-    const Eigen::Map<const analysis::RowMatrixXf> r(rates.data(), static_cast<Eigen::Index>(x.size()), n_place);
-    return analysis::analyze_trial<float>(x, y, r, params);
-}
-
 namespace {
 
 class LocalCoordinator : public Coordinator {
@@ -152,7 +134,7 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
         outcome.files.push_back(trial_path(options.out_dir, trials[i]));
     }
     const auto groups = make_groups(trials, all);
-    auto complete = [&](std::size_t i) { return trial_file_fingerprint(outcome.files[i]) == trials[i].fingerprint(); };
+    auto complete = [&](std::size_t i) { return trial_file_complete(outcome.files[i], trials[i]); };
     std::vector<std::size_t> pending;
     int complete_before = 0;
     if (coord.is_root())
@@ -169,8 +151,7 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
     double total_seconds = 0;
     int todo_trials = 0;
     for (std::size_t g : pending) {
-        const auto& p = trials[groups[g].members.front()].protocol;
-        total_seconds += 3600 * (p.kind == Protocol::Kind::online ? p.sample_hours : p.explore_hours + p.sample_hours);
+        total_seconds += trials[groups[g].members.front()].protocol.seconds();
         todo_trials += static_cast<int>(groups[g].members.size());
     }
     if (!pending.empty()) ensure_writable_directory(ckpt_dir);
@@ -190,10 +171,14 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
     });
 
     auto run_group = [&](const Group& g) {
-        // Only the members whose files are missing run; they still share the walk.
+        // Only the members whose files are missing run; they still share the agent.
         std::vector<TrialConfig> members;
+        std::vector<std::filesystem::path> paths;
         for (std::size_t i : g.members)
-            if (!complete(i)) members.push_back(trials[i]);
+            if (!complete(i)) {
+                members.push_back(trials[i]);
+                paths.push_back(outcome.files[i]);
+            }
         if (members.empty()) return;
         RunControl control;
         control.stop = &stop_all;
@@ -207,19 +192,14 @@ ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const E
             last = t;
             last_steps = steps;
         };
-        const GroupResult result = run_trial_group(members, control);
-        const WorldDescription world = members.front().world.resolve();
-        for (std::size_t k = 0; k < members.size(); ++k) {
-            const auto metrics =
-                analyze(members[k], world, result.x, result.y, result.models[k].rates, result.models[k].n_place);
-            write_trial_file(trial_path(options.out_dir, members[k]), members[k], result, k, metrics,
-                             analysis_params(members[k], world));
-            if (options.on_trial_done) options.on_trial_done(members[k].name());
+        const GroupOutcome done = run_analyze_write(members, paths, control);
+        for (const auto& m : members) {
+            if (options.on_trial_done) options.on_trial_done(m.name());
             progress.trial_done();
             ++ran;
         }
-        progress.add_steps(result.stats.explore_steps + result.stats.sample_steps, static_cast<std::int64_t>(members.size()));
-        remove_checkpoint(control.checkpoint);
+        const auto& stats = done.result.stats;
+        progress.add_steps(stats.explore_steps + stats.sample_steps, static_cast<std::int64_t>(members.size()));
     };
     auto worker = [&] {
         while (!stop_all.load()) {

@@ -1,7 +1,7 @@
 #pragma once
-// Runs a list of trials into a folder of trial files: the engine under `bvc3d paper` and sweeps.
-// Completed trials (a file whose configuration matches) are skipped; the rest run in groups that
-// share a walk, in parallel, one group per thread; each finished trial is analysed and written.
+// Experiment engine: runs a list of trials into a folder of trial files (`bvc3d paper`, sweeps).
+// Completed trials (a file whose configuration and metrics match) are skipped; the rest run in
+// groups that share an agent, in parallel, one group per thread, through the trial pipeline.
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -10,7 +10,7 @@
 #include <optional>
 #include <vector>
 
-#include "bvc3d/experiment/trial_config.hpp"
+#include "bvc3d/config/trial_config.hpp"
 
 namespace bvc3d {
 
@@ -51,12 +51,5 @@ std::filesystem::path trial_path(const std::filesystem::path& out_dir, const Tri
 // Without a coordinator, options.jobs threads share the work.
 ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options,
                                  Coordinator* coordinator = nullptr);
-
-// A trial's analysis parameters, with the arena's bounds as the extent when it asks for them.
-analysis::AnalysisParams analysis_params(const TrialConfig& t, const WorldDescription& world);
-
-// Analyses a trial's recorded samples (SPEC §8) with its configured parameters.
-analysis::TrialMetrics analyze(const TrialConfig& t, const WorldDescription& world, const std::vector<double>& x,
-                               const std::vector<double>& y, const std::vector<float>& rates, int n_place);
 
 }  // namespace bvc3d

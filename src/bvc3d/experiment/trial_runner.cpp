@@ -1,22 +1,25 @@
 #include "bvc3d/experiment/trial_runner.hpp"
 
+#include <cmath>
 #include <filesystem>
-#include <sstream>
 
+#include "bvc3d/bvc/boundary_vector_layer.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/place/place_cell_network.hpp"
 #include "bvc3d/recorder/checkpoint_file.hpp"
 
 namespace bvc3d {
 
 namespace {
 
-// A sensor shared by the group's models, and the rows at least one of them needs.
-struct SensorUse {
-    LidarSpec spec;
-    Lidar lidar;
+// A return source shared by the group's models, and the rows of its beam table at least one needs.
+struct SourceUse {
+    std::shared_ptr<ReturnSource> source;
     std::vector<char> rows;
     Scan scan, full;
-    bool full_cast = false;
+    bool full_read = false;
 };
 
 void check_group(const std::vector<TrialConfig>& trials) {
@@ -25,95 +28,106 @@ void check_group(const std::vector<TrialConfig>& trials) {
     for (const auto& b : trials) {
         b.validate();
         if (b.walk_key() != a.walk_key())
-            throw InputError("trials in one group must share world, seed, protocol and robot");
+            throw InputError("trials in one group must share world, seed, protocol and agent");
     }
 }
 
 // The group's running state: everything a checkpoint saves.
 struct GroupRun {
     const std::vector<TrialConfig>& trials;
-    World world;
-    std::vector<SensorUse> sensors;
-    std::vector<int> sensor_of;
+    const World& world;
+    std::unique_ptr<Agent> agent;
+    std::vector<SourceUse> sources;
+    std::vector<int> source_of;  // per model
     std::vector<BoundaryVectorLayer> layers;
-    std::vector<BoundaryVectorLayer::ScanPlan> plans;
+    std::vector<BoundaryVectorLayer::ScanPlan> plans;  // per model; empty rows without a beam table
     std::vector<PlaceCellNetwork> nets;
     std::vector<std::vector<double>> bvc_rates;
-    RandomWalk walk;
     GroupResult result;
     std::int64_t step_index = 0;
-
-    explicit GroupRun(const std::vector<TrialConfig>& t);
-    void reserve_samples();
-    void step(const WalkStep& s, bool learn, bool record);
     std::size_t ckpt_segments = 0, ckpt_saved = 0;  // samples already in checkpoint segments
+
+    GroupRun(const World& w, const std::vector<TrialConfig>& t, const SourceFactory& factory);
+    int use_source(const ModelSpec& model, const SourceFactory& factory);
+    void reserve_samples();
+    bool model_rates(std::size_t i, const Pose& pose);
+    void step(const ModelStep& s, bool learn, bool record);
     GroupCheckpoint checkpoint(const std::string& fingerprint) const;
     void restore(const GroupCheckpoint& c);
 };
 
-RandomWalk make_walk(const World& world, const TrialConfig& c) {
-    auto body = std::make_shared<const BodyCollider>(world.description(), c.robot.radius, c.robot.height);
-    Rng rng(c.seed, Stream::walk);
-    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
-    return RandomWalk(body, c.robot, std::move(rng), start);
-}
-
-GroupRun::GroupRun(const std::vector<TrialConfig>& t)
-    : trials(t), world(t.front().world.resolve()), walk(make_walk(world, t.front())) {
+GroupRun::GroupRun(const World& w, const std::vector<TrialConfig>& t, const SourceFactory& factory)
+    : trials(t), world(w), agent(t.front().agent->make(w, t.front().seed)) {
     for (const auto& c : trials) {
         layers.emplace_back(c.model.bvc);
         nets.emplace_back(c.model.bvc.n_cells(), c.model.place, c.seed);
         bvc_rates.emplace_back(layers.back().n_cells());
-        auto it = std::find_if(sensors.begin(), sensors.end(),
-                               [&](const SensorUse& u) { return u.spec.same_beams(c.model.sensor); });
-        if (it == sensors.end()) {
-            sensors.push_back(SensorUse{c.model.sensor, Lidar(c.model.sensor),
-                                        std::vector<char>(c.model.sensor.elevations.size(), 0), {}, {}, false});
-            it = sensors.end() - 1;
-        }
-        const int si = static_cast<int>(it - sensors.begin());
-        sensor_of.push_back(si);
-        plans.push_back(layers.back().plan(c.model.sensor));
-        for (std::size_t r = 0; r < plans.back().rows.size(); ++r) sensors[si].rows[r] |= plans.back().rows[r];
+        const int si = use_source(c.model, factory);
+        source_of.push_back(si);
+        const LidarSpec* table = sources[si].source->beam_table();
+        plans.push_back(table ? layers.back().plan(*table) : BoundaryVectorLayer::ScanPlan{});
+        for (std::size_t r = 0; r < plans.back().rows.size(); ++r) sources[si].rows[r] |= plans.back().rows[r];
         ModelRecord rec;
         rec.n_place = c.model.place.n_place;
         rec.n_bvc = c.model.bvc.n_cells();
         result.models.push_back(std::move(rec));
     }
-    // Room for the samples a full recording phase can hold (a model step takes model_dt of forward
-    // motion), so growing buffers never double past it: with many models on one walk that matters.
+    // Room for the samples a full recording phase can hold, so growing buffers never double past
+    // it: with many models on one agent that matters.
     reserve_samples();
+}
+
+int GroupRun::use_source(const ModelSpec& model, const SourceFactory& factory) {
+    std::shared_ptr<ReturnSource> made = factory ? factory(model, world) : nullptr;
+    for (std::size_t i = 0; i < sources.size(); ++i) {
+        const LidarSpec* table = sources[i].source->beam_table();
+        if (made ? sources[i].source == made : table && table->same_beams(model.sensor)) return static_cast<int>(i);
+    }
+    if (!made) {
+        // Sensor noise: the trial's own stream, the same draws for every sensor of the group (common
+        // random numbers: conditions that differ in their noise level see the same underlying draws).
+        const std::uint64_t noise_seed = hash_u64(trials.front().seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
+        made = std::make_shared<RayCastSource>(world, model.sensor, noise_seed);
+    }
+    const LidarSpec* table = made->beam_table();
+    sources.push_back(SourceUse{made, std::vector<char>(table ? table->elevations.size() : 0, 0), {}, {}, false});
+    return static_cast<int>(sources.size() - 1);
 }
 
 void GroupRun::reserve_samples() {
     const auto& first = trials.front();
-    const auto expected = static_cast<std::size_t>(first.protocol.sample_hours * 3600.0 / first.robot.model_dt) + 64;
-    for (auto* v : {&result.t, &result.x, &result.y, &result.heading}) v->reserve(expected);
+    const auto expected =
+        static_cast<std::size_t>(first.protocol.sample_hours * 3600.0 * first.agent->steps_per_second()) + 64;
+    for (auto* v : {&result.t, &result.x, &result.y, &result.z, &result.heading}) v->reserve(expected);
     for (auto& rec : result.models) {
         rec.rates.reserve(expected * rec.n_place);
         if (first.protocol.record_bvc) rec.bvc.reserve(expected * rec.n_bvc);
     }
 }
 
-void GroupRun::step(const WalkStep& s, bool learn, bool record) {
-    const Pose pose{s.x, s.y, s.heading};
-    // Sensor noise: the trial's own stream, the same draws for every sensor of the group (common
-    // random numbers: conditions that differ in their noise level see the same underlying draws).
-    const NoiseKey noise{hash_u64(trials.front().seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0),
-                         static_cast<std::uint64_t>(step_index)};
-    for (auto& u : sensors) {
-        u.lidar.scan(world, pose, u.scan, noise, u.rows);
-        u.full_cast = false;
+// Model i's BVC rates from its source's returns of this step. A scan cast with a plan's rows whose
+// pruning bound fails (almost nothing in view) is read again in full and summed exactly.
+bool GroupRun::model_rates(std::size_t i, const Pose& pose) {
+    SourceUse& u = sources[source_of[i]];
+    if (u.source->beam_table() && pose.level() && layers[i].rates_pruned(u.scan, plans[i], bvc_rates[i])) return true;
+    if (!u.source->beam_table() || !pose.level()) {
+        layers[i].rates(u.scan, bvc_rates[i]);  // every return was read
+        return true;
+    }
+    if (!u.full_read) u.source->returns(static_cast<std::uint64_t>(step_index), pose, {}, u.full);
+    u.full_read = true;
+    layers[i].rates(u.full, bvc_rates[i]);
+    return false;
+}
+
+void GroupRun::step(const ModelStep& s, bool learn, bool record) {
+    static const std::vector<char> all_rows;
+    for (auto& u : sources) {
+        u.source->returns(static_cast<std::uint64_t>(step_index), s.pose, s.pose.level() ? u.rows : all_rows, u.scan);
+        u.full_read = false;
     }
     for (std::size_t i = 0; i < layers.size(); ++i) {
-        SensorUse& u = sensors[sensor_of[i]];
-        if (!layers[i].rates_pruned(u.scan, plans[i], bvc_rates[i])) {
-            // The pruning bound failed (almost nothing in view): every beam, the full sum.
-            if (!u.full_cast) u.lidar.scan(world, pose, u.full, noise);
-            u.full_cast = true;
-            layers[i].rates(u.full, bvc_rates[i]);
-            ++result.stats.full_scan_fallbacks;
-        }
+        if (!model_rates(i, s.pose)) ++result.stats.full_scan_fallbacks;
         const auto v = nets[i].step(bvc_rates[i], learn);
         if (record) {
             auto& rec = result.models[i];
@@ -124,9 +138,10 @@ void GroupRun::step(const WalkStep& s, bool learn, bool record) {
     }
     if (record) {
         result.t.push_back(s.t);
-        result.x.push_back(s.x);
-        result.y.push_back(s.y);
-        result.heading.push_back(s.heading);
+        result.x.push_back(s.pose.x);
+        result.y.push_back(s.pose.y);
+        result.z.push_back(s.pose.z);
+        result.heading.push_back(s.pose.heading);
     }
     ++step_index;
     result.stats.bumps += s.bumped;
@@ -137,16 +152,16 @@ GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {
     // The state, and only the samples recorded since the last checkpoint.
     GroupCheckpoint c;
     c.fingerprint = fingerprint;
-    c.walk = walk.state();
+    c.agent_state = agent->save_state();
     c.step_index = step_index;
     c.segments = ckpt_segments;
     c.saved = ckpt_saved;
     c.partial.stats = result.stats;
     const auto from = static_cast<std::ptrdiff_t>(ckpt_saved);
-    c.partial.t.assign(result.t.begin() + from, result.t.end());
-    c.partial.x.assign(result.x.begin() + from, result.x.end());
-    c.partial.y.assign(result.y.begin() + from, result.y.end());
-    c.partial.heading.assign(result.heading.begin() + from, result.heading.end());
+    for (auto [to, all] : {std::pair{&c.partial.t, &result.t}, std::pair{&c.partial.x, &result.x},
+                           std::pair{&c.partial.y, &result.y}, std::pair{&c.partial.z, &result.z},
+                           std::pair{&c.partial.heading, &result.heading}})
+        to->assign(all->begin() + from, all->end());
     for (std::size_t i = 0; i < nets.size(); ++i) {
         const auto& rec = result.models[i];
         ModelRecord m;
@@ -154,8 +169,8 @@ GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {
         m.n_bvc = rec.n_bvc;
         m.rates.assign(rec.rates.begin() + from * rec.n_place, rec.rates.end());
         if (!rec.bvc.empty()) m.bvc.assign(rec.bvc.begin() + from * rec.n_bvc, rec.bvc.end());
+        m.weights = nets[i].weights();
         c.partial.models.push_back(std::move(m));
-        c.partial.models[i].weights = nets[i].weights();
         c.membrane.emplace_back(nets[i].membrane().begin(), nets[i].membrane().end());
         c.place_rates.emplace_back(nets[i].rates().begin(), nets[i].rates().end());
     }
@@ -164,7 +179,7 @@ GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {
 
 void GroupRun::restore(const GroupCheckpoint& c) {
     if (c.partial.models.size() != nets.size()) throw InputError("checkpoint does not match the group");
-    walk.restore(c.walk);
+    agent->restore_state(c.agent_state);
     step_index = c.step_index;
     ckpt_segments = c.segments;
     ckpt_saved = c.saved;
@@ -187,7 +202,14 @@ std::string group_fingerprint(const std::vector<TrialConfig>& trials) {
 
 GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunControl& control) {
     check_group(trials);
-    GroupRun run(trials);
+    const World world(trials.front().world.resolve());
+    return run_trial_group(world, trials, control);
+}
+
+GroupResult run_trial_group(const World& world, const std::vector<TrialConfig>& trials, const RunControl& control,
+                            const SourceFactory& sources) {
+    check_group(trials);
+    GroupRun run(world, trials, sources);
     const std::string fingerprint = group_fingerprint(trials);
     if (!control.checkpoint.empty() && std::filesystem::exists(control.checkpoint)) {
         const auto saved = read_checkpoint(control.checkpoint);
@@ -198,30 +220,33 @@ GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunCon
     const double t_explore = online ? 0.0 : p.explore_hours * 3600.0;
     const double t_end = t_explore + p.sample_hours * 3600.0;
     const double ckpt_every = control.checkpoint_minutes * 60.0;
-    double next_ckpt = ckpt_every > 0 ? (std::floor(run.walk.time() / ckpt_every) + 1) * ckpt_every : INFINITY;
+    double next_ckpt = ckpt_every > 0 ? (std::floor(run.agent->time() / ckpt_every) + 1) * ckpt_every : INFINITY;
 
     for (std::int64_t n = 0;; ++n) {
-        const bool sampling = run.walk.time() >= t_explore;
-        const auto s = run.walk.next(sampling ? t_end : t_explore);
+        const bool sampling = run.agent->time() >= t_explore;
+        const auto s = run.agent->next(sampling ? t_end : t_explore);
         if (!s) {
             if (sampling) break;
+            if (run.agent->finished())
+                throw InputError("the agent's path ends after " + format_number(run.agent->time() / 3600) +
+                                 " h, before the recorded phase begins (explore_hours = " + format_number(p.explore_hours) + ")");
             continue;  // exploration is over: go on sampling from here
         }
         run.step(*s, !sampling || online, sampling);
-        if (control.progress && n % 512 == 0) control.progress(run.walk.time(), run.step_index);
+        if (control.progress && n % 512 == 0) control.progress(run.agent->time(), run.step_index);
         const bool stop = control.stop && n % 64 == 0 && control.stop->load();
-        if (!control.checkpoint.empty() && (stop || run.walk.time() >= next_ckpt)) {
+        if (!control.checkpoint.empty() && (stop || run.agent->time() >= next_ckpt)) {
             GroupCheckpoint c = run.checkpoint(fingerprint);
             write_checkpoint(control.checkpoint, c);
             run.ckpt_segments = c.segments;
             run.ckpt_saved = c.saved;
-            while (next_ckpt <= run.walk.time()) next_ckpt += ckpt_every;
+            while (next_ckpt <= run.agent->time()) next_ckpt += ckpt_every;
         }
         if (stop) throw Interrupted();
     }
-    if (control.progress) control.progress(run.walk.time(), run.step_index);
+    if (control.progress) control.progress(run.agent->time(), run.step_index);
     for (std::size_t i = 0; i < run.nets.size(); ++i) run.result.models[i].weights = run.nets[i].weights();
-    run.result.stats.end_time = run.walk.time();
+    run.result.stats.end_time = run.agent->time();
     return std::move(run.result);
 }
 

@@ -1,18 +1,21 @@
 #pragma once
-// Runs trials (SPEC §7): the random walk, the sensors, and each model's BVC layer and place cells.
+// Runs trials: the agent's steps, each model's returns, BVC layer and place cells.
 // Takes: trial configurations. Gives: the recorded samples and trained weights of each.
 //
-// A group is several models in one world with one seed: they share one walk (the walk has its
-// own random stream) and each distinct sensor is cast once per step, with the union of the rows
-// the models need. Each model's results are bit-identical to running it alone.
+// A group is several models on one agent in one world with one seed: they share the agent's steps
+// (the agent has its own random stream) and each distinct return source is read once per step
+// (a ray-cast sensor with the union of the rows the models need). Each model's results are
+// bit-identical to running it alone.
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
-#include "bvc3d/experiment/trial_config.hpp"
+#include "bvc3d/config/trial_config.hpp"
 #include "bvc3d/recorder/trial_record.hpp"
+#include "bvc3d/sensor/return_source.hpp"
 
 namespace bvc3d {
 
@@ -29,8 +32,15 @@ struct RunControl {
     double checkpoint_minutes = 0;                      // > 0: also every this many simulated minutes
 };
 
-// All trials must share world, seed, protocol and robot (InputError otherwise).
+// Where each model's returns come from. Models given the same source share it. Default: the
+// model's sensor ray-cast in the world (models with the same beam table share one).
+using SourceFactory = std::function<std::shared_ptr<ReturnSource>(const ModelSpec& model, const World& world)>;
+
+// All trials must share world, seed, protocol and agent (InputError otherwise).
 GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunControl& control = {});
+// The same in a world already built from trials.front().world.
+GroupResult run_trial_group(const World& world, const std::vector<TrialConfig>& trials, const RunControl& control = {},
+                            const SourceFactory& sources = {});
 
 // Fingerprint of a group: what its checkpoint must match to be resumed.
 std::string group_fingerprint(const std::vector<TrialConfig>& trials);

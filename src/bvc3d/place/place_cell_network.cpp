@@ -10,15 +10,19 @@
 
 namespace bvc3d {
 
-void PlaceParams::validate() const {
-    auto fail = [](const std::string& what) { throw InputError("place cells: " + what); };
-    if (n_place < 1 || n_place > 1000000) fail("n_place must be in [1, 1000000]");
-    if (!(p_connect >= 0 && p_connect <= 1)) fail("p_connect must be in [0, 1]");
-    if (!(std::isfinite(dt_over_tau) && dt_over_tau > 0 && dt_over_tau <= 1)) fail("dt_over_tau must be in (0, 1]");
-    if (!(std::isfinite(gamma_pb) && std::isfinite(gamma_pp))) fail("gamma_pb and gamma_pp must be finite");
-    if (!(std::isfinite(gain) && gain > 0)) fail("gain must be > 0");
-    if (!(std::isfinite(eta) && eta >= 0)) fail("eta must be >= 0");
-    if (!(std::isfinite(alpha_pb) && alpha_pb > 0)) fail("alpha_pb must be > 0");
+const params::Table<PlaceParams>& PlaceParams::table() {
+    using namespace params;
+    static const Table<PlaceParams> t(
+        "place cells",
+        {integer("n_place", &PlaceParams::n_place, closed(1, 1000000), "place cells"),
+         real("p_connect", &PlaceParams::p_connect, closed(0, 1), "initial weights are Bernoulli(p_connect)"),
+         real("dt_over_tau", &PlaceParams::dt_over_tau, open_closed(0, 1), "Δt/τ_p, the membrane's Euler step"),
+         real("gamma_pb", &PlaceParams::gamma_pb, finite(), "feedforward inhibition Γ_pb"),
+         real("gamma_pp", &PlaceParams::gamma_pp, finite(), "recurrent inhibition Γ_pp"),
+         real("gain", &PlaceParams::gain, open_closed(0, 1e6), "g in v = tanh(g·[s]+)"),
+         real("eta", &PlaceParams::eta, closed(0, 1e6), "learning rate η = Δt/τ_W"),
+         real("alpha_pb", &PlaceParams::alpha_pb, above(0), "α_pb of Oja's rule")});
+    return t;
 }
 
 PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::uint64_t seed)

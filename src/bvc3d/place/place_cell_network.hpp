@@ -1,5 +1,6 @@
 #pragma once
-// Place-cell stage (SPEC §6): a rate network driven by BVCs, learning with Oja's rule.
+// Place-cell stage (docs/model-reference.md#place-cells): a rate network driven by BVCs, learning
+// with Oja's rule.
 // Takes: BVC rates, one vector per model step. Gives: place-cell rates.
 //
 // Single precision (weights, membrane, rates): the recorded rates are float32 anyway, and sums run
@@ -8,6 +9,8 @@
 #include <cstdint>
 #include <span>
 #include <vector>
+
+#include "bvc3d/core/params.hpp"
 
 namespace bvc3d {
 
@@ -20,7 +23,8 @@ struct PlaceParams {
     double gain = 1.0;          // g in v = tanh(g·[s]+)
     double eta = 0.096;         // learning rate Δt/τ_W
     double alpha_pb = 0.70710678118654752;  // √0.5
-    void validate() const;
+    static const params::Table<PlaceParams>& table();
+    void validate() const { table().check(*this); }
 };
 
 class PlaceCellNetwork {

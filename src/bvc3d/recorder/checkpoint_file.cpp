@@ -25,6 +25,7 @@ void write_segment(const std::filesystem::path& path, const GroupResult& r) {
         h5::write(f, "t", r.t, {n});
         h5::write(f, "x", r.x, {n});
         h5::write(f, "y", r.y, {n});
+        h5::write(f, "z", r.z, {n});
         h5::write(f, "heading", r.heading, {n});
         for (std::size_t i = 0; i < r.models.size(); ++i) {
             h5::write(f, "rates" + std::to_string(i), r.models[i].rates, {r.models[i].rates.size()});
@@ -46,6 +47,7 @@ void read_segment(const std::filesystem::path& path, GroupResult& r) {
     append(r.t, h5::read_doubles(f, "t"));
     append(r.x, h5::read_doubles(f, "x"));
     append(r.y, h5::read_doubles(f, "y"));
+    append(r.z, h5::read_doubles(f, "z"));
     append(r.heading, h5::read_doubles(f, "heading"));
     for (std::size_t i = 0; i < r.models.size(); ++i) {
         append(r.models[i].rates, h5::read_floats(f, "rates" + std::to_string(i)));
@@ -68,13 +70,7 @@ void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c) {
         h5::write_attr(f, "segments", static_cast<std::int64_t>(segments));
         h5::write_attr(f, "samples", static_cast<std::int64_t>(saved));
         h5::write_attr(f, "step_index", c.step_index);
-        h5::write_attr(f, "walk_x", c.walk.pose.x);
-        h5::write_attr(f, "walk_y", c.walk.pose.y);
-        h5::write_attr(f, "walk_heading", c.walk.pose.heading);
-        h5::write_attr(f, "walk_t", c.walk.t);
-        h5::write_attr(f, "walk_steps_since_turn", static_cast<std::int64_t>(c.walk.steps_since_turn));
-        h5::write_attr(f, "walk_bump_pending", static_cast<std::int64_t>(c.walk.bump_pending));
-        h5::write_attr(f, "walk_rng", c.walk.rng_state);
+        h5::write_attr(f, "agent_state", c.agent_state);
         const auto& s = c.partial.stats;
         h5::write_attr(f, "explore_steps", s.explore_steps);
         h5::write_attr(f, "sample_steps", s.sample_steps);
@@ -108,12 +104,7 @@ std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path
         c.segments = static_cast<std::size_t>(h5::read_attr_int(f, "segments"));
         c.saved = static_cast<std::size_t>(h5::read_attr_int(f, "samples"));
         c.step_index = h5::read_attr_int(f, "step_index");
-        c.walk.pose = {h5::read_attr_double(f, "walk_x"), h5::read_attr_double(f, "walk_y"),
-                       h5::read_attr_double(f, "walk_heading")};
-        c.walk.t = h5::read_attr_double(f, "walk_t");
-        c.walk.steps_since_turn = static_cast<int>(h5::read_attr_int(f, "walk_steps_since_turn"));
-        c.walk.bump_pending = h5::read_attr_int(f, "walk_bump_pending") != 0;
-        c.walk.rng_state = h5::read_attr_string(f, "walk_rng");
+        c.agent_state = h5::read_attr_string(f, "agent_state");
         auto& s = c.partial.stats;
         s.explore_steps = h5::read_attr_int(f, "explore_steps");
         s.sample_steps = h5::read_attr_int(f, "sample_steps");

@@ -190,6 +190,41 @@ std::int64_t read_attr_int(hid_t obj, const std::string& name) {
     return v;
 }
 
+void write_attr(hid_t obj, const std::string& name, const params::Value& value) {
+    if (const auto* d = std::get_if<double>(&value)) write_attr(obj, name, *d);
+    else if (const auto* i = std::get_if<long long>(&value)) write_attr(obj, name, static_cast<std::int64_t>(*i));
+    else if (const auto* b = std::get_if<bool>(&value)) write_attr(obj, name, static_cast<std::int64_t>(*b));
+    else if (const auto* t = std::get_if<std::string>(&value)) write_attr(obj, name, *t);
+    else throw std::logic_error("HDF5: attribute '" + name + "' cannot hold a list");
+}
+
+params::Value read_attr(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
+    Handle type(check(H5Aget_type(a), "type"), H5Tclose);
+    switch (H5Tget_class(type)) {
+        case H5T_STRING: return read_attr_string(obj, name);
+        case H5T_INTEGER: return static_cast<long long>(read_attr_int(obj, name));
+        case H5T_FLOAT: return read_attr_double(obj, name);
+        default: fail("attribute '" + name + "' is neither a number nor text");
+    }
+}
+
+namespace {
+herr_t collect_name(hid_t, const char* name, const H5A_info_t*, void* out) {
+    static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+    return 0;
+}
+}  // namespace
+
+std::vector<std::string> attribute_names(hid_t obj) {
+    auto lock = hdf5_lock();
+    std::vector<std::string> names;
+    hsize_t at = 0;
+    check(H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, &at, collect_name, &names), "attribute names");
+    return names;
+}
+
 void write(hid_t loc, const std::string& name, const std::vector<double>& v, std::vector<std::size_t> d, bool c) {
     write_any(loc, name, v, std::move(d), H5T_NATIVE_DOUBLE, c);
 }

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/core/params.hpp"
+
 namespace bvc3d::h5 {
 
 std::unique_lock<std::recursive_mutex> hdf5_lock();
@@ -44,6 +46,12 @@ void write_attr(hid_t obj, const std::string& name, std::int64_t value);
 std::string read_attr_string(hid_t obj, const std::string& name);
 double read_attr_double(hid_t obj, const std::string& name);
 std::int64_t read_attr_int(hid_t obj, const std::string& name);
+// A parameter value as an attribute: reals as float64, integers as int64, text, flags as int64 0/1,
+// lists as float64 datasets are not attributes (rejected).
+void write_attr(hid_t obj, const std::string& name, const params::Value& value);
+// Any scalar attribute as a value (float → double, integer → long long, text → string).
+params::Value read_attr(hid_t obj, const std::string& name);
+std::vector<std::string> attribute_names(hid_t obj);
 
 // Row-major datasets of 1 or 2 dimensions; chunked and compressed when `compress` (for h5py users
 // this is transparent).

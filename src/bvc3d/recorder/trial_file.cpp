@@ -1,5 +1,6 @@
 #include "bvc3d/recorder/trial_file.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "bvc3d/core/atomic_file.hpp"
@@ -10,92 +11,54 @@ namespace bvc3d {
 
 namespace {
 
-template <class T>
-std::vector<T> column(const Eigen::Ref<const Eigen::VectorXd>& v) {
-    return std::vector<T>(v.data(), v.data() + v.size());
+void write_identity(hid_t f, const TrialIdentity& id) {
+    h5::write_attr(f, "format", std::string("bvc3d-trial"));
+    h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_format_version));
+    h5::write_attr(f, "name", id.name);
+    h5::write_attr(f, "condition", id.condition);
+    std::string swept;
+    for (const auto& [k, v] : id.swept) swept += k + "=" + v + "\n";
+    h5::write_attr(f, "swept", swept);
+    h5::write_attr(f, "world", id.world);
+    h5::write_attr(f, "world_source", id.world_source);
+    if (std::isfinite(id.tilt_deg)) h5::write_attr(f, "tilt_deg", id.tilt_deg);
+    h5::write_attr(f, "model", id.model);
+    h5::write_attr(f, "sensor", id.sensor);
+    h5::write_attr(f, "seed", static_cast<std::int64_t>(id.seed));
+    h5::write_attr(f, "protocol", id.protocol);
+    h5::write_attr(f, "explore_hours", id.explore_hours);
+    h5::write_attr(f, "sample_hours", id.sample_hours);
+    h5::write_attr(f, "config", id.config);
+    h5::write_attr(f, "fingerprint", id.fingerprint);
 }
 
-void write_metrics(hid_t f, const analysis::TrialMetrics& m, const analysis::AnalysisParams& p) {
+void write_array(hid_t loc, const NamedArray& a) {
+    std::visit([&](const auto& v) { h5::write(loc, a.name, v, a.shape, a.compress); }, a.data);
+}
+
+void write_metrics(hid_t f, const MetricsRecord& m) {
     const auto g = h5::create_group(f, "metrics");
-    for (const auto& [name, value] : scalar_metrics(m)) h5::write_attr(g, name, value);
-    // How they were computed, so that `bvc3d analyze` starts from the same parameters.
-    h5::write_attr(g, "gridsize", static_cast<std::int64_t>(p.gridsize));
-    h5::write_attr(g, "quantile", p.quantile);
-    h5::write_attr(g, "eps", p.dbscan.eps);
-    h5::write_attr(g, "min_samples", static_cast<std::int64_t>(p.dbscan.min_samples));
-    h5::write_attr(g, "d_th", p.d_th);
-    h5::write_attr(g, "decoding_templates", analysis::decoding_templates_name(p.decoding_templates));
-    if (p.extent) h5::write(g, "extent", std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, {4}, false);
-    const auto& bins = m.maps.bins;
-    const std::size_t nb = static_cast<std::size_t>(bins.size()), nc = static_cast<std::size_t>(m.maps.map.cols());
-    h5::write(g, "modality", std::vector<std::int64_t>(m.modality.begin(), m.modality.end()), {m.modality.size()});
-    h5::write(g, "bin_centers", std::vector<double>(bins.centers.data(), bins.centers.data() + 2 * nb), {nb, 2});
-    h5::write(g, "bin_counts", std::vector<std::int64_t>(bins.counts.begin(), bins.counts.end()), {nb});
-    h5::write(g, "sai", column<double>(m.aliasing.sai), {nb});
-    std::vector<float> maps(nb * nc);
-    for (std::size_t i = 0; i < maps.size(); ++i) maps[i] = static_cast<float>(m.maps.map.data()[i]);
-    h5::write(g, "rate_maps", maps, {nb, nc});
-    h5::write(g, "peak_rate", m.cells.peak_rate, {nc});
-    h5::write(g, "field_area", m.cells.field_area, {nc});
-    h5::write(g, "spatial_info", m.cells.spatial_info, {nc});
+    for (const auto& [name, value] : m.scalars) h5::write_attr(g, name, value);
+    for (const auto& [name, value] : m.parameters) h5::write_attr(g, name, value);
+    for (const auto& a : m.arrays) write_array(g, a);
 }
 
 }  // namespace
 
-const std::vector<std::string>& scalar_metric_names() {
-    static const std::vector<std::string> names{"frac_active", "mean_mi_active", "frac_multimodal",
-                                                "msai",        "decode_median_m", "decode_mean_m",
-                                                "n_bins",      "n_decoded",      "n_undecoded"};
-    return names;
-}
-
-std::vector<std::pair<std::string, double>> scalar_metrics(const analysis::TrialMetrics& m) {
-    const double values[] = {m.modality_summary.frac_active,
-                             m.modality_summary.mean_mi_active,
-                             m.modality_summary.frac_multimodal,
-                             m.aliasing.msai,
-                             m.decoding.median_m,
-                             m.decoding.mean_m,
-                             static_cast<double>(m.maps.bins.size()),
-                             static_cast<double>(m.decoding.n_decoded),
-                             static_cast<double>(m.decoding.n_undecoded)};
-    std::vector<std::pair<std::string, double>> out;
-    for (std::size_t i = 0; i < scalar_metric_names().size(); ++i) out.emplace_back(scalar_metric_names()[i], values[i]);
-    return out;
-}
-
-void write_trial_file(const std::filesystem::path& path, const TrialConfig& config, const GroupResult& group,
-                      std::size_t model_index, const analysis::TrialMetrics& metrics,
-                      const analysis::AnalysisParams& params) {
+void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id, const GroupResult& group,
+                      std::size_t model_index, const MetricsRecord& metrics) {
     const ModelRecord& rec = group.models.at(model_index);
     const std::size_t n = group.t.size();
     AtomicFile out(path);
     {
         auto lock = h5::hdf5_lock();
         const auto f = h5::create_file(out.temp_path().string());
-        h5::write_attr(f, "format", std::string("bvc3d-trial"));
-        h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_format_version));
-        h5::write_attr(f, "name", config.name());
-        h5::write_attr(f, "condition", config.condition_label());
-        std::string swept;
-        for (const auto& [k, v] : config.swept) swept += k + "=" + v + "\n";
-        h5::write_attr(f, "swept", swept);
-        h5::write_attr(f, "world", config.world.label());
-        h5::write_attr(f, "world_source", config.world.source);
-        if (const auto tilt = config.world.resolve().tilt_deg) h5::write_attr(f, "tilt_deg", *tilt);
-        h5::write_attr(f, "model", config.model.name);
-        h5::write_attr(f, "sensor", config.model.sensor.name);
-        h5::write_attr(f, "seed", static_cast<std::int64_t>(config.seed));
-        h5::write_attr(f, "protocol", protocol_name(config.protocol.kind));
-        h5::write_attr(f, "explore_hours", config.protocol.explore_hours);
-        h5::write_attr(f, "sample_hours", config.protocol.sample_hours);
-        h5::write_attr(f, "config", config.canonical());
-        h5::write_attr(f, "fingerprint", config.fingerprint());
-
+        write_identity(f, id);
         const auto s = h5::create_group(f, "samples");
         h5::write(s, "t", group.t, {n});
         h5::write(s, "x", group.x, {n});
         h5::write(s, "y", group.y, {n});
+        if (std::any_of(group.z.begin(), group.z.end(), [](double z) { return z != 0.0; })) h5::write(s, "z", group.z, {n});
         h5::write(s, "heading", group.heading, {n});
         h5::write(s, "rates", rec.rates, {n, static_cast<std::size_t>(rec.n_place)});
         if (!rec.bvc.empty()) h5::write(s, "bvc_rates", rec.bvc, {n, static_cast<std::size_t>(rec.n_bvc)});
@@ -107,12 +70,12 @@ void write_trial_file(const std::filesystem::path& path, const TrialConfig& conf
         h5::write_attr(w, "bumps", group.stats.bumps);
         h5::write_attr(w, "full_scan_fallbacks", group.stats.full_scan_fallbacks);
         h5::write_attr(w, "end_time", group.stats.end_time);
-        write_metrics(f, metrics, params);
+        write_metrics(f, metrics);
     }
     out.commit();
 }
 
-std::optional<std::string> trial_file_fingerprint(const std::filesystem::path& path) {
+std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
     try {
@@ -120,13 +83,14 @@ std::optional<std::string> trial_file_fingerprint(const std::filesystem::path& p
         const auto f = h5::open_file(path.string());
         if (h5::read_attr_string(f, "format") != "bvc3d-trial") return std::nullopt;
         if (!h5::exists(f, "metrics")) return std::nullopt;
-        return h5::read_attr_string(f, "fingerprint");
+        return TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
     } catch (const InputError&) {
         return std::nullopt;
     }
 }
 
 namespace {
+
 h5::Handle open_trial(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
@@ -143,20 +107,30 @@ h5::Handle open_trial(const std::filesystem::path& path) {
 
 TrialIdentity read_identity(hid_t f) {
     TrialIdentity id;
+    auto text = [&](const char* name) { return h5::exists_attr(f, name) ? h5::read_attr_string(f, name) : std::string(); };
+    auto number = [&](const char* name) { return h5::exists_attr(f, name) ? h5::read_attr_double(f, name) : NAN; };
     id.name = h5::read_attr_string(f, "name");
     id.world = h5::read_attr_string(f, "world");
     id.model = h5::read_attr_string(f, "model");
     id.seed = static_cast<std::uint64_t>(h5::read_attr_int(f, "seed"));
-    id.tilt_deg = h5::exists_attr(f, "tilt_deg") ? h5::read_attr_double(f, "tilt_deg") : NAN;
+    id.tilt_deg = number("tilt_deg");
+    id.world_source = text("world_source");
+    id.sensor = text("sensor");
+    id.protocol = text("protocol");
+    id.config = text("config");
+    id.fingerprint = text("fingerprint");
+    id.explore_hours = number("explore_hours");
+    id.sample_hours = number("sample_hours");
     // Files from before conditions were recorded: the paper's condition, model and world.
     id.condition = h5::exists_attr(f, "condition") ? h5::read_attr_string(f, "condition") : id.world + "_" + id.model;
-    std::istringstream swept(h5::exists_attr(f, "swept") ? h5::read_attr_string(f, "swept") : std::string());
+    std::istringstream swept(text("swept"));
     for (std::string line; std::getline(swept, line);) {
         const auto eq = line.find('=');
         if (eq != std::string::npos) id.swept.emplace_back(line.substr(0, eq), line.substr(eq + 1));
     }
     return id;
 }
+
 }  // namespace
 
 TrialFileData read_trial_samples(const std::filesystem::path& path) {
@@ -164,43 +138,29 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     const auto f = open_trial(path);
     TrialFileData d;
     static_cast<TrialIdentity&>(d) = read_identity(f);
-    d.protocol = h5::read_attr_string(f, "protocol");
-    d.config = h5::read_attr_string(f, "config");
     const auto g = h5::open_group(f, "metrics");
-    if (h5::exists_attr(g, "gridsize")) {
-        d.analysis.gridsize = static_cast<int>(h5::read_attr_int(g, "gridsize"));
-        d.analysis.quantile = h5::read_attr_double(g, "quantile");
-        d.analysis.dbscan.eps = h5::read_attr_double(g, "eps");
-        d.analysis.dbscan.min_samples = static_cast<int>(h5::read_attr_int(g, "min_samples"));
-        d.analysis.d_th = h5::read_attr_double(g, "d_th");
-    }
-    // Files from before the template choice was recorded decoded with raw means.
-    d.analysis.decoding_templates =
-        h5::exists_attr(g, "decoding_templates")
-            ? analysis::parse_decoding_templates(h5::read_attr_string(g, "decoding_templates"))
-            : (h5::exists_attr(g, "gridsize") ? analysis::DecodingTemplates::rate_maps : analysis::DecodingTemplates::means);
-    if (h5::exists(g, "extent")) {
-        const auto e = h5::read_doubles(g, "extent");
-        if (e.size() == 4) d.analysis.extent = analysis::Extent{e[0], e[1], e[2], e[3]};
-    }
+    for (const auto& name : h5::attribute_names(g)) d.metric_attributes.emplace_back(name, h5::read_attr(g, name));
+    if (h5::exists(g, "extent")) d.extent = h5::read_doubles(g, "extent");
     const auto s = h5::open_group(f, "samples");
     d.x = h5::read_doubles(s, "x");
     d.y = h5::read_doubles(s, "y");
+    if (h5::exists(s, "z")) d.z = h5::read_doubles(s, "z");
     const auto dims = h5::dims(s, "rates");
-    if (dims.size() != 2 || dims[0] != d.x.size()) throw InputError("'" + path.string() + "': samples/rates has the wrong shape");
-    const auto flat = h5::read_floats(s, "rates");
-    d.rates = Eigen::Map<const analysis::RowMatrixXf>(flat.data(), static_cast<Eigen::Index>(dims[0]),
-                                                      static_cast<Eigen::Index>(dims[1]));
+    if (dims.size() != 2 || dims[0] != d.x.size() || d.y.size() != d.x.size() || (!d.z.empty() && d.z.size() != d.x.size()))
+        throw InputError("'" + path.string() + "': samples/rates has the wrong shape");
+    d.rates = h5::read_floats(s, "rates");
+    d.n_place = dims[1];
     return d;
 }
 
-TrialSummaryRow read_trial_summary(const std::filesystem::path& path) {
+TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names) {
     auto lock = h5::hdf5_lock();
     const auto f = open_trial(path);
     TrialSummaryRow r;
     static_cast<TrialIdentity&>(r) = read_identity(f);
     const auto g = h5::open_group(f, "metrics");
-    for (const auto& name : scalar_metric_names()) r.metrics.emplace_back(name, h5::read_attr_double(g, name));
+    for (const auto& name : metric_names)
+        r.metrics.emplace_back(name, h5::exists_attr(g, name) ? h5::read_attr_double(g, name) : NAN);
     return r;
 }
 

@@ -1,52 +1,75 @@
 #pragma once
-// Trial files (SPEC §9): one HDF5 file per trial with the configuration as attributes, the
-// recorded samples, the trained weights and the metrics. The layout is in docs/trial-files.md.
+// Trial files: one HDF5 file per trial with the trial's identity and configuration as attributes,
+// the recorded samples, the trained weights and the metrics (layout: docs/trial-files.md).
+// Takes: a GroupResult, the trial's identity and its metrics as named values and arrays (the
+// recorder does not interpret them). Gives: files, and what they hold read back.
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <variant>
+#include <vector>
 
-#include "bvc3d/analysis/trial_metrics.hpp"
-#include "bvc3d/experiment/trial_config.hpp"
+#include "bvc3d/core/params.hpp"
 #include "bvc3d/recorder/trial_record.hpp"
 
 namespace bvc3d {
 
 inline constexpr int trial_file_format_version = 1;
 
-// Writes the file atomically: it appears only when complete.
-// `params` are the analysis parameters the metrics were computed with; they are stored with them.
-void write_trial_file(const std::filesystem::path& path, const TrialConfig& config, const GroupResult& group,
-                      std::size_t model_index, const analysis::TrialMetrics& metrics,
-                      const analysis::AnalysisParams& params);
-
-// The fingerprint of a complete trial file, or nullopt if it is missing, broken or not a trial file.
-std::optional<std::string> trial_file_fingerprint(const std::filesystem::path& path);
-
-// Which trial a file holds.
+// Which trial a file holds and how it was configured (the root attributes).
 struct TrialIdentity {
-    std::string name, condition, world, model;
+    std::string name, condition, world, world_source, model, sensor, protocol, config, fingerprint;
     std::vector<std::pair<std::string, std::string>> swept;  // the condition's defining values
     std::uint64_t seed = 0;
     double tilt_deg = NAN;  // cross arenas only
+    double explore_hours = NAN, sample_hours = NAN;
 };
+
+// A named array of a trial file, row-major with the given shape.
+struct NamedArray {
+    std::string name;
+    std::vector<std::size_t> shape;
+    std::variant<std::vector<double>, std::vector<float>, std::vector<std::int64_t>> data;
+    bool compress = true;
+};
+
+// The /metrics group: scalar metrics and the parameters they were computed with (attributes, in
+// this order), and per-bin or per-cell arrays.
+struct MetricsRecord {
+    std::vector<std::pair<std::string, double>> scalars;
+    std::vector<std::pair<std::string, params::Value>> parameters;
+    std::vector<NamedArray> arrays;
+};
+
+// Writes the file atomically: it appears only when complete. z is written when any sample has z != 0.
+void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id, const GroupResult& group,
+                      std::size_t model_index, const MetricsRecord& metrics);
+
+// A complete trial file's fingerprint and the names of the attributes under /metrics (the metrics
+// it holds, with their parameters); nullopt if the file is missing, broken or not a trial file.
+struct TrialStamp {
+    std::string fingerprint;
+    std::vector<std::string> metric_attributes;
+};
+std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path);
 
 // What `bvc3d analyze` reads back.
 struct TrialFileData : TrialIdentity {
-    std::string protocol, config;
-    analysis::AnalysisParams analysis;  // the parameters its metrics were computed with (defaults if unrecorded)
-    std::vector<double> x, y;
-    analysis::RowMatrixXf rates;  // samples × cells
+    std::vector<std::pair<std::string, params::Value>> metric_attributes;  // everything under /metrics
+    std::optional<std::vector<double>> extent;                          // /metrics/extent, if fixed
+    std::vector<double> x, y, z;                                        // z empty for ground trials
+    std::vector<float> rates;                                           // samples × n_place
+    std::size_t n_place = 0;
 };
 TrialFileData read_trial_samples(const std::filesystem::path& path);  // throws InputError
 
-// The scalar metrics stored in a trial file, by name (for summaries).
+// The named scalar metrics of a file, for summaries; a metric the file lacks (written before it
+// existed) reads as NaN.
 struct TrialSummaryRow : TrialIdentity {
     std::vector<std::pair<std::string, double>> metrics;
 };
-TrialSummaryRow read_trial_summary(const std::filesystem::path& path);  // throws InputError
-
-// The scalar metrics of an analysis (stored as attributes of /metrics), in the order summaries print them.
-const std::vector<std::string>& scalar_metric_names();
-std::vector<std::pair<std::string, double>> scalar_metrics(const analysis::TrialMetrics& m);
+TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names);
 
 }  // namespace bvc3d

@@ -1,10 +1,10 @@
 #pragma once
-// Recorder stage: what a trial records (SPEC §7, §9), in memory. trial_file.hpp writes it to HDF5.
+// Recorder stage: what a trial records, in memory (trial_file.hpp writes it to HDF5,
+// checkpoint_file.hpp saves a running one).
+// Takes: each model step's time and pose and each model's rates. Gives: the arrays of a trial.
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include "bvc3d/robot/random_walk.hpp"
 
 namespace bvc3d {
 
@@ -17,20 +17,20 @@ struct ModelRecord {
 
 struct WalkStats {
     std::int64_t explore_steps = 0, sample_steps = 0, bumps = 0, full_scan_fallbacks = 0;
-    double end_time = 0;  // simulated seconds at the end of the walk
+    double end_time = 0;  // seconds of agent time at the end
 };
 
-// A group of models on one walk: the samples' positions are shared, the records are per model.
+// A group of models on one agent's steps: the samples' poses are shared, the records are per model.
 struct GroupResult {
-    std::vector<double> t, x, y, heading;  // one per recorded sample
-    std::vector<ModelRecord> models;       // in the order of the group's trials
+    std::vector<double> t, x, y, z, heading;  // one per recorded sample
+    std::vector<ModelRecord> models;          // in the order of the group's trials
     WalkStats stats;
 };
 
 // Everything needed to continue a group exactly where it stopped.
 struct GroupCheckpoint {
     std::string fingerprint;  // of the group's configuration
-    WalkState walk;
+    std::string agent_state;  // Agent::save_state()
     std::int64_t step_index = 0;
     GroupResult partial;  // samples (see below); per model the current weights
     std::vector<std::vector<float>> membrane, place_rates;  // per model

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 
+#include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -20,16 +21,6 @@ std::string fixed(double v, int digits) {
     std::snprintf(buf, sizeof buf, "%.*f", digits, v);
     return buf;
 }
-
-// Human headings and precision for the Markdown table.
-struct Column {
-    const char* metric;
-    const char* heading;
-    int digits;
-};
-const Column markdown_columns[] = {{"frac_active", "MI>0 fraction", 3},   {"mean_mi_active", "mean MI (MI>0)", 2},
-                                   {"frac_multimodal", "MI>1 fraction", 3}, {"msai", "MSAI", 4},
-                                   {"decode_median_m", "decoding median (m)", 2}, {"decode_mean_m", "decoding mean (m)", 2}};
 
 // The swept keys of a table, in first-seen order.
 template <class Row>
@@ -60,7 +51,8 @@ std::string csv(const std::string& s) {
 
 std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files) {
     std::vector<TrialSummaryRow> rows;
-    for (const auto& f : files) rows.push_back(read_trial_summary(f));
+    const auto names = analysis::metric_names();
+    for (const auto& f : files) rows.push_back(read_trial_summary(f, names));
     return rows;
 }
 
@@ -124,20 +116,24 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
     if (plain) keys = {"model", "world"};
     os << '|';
     for (const auto& k : keys) os << ' ' << k << " |";
+    std::vector<const analysis::Metric*> columns;
+    for (const auto& m : analysis::metric_table())
+        if (m.digits >= 0) columns.push_back(&m);
     os << " seeds |";
-    for (const auto& c : markdown_columns) os << ' ' << c.heading << " |";
+    for (const auto* c : columns) os << ' ' << c->heading << " |";
     os << "\n|";
-    for (std::size_t i = 0; i < keys.size() + 1 + std::size(markdown_columns); ++i) os << "---|";
+    for (std::size_t i = 0; i < keys.size() + 1 + columns.size(); ++i) os << "---|";
     os << '\n';
     for (const auto& r : rows) {
         os << '|';
         for (const auto& k : keys) os << ' ' << (plain ? (k == "model" ? r.model : r.world) : swept_value(r, k)) << " |";
         os << ' ' << r.n_seeds << " |";
-        for (const auto& c : markdown_columns) {
-            const auto it = std::find(r.metric_names.begin(), r.metric_names.end(), c.metric);
+        for (const auto* c : columns) {
+            const auto it = std::find(r.metric_names.begin(), r.metric_names.end(), c->name);
             const std::size_t m = static_cast<std::size_t>(it - r.metric_names.begin());
-            os << ' ' << fixed(r.mean[m], c.digits);
-            if (r.n_seeds > 1) os << " ± " << fixed(r.sd[m], c.digits);
+            const bool known = m < r.mean.size();
+            os << ' ' << fixed(known ? r.mean[m] : NAN, c->digits);
+            if (r.n_seeds > 1) os << " ± " << fixed(known ? r.sd[m] : NAN, c->digits);
             os << " |";
         }
         os << '\n';

@@ -1,7 +1,8 @@
 #pragma once
-// Report stage (C++ side): the experiment summary (SPEC §9), one row per condition with every
-// metric's mean ± sd over seeds, as CSV and as a Markdown table. Figures are drawn by the Python
-// module bvc3d.report, which reads these files and the trial files.
+// Report stage (C++ side): the experiment summary, one row per condition with every metric's
+// mean ± sd over seeds, as CSV and as a Markdown table. Figures are drawn by the Python module
+// bvc3d.report, which reads these files and the trial files.
+// Takes: trial files (recorder) and the metric table (analysis). Gives: trials.csv, summary.csv/.md.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -21,6 +22,7 @@ struct SummaryRow {
 
 // Rows in the order conditions first appear in `trials`.
 std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials);
+// Every metric of the analysis stage's table, from each file (NaN where a file predates a metric).
 std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files);
 
 // Written atomically. The CSV has columns condition, model, world, tilt_deg, swept:<key>..., n_seeds,

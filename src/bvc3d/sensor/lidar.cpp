@@ -29,19 +29,25 @@ LidarSpec LidarSpec::spherical(bool upper_only) {
     return s;
 }
 
-void LidarSpec::validate() const {
-    auto fail = [&](const std::string& what) { throw InputError("sensor '" + name + "': " + what); };
-    if (elevations.empty()) fail("elevations must not be empty");
-    for (double e : elevations)
-        if (!std::isfinite(e) || std::abs(e) > pi / 2) fail("every elevation must lie in [-90°, 90°]");
-    if (azimuth_count < 1 || azimuth_count > 1000000) fail("azimuth_count must be in [1, 1000000]");
-    if (elevations.size() > 100000) fail("at most 100000 rows");
-    if (!std::isfinite(azimuth_offset)) fail("azimuth_offset must be finite");
-    if (!std::isfinite(height) || height < 0) fail("height must be >= 0");
-    if (!std::isfinite(max_range) || max_range <= 0) fail("max_range must be > 0");
-    if (!std::isfinite(range_noise_sd) || range_noise_sd < 0) fail("range_noise_sd must be >= 0");
-    if (!std::isfinite(dropout) || dropout < 0 || dropout >= 1) fail("dropout must be in [0, 1)");
+const params::Table<LidarSpec>& LidarSpec::table() {
+    using namespace params;
+    static const Table<LidarSpec> t(
+        "sensor",
+        {text("name", &LidarSpec::name, "a label (scans are identical whatever the name)"),
+         reals("elevations", &LidarSpec::elevations, closed(-pi / 2, pi / 2), "rad, the rows' elevations, top first")
+             .in_radians()
+             .sizes(1, 100000),
+         integer("azimuth_count", &LidarSpec::azimuth_count, closed(1, 1000000), "columns per row, evenly spaced"),
+         real("azimuth_offset", &LidarSpec::azimuth_offset, closed(-2 * pi, 2 * pi), "rad, the first column's azimuth")
+             .in_radians(),
+         real("height", &LidarSpec::height, closed(0, 1000), "m above the agent's base"),
+         real("max_range", &LidarSpec::max_range, open_closed(0, 1e5), "m, farthest return"),
+         real("range_noise_sd", &LidarSpec::range_noise_sd, closed(0, 1000), "m, Gaussian noise added to each range"),
+         real("dropout", &LidarSpec::dropout, closed_open(0, 1), "probability that a beam returns nothing")});
+    return t;
 }
+
+void LidarSpec::validate() const { table().check(*this); }
 
 Lidar::Lidar(LidarSpec spec) : spec_(std::move(spec)) {
     spec_.validate();
@@ -60,13 +66,18 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
                  const std::vector<char>& rows) const {
     out.clear();
     // Poses far outside any world are mistakes, and beyond ~1e18 Embree rejects the rays outright.
-    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.heading) || std::abs(pose.x) > 1e6 ||
-        std::abs(pose.y) > 1e6)
+    if (!pose.finite() || std::abs(pose.x) > 1e6 || std::abs(pose.y) > 1e6 || std::abs(pose.z) > 1e6)
         throw InputError("scan pose (" + std::to_string(pose.x) + ", " + std::to_string(pose.y) + ", " +
-                         std::to_string(pose.heading) + "): coordinates must be finite and within ±1e6 m");
+                         std::to_string(pose.z) + ", heading " + std::to_string(pose.heading) +
+                         "): coordinates must be finite and within ±1e6 m");
+    if (!pose.level()) {
+        if (!rows.empty()) throw InputError("a row mask applies to level poses only");
+        scan_tilted(world, pose, out, noise);
+        return;
+    }
     const std::size_t n_rows = spec_.elevations.size(), n_cols = column_azimuth_.size();
     if (!rows.empty() && rows.size() != n_rows) throw InputError("row mask has the wrong length");
-    const Vec3 origin(pose.x, pose.y, spec_.height);
+    const Vec3 origin(pose.x, pose.y, pose.z + spec_.height);
     const bool noisy = spec_.range_noise_sd > 0 || spec_.dropout > 0;
 
     // Allocentric azimuths (exact, SPEC §1) and the horizontal unit vectors of the columns: the
@@ -87,19 +98,40 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
         world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
         for (std::size_t j = 0; j < n_cols; ++j) {
             double r = ranges_[j];
-            if (r == RayCaster::no_hit) continue;
-            if (noisy) {
-                const std::uint64_t beam = i * n_cols + j;
-                if (spec_.dropout > 0 && hash_uniform(noise.seed, noise.scan_index, 2 * beam) < spec_.dropout)
-                    continue;
-                if (spec_.range_noise_sd > 0) {
-                    const double u1 = 1.0 - hash_uniform(noise.seed, noise.scan_index, 2 * beam + 1);
-                    const double u2 = hash_uniform(noise.seed ^ 0x5bd1e995u, noise.scan_index, 2 * beam + 1);
-                    r += spec_.range_noise_sd * std::sqrt(-2.0 * std::log(u1)) * std::cos(two_pi * u2);
-                    if (r <= 0.0 || r > spec_.max_range) continue;
-                }
-            }
+            if (r == RayCaster::no_hit || (noisy && !add_noise(r, noise, i * n_cols + j))) continue;
             out.push_back({r, azimuths_[j], spec_.elevations[i]});
+        }
+    }
+}
+
+bool Lidar::add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) const {
+    if (spec_.dropout > 0 && hash_uniform(noise.seed, noise.scan_index, 2 * beam) < spec_.dropout) return false;
+    if (spec_.range_noise_sd > 0) {
+        const double u1 = 1.0 - hash_uniform(noise.seed, noise.scan_index, 2 * beam + 1);
+        const double u2 = hash_uniform(noise.seed ^ 0x5bd1e995u, noise.scan_index, 2 * beam + 1);
+        r += spec_.range_noise_sd * std::sqrt(-2.0 * std::log(u1)) * std::cos(two_pi * u2);
+        if (r <= 0.0 || r > spec_.max_range) return false;
+    }
+    return true;
+}
+
+void Lidar::scan_tilted(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise) const {
+    // The beam table turns with the sensor; each hit's angles are measured in the world frame.
+    const Eigen::Matrix3d R = pose.rotation();
+    const Vec3 origin = pose.position() + R * Vec3(0.0, 0.0, spec_.height);
+    const std::size_t n_rows = spec_.elevations.size(), n_cols = column_azimuth_.size();
+    const bool noisy = spec_.range_noise_sd > 0 || spec_.dropout > 0;
+    dirs_.resize(n_cols);
+    ranges_.resize(n_cols);
+    for (std::size_t i = 0; i < n_rows; ++i) {
+        for (std::size_t j = 0; j < n_cols; ++j)
+            dirs_[j] = R * Vec3(cos_el_[i] * column_cos_[j], cos_el_[i] * column_sin_[j], sin_el_[i]);
+        world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
+        for (std::size_t j = 0; j < n_cols; ++j) {
+            double r = ranges_[j];
+            if (r == RayCaster::no_hit || (noisy && !add_noise(r, noise, i * n_cols + j))) continue;
+            const Vec3& d = dirs_[j];
+            out.push_back({r, wrap_pi(std::atan2(d.y(), d.x())), std::atan2(d.z(), std::hypot(d.x(), d.y()))});
         }
     }
 }

@@ -1,18 +1,17 @@
 #pragma once
-// Sensor stage: range scanners on the robot.
-// Takes: a World and the robot's pose. Gives: the hits as (range, allocentric azimuth,
-// elevation) relative to the sensor (SPEC §1, §3); beams with no hit within max_range are dropped.
+// Sensor stage: range scanners on the agent.
+// Takes: a World and the agent's pose. Gives: the hits as (range, allocentric azimuth, elevation)
+// relative to the sensor (docs/model-reference.md#sensors); beams with no hit within max_range are
+// dropped. return_source.hpp is the seam through which a model step gets its returns.
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "bvc3d/core/geometry.hpp"
+#include "bvc3d/core/params.hpp"
 #include "bvc3d/world/world.hpp"
 
 namespace bvc3d {
-
-struct Pose {
-    double x = 0.0, y = 0.0, heading = 0.0;
-};
 
 // One return. Laid out as three doubles so a scan is an (N, 3) array for numpy.
 struct LidarReturn {
@@ -29,7 +28,7 @@ struct LidarSpec {
     std::vector<double> elevations{0.0};  // radians
     int azimuth_count = 720;
     double azimuth_offset = 0.0;  // radians
-    double height = 0.08;         // m above the floor
+    double height = 0.08;         // m above the agent's base (for a ground robot, above the floor)
     double max_range = 20.0;      // m
     double range_noise_sd = 0.0;  // m, Gaussian noise added to each range
     double dropout = 0.0;         // probability that a beam returns nothing
@@ -45,7 +44,8 @@ struct LidarSpec {
         return elevations == o.elevations && azimuth_count == o.azimuth_count && azimuth_offset == o.azimuth_offset &&
                height == o.height && max_range == o.max_range && range_noise_sd == o.range_noise_sd && dropout == o.dropout;
     }
-    void validate() const;  // throws InputError naming the bad field
+    static const params::Table<LidarSpec>& table();
+    void validate() const;  // throws params::ParamError naming the bad field
 };
 
 // Seeds the optional range noise and dropout. The noise of beam b in scan s depends only on
@@ -60,8 +60,10 @@ public:
     explicit Lidar(LidarSpec spec);
     const LidarSpec& spec() const { return spec_; }
 
-    // Cast the beams from `pose` and append the hits to `out` (which is cleared first).
-    // `rows`, if not empty, flags which rows to cast (one flag per elevation).
+    // Cast the beams from `pose` and append the hits to `out` (which is cleared first). The sensor
+    // sits `height` above the pose along its up axis and turns with it; returns are in the world
+    // frame (allocentric). `rows`, if not empty, flags which rows to cast (one flag per elevation);
+    // only a level pose takes a row mask, since a tilted sensor's rows no longer have one elevation.
     void scan(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise = {},
               const std::vector<char>& rows = {}) const;
     Scan scan(const World& world, const Pose& pose, const NoiseKey& noise = {}) const {
@@ -71,6 +73,10 @@ public:
     }
 
 private:
+    void scan_tilted(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise) const;
+    // Adds the beam's noise to r; false if the beam drops out or leaves (0, max_range].
+    bool add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) const;
+
     LidarSpec spec_;
     std::vector<double> cos_el_, sin_el_, column_azimuth_, column_cos_, column_sin_;
     // Scratch space reused between scans: a Lidar is not shared between threads.

@@ -54,7 +54,7 @@ TriangleMesh tilted_wall_mesh(const TiltedWall& w) {
     std::array<Vec3, 4> bottom, top;
     const double s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
     for (int i = 0; i < 4; ++i) {
-        const Vec2 p = w.centre + s[i][0] * half_len * along + s[i][1] * half_thick * left;
+        const Vec2 p = w.center + s[i][0] * half_len * along + s[i][1] * half_thick * left;
         bottom[i] = Vec3(p.x(), p.y(), 0.0);
         top[i] = Vec3(p.x() + shift.x(), p.y() + shift.y(), w.height);
     }

@@ -1,15 +1,12 @@
 #pragma once
 // Triangle geometry: what worlds are made of. Plain data, double precision.
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <vector>
 
-namespace bvc3d {
+#include "bvc3d/core/geometry.hpp"
 
-using Vec2 = Eigen::Vector2d;
-using Vec3 = Eigen::Vector3d;
+namespace bvc3d {
 
 struct TriangleMesh {
     std::vector<Vec3> vertices;
@@ -30,16 +27,16 @@ struct TriangleMesh {
 // A convex hexahedron given by its 8 corners: bottom face b0..b3, top face t0..t3 (same order).
 TriangleMesh hexahedron_mesh(const std::array<Vec3, 4>& bottom, const std::array<Vec3, 4>& top);
 
-// Axis-aligned box of the given full size, centred on the origin.
+// Axis-aligned box of the given full size, centered on the origin.
 TriangleMesh box_mesh(const Vec3& size);
 
 // A straight wall standing on z = 0 whose horizontal cross-section slides sideways with height:
-// at height z it is the rectangle of the given length and thickness centred on
-// centre + z·tan(tilt)·left_normal, with left_normal = (-sin yaw, cos yaw). The footprint stays put
+// at height z it is the rectangle of the given length and thickness centered on
+// center + z·tan(tilt)·left_normal, with left_normal = (-sin yaw, cos yaw). The footprint stays put
 // and the horizontal thickness is thickness / cos(tilt) (SPEC §2.1), so the wall's true
 // thickness measured perpendicular to its faces is `thickness`.
 struct TiltedWall {
-    Vec2 centre{0.0, 0.0};
+    Vec2 center{0.0, 0.0};
     double length = 7.0;
     double thickness = 0.3;
     double height = 2.5;

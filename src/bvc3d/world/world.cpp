@@ -53,7 +53,7 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
 
     // Wall A runs along x and leans toward sy·y; wall B runs along y and leans toward sx·x.
     // For yaw = 90° the left normal is -x, hence the sign flip on B's tilt.
-    TiltedWall wall{.centre = Vec2(0, 0), .length = p.wall_length, .thickness = p.wall_thickness,
+    TiltedWall wall{.center = Vec2(0, 0), .length = p.wall_length, .thickness = p.wall_thickness,
                     .height = h, .yaw = 0.0, .tilt = sy * alpha};
     m.append(tilted_wall_mesh(wall));
     wall.yaw = pi / 2;

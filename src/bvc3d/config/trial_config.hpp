@@ -1,12 +1,16 @@
 #pragma once
-// What one trial is (SPEC §7): a world, a model, a protocol, a seed, and how to analyse it.
+// Config stage: what one trial is (docs/experiments.md) — a world, a model, an agent, a protocol, a
+// seed, and how to analyze it — as plain data with its canonical text and fingerprint.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
+#include "bvc3d/agent/agent.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
-#include "bvc3d/experiment/model_spec.hpp"
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/core/params.hpp"
 
 namespace bvc3d {
 
@@ -28,15 +32,18 @@ struct Protocol {
     double explore_hours = 4.0;  // learning on, nothing recorded
     double sample_hours = 4.0;   // learning off, every step recorded (online: the one recorded phase)
     bool record_bvc = false;     // also record the BVC rates
+
+    static const params::Table<Protocol>& table();
     void validate() const;
+    double seconds() const;  // agent time the protocol runs
 };
 
 struct TrialConfig {
     WorldSpec world;
-    ModelSpec model;
+    ModelSpec model = model_preset("3d-0.2");
     Protocol protocol;
-    RobotParams robot;
-    analysis::AnalysisParams analysis;  // SPEC §8 defaults; its extent is set from arena_extent
+    std::shared_ptr<const AgentSpec> agent = std::make_shared<RandomWalkSpec>();  // where the agent goes
+    analysis::AnalysisParams analysis;  // defaults as the paper; its extent is set from arena_extent
     bool arena_extent = false;          // bin over the walkable region's bounds, not the trajectory's
     std::uint64_t seed = 0;
 
@@ -47,15 +54,18 @@ struct TrialConfig {
     std::vector<std::pair<std::string, std::string>> swept;
 
     std::string condition_label() const;
-    // Throws InputError for impossible values (model, protocol, robot, analysis, durations).
+    // Throws InputError for impossible values (model, protocol, agent, analysis, durations).
     void validate() const;
     std::string name() const;  // "<condition>_seed<N>", the trial file's stem
-    // Everything that determines the walk (world, seed, protocol, robot), as text: trials with equal
-    // keys can share one walk.
+    // Everything that determines the agent's steps (world, seed, protocol, agent), as text: trials
+    // with equal keys can share one agent.
     std::string walk_key() const;
     // Everything that determines the trial's results, as text: equal text, equal results.
     std::string canonical() const;
     std::string fingerprint() const;  // a short hash of canonical()
+    // The trial's analysis parameters, with the walkable region's bounds as the extent when
+    // arena_extent asks for them.
+    analysis::AnalysisParams analysis_params(const WorldDescription& world) const;
 };
 
 std::string protocol_name(Protocol::Kind k);

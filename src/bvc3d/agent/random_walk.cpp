@@ -1,26 +1,26 @@
-#include "bvc3d/robot/random_walk.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 
 #include <cmath>
+#include <sstream>
 
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 
-void RobotParams::validate() const {
-    auto positive = [](double v, const char* name) {
-        if (!std::isfinite(v) || v <= 0) throw InputError(std::string("robot: ") + name + " must be > 0");
-    };
-    positive(radius, "radius");
-    positive(height, "height");
-    positive(speed, "speed");
-    positive(turn_rate, "turn_rate");
-    if (turn_rate > 1e6) throw InputError("robot: turn_rate must be <= 1e6 rad/s");
-    positive(model_dt, "model_dt");
-    if (n_walk < 1) throw InputError("robot: n_walk must be >= 1");
-    if (!std::isfinite(turn_sd) || turn_sd < 0) throw InputError("robot: turn_sd must be >= 0");
-    if (!std::isfinite(min_update_move) || min_update_move < 0)
-        throw InputError("robot: min_update_move must be >= 0");
+const params::Table<RobotParams>& RobotParams::table() {
+    using namespace params;
+    static const Table<RobotParams> t(
+        "robot", {real("radius", &RobotParams::radius, open_closed(0, 100), "m, the body's radius"),
+                  real("height", &RobotParams::height, open_closed(0, 100), "m, the body's height"),
+                  real("speed", &RobotParams::speed, open_closed(0, 1e3), "m/s, forward speed"),
+                  real("turn_rate", &RobotParams::turn_rate, open_closed(0, 1e6), "rad/s, turning in place"),
+                  real("model_dt", &RobotParams::model_dt, open_closed(0, 1e6), "s of forward motion per model step"),
+                  integer("n_walk", &RobotParams::n_walk, closed(1, 1e9), "model steps between Gaussian turns"),
+                  real("turn_sd", &RobotParams::turn_sd, closed(0, 100), "rad, sd of the Gaussian turn").in_radians(),
+                  real("min_update_move", &RobotParams::min_update_move, closed(0, 1),
+                       "m: a step cut short by a bump updates the model if it moved more")});
+    return t;
 }
 
 RandomWalk::RandomWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& params, Rng rng,
@@ -84,7 +84,7 @@ void RandomWalk::bump() {
     state_.bump_pending = false;
 }
 
-std::optional<WalkStep> RandomWalk::next(double t_end) {
+std::optional<ModelStep> RandomWalk::next(double t_end) {
     const double step_len = p_.speed * p_.model_dt;
     int stuck = 0;  // bumps in a row without moving
     while (state_.t < t_end) {
@@ -110,7 +110,7 @@ std::optional<WalkStep> RandomWalk::next(double t_end) {
             q.y += step_len * u.y();
             state_.t += p_.model_dt;
             ++state_.steps_since_turn;
-            return WalkStep{state_.t, q.x, q.y, q.heading, false};
+            return ModelStep{state_.t, q, false};
         }
         // Bumper: stop at contact (a nanometre short of it), then turn to a uniform heading.
         const double moved = std::max(0.0, free - 1e-9);
@@ -118,7 +118,7 @@ std::optional<WalkStep> RandomWalk::next(double t_end) {
         q.y += moved * u.y();
         state_.t += moved / p_.speed;
         state_.bump_pending = true;
-        if (moved > p_.min_update_move) return WalkStep{state_.t, q.x, q.y, q.heading, true};
+        if (moved > p_.min_update_move) return ModelStep{state_.t, q, true};
     }
     return std::nullopt;
 }
@@ -134,16 +134,50 @@ void RandomWalk::restore(const WalkState& s) {
     rng_.set_state(s.rng_state);
 }
 
-std::vector<WalkStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params) {
-    if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0");
-    params.validate();
-    auto body = std::make_shared<const BodyCollider>(world.description(), params.radius, params.height);
+std::string RandomWalk::save_state() const {
+    const WalkState w = state();
+    std::ostringstream os;
+    os << "random_walk " << format_number(w.pose.x) << ' ' << format_number(w.pose.y) << ' ' << format_number(w.pose.heading)
+       << ' ' << format_number(w.t) << ' ' << w.steps_since_turn << ' ' << (w.bump_pending ? 1 : 0) << '\n'
+       << w.rng_state;
+    return os.str();
+}
+
+void RandomWalk::restore_state(const std::string& text) {
+    std::istringstream is(text);
+    std::string kind, x, y, heading, t;
+    WalkState w;
+    int bump = 0;
+    is >> kind >> x >> y >> heading >> t >> w.steps_since_turn >> bump;
+    if (!is || kind != "random_walk") throw InputError("saved state is not a random walk's");
+    try {
+        w.pose = Pose::on_floor(std::stod(x), std::stod(y), std::stod(heading));
+        w.t = std::stod(t);
+    } catch (const std::exception&) {
+        throw InputError("saved random-walk state is corrupt");
+    }
+    w.bump_pending = bump != 0;
+    is.ignore(1);
+    w.rng_state.assign(std::istreambuf_iterator<char>(is), {});
+    restore(w);
+}
+
+std::unique_ptr<Agent> RandomWalkSpec::make(const World& world, std::uint64_t seed) const {
+    validate();
+    auto body = std::make_shared<const BodyCollider>(world.description(), robot_.radius, robot_.height);
     Rng rng(seed, Stream::walk);
     const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
-    RandomWalk walk(body, params, std::move(rng), start);
-    std::vector<WalkStep> steps;
+    return std::make_unique<RandomWalk>(body, robot_, std::move(rng), start);
+}
+
+std::string RandomWalkSpec::key() const { return "robot:\n" + params::yaml_lines(RobotParams::table(), robot_, "  "); }
+
+std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params) {
+    if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0");
+    const auto walk = RandomWalkSpec(params).make(world, seed);
+    std::vector<ModelStep> steps;
     steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
-    while (auto s = walk.next(hours * 3600.0)) steps.push_back(*s);
+    while (auto s = walk->next(hours * 3600.0)) steps.push_back(*s);
     return steps;
 }
 

@@ -1,15 +1,17 @@
 #pragma once
-// The robot and its random walk (SPEC §4).
+// The ground robot and its random walk (docs/model-reference.md#robot-and-random-walk).
 // Takes: a World (through its BodyCollider) and a seeded random stream.
-// Gives: the model steps: where and when the place-cell model is updated.
+// Gives: the model steps of the walk, as an Agent.
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "bvc3d/agent/agent.hpp"
+#include "bvc3d/agent/body_collider.hpp"
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/params.hpp"
 #include "bvc3d/core/random.hpp"
-#include "bvc3d/robot/body_collider.hpp"
-#include "bvc3d/sensor/lidar.hpp"
 
 namespace bvc3d {
 
@@ -22,14 +24,9 @@ struct RobotParams {
     int n_walk = 10;                       // model steps between Gaussian turns (the paper's τ_w)
     double turn_sd = pi / 6;               // rad, sd of the Gaussian turn
     double min_update_move = 1e-3;         // m: a step cut short by a bump updates if it moved more
-    void validate() const;
-};
 
-// One model update.
-struct WalkStep {
-    double t;  // simulated seconds since the start of the walk
-    double x, y, heading;
-    bool bumped;  // the step ended at a contact
+    static const params::Table<RobotParams>& table();
+    void validate() const { table().check(*this); }
 };
 
 // Every turn the walk draws, for checking its distributions.
@@ -47,7 +44,7 @@ struct WalkState {
     std::string rng_state;
 };
 
-class RandomWalk {
+class RandomWalk : public Agent {
 public:
     RandomWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& params, Rng rng, const Pose& start);
 
@@ -55,12 +52,12 @@ public:
     // region) and a uniform heading.
     static Pose draw_start(const WorldDescription& world, const BodyCollider& body, Rng& rng);
 
-    // Moves until the next model update and returns it; nullopt once simulated time reaches t_end
-    // (a step begun before t_end is completed).
-    std::optional<WalkStep> next(double t_end);
+    std::optional<ModelStep> next(double t_end) override;
+    double time() const override { return state_.t; }
+    std::string save_state() const override;
+    void restore_state(const std::string& state) override;
 
     const Pose& pose() const { return state_.pose; }
-    double time() const { return state_.t; }
     WalkState state() const;
     void restore(const WalkState& s);
     void log_turns(std::vector<TurnEvent>* log) { log_ = log; }
@@ -76,7 +73,22 @@ private:
     std::vector<TurnEvent>* log_ = nullptr;
 };
 
+// The random walk as a trial's agent: the robot's parameters, a start drawn from the seed.
+class RandomWalkSpec : public AgentSpec {
+public:
+    explicit RandomWalkSpec(RobotParams robot = {}) : robot_(robot) {}
+    const RobotParams& robot() const { return robot_; }
+    std::string kind() const override { return "random_walk"; }
+    void validate() const override { robot_.validate(); }
+    std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
+    std::string key() const override;
+    double steps_per_second() const override { return 1.0 / robot_.model_dt; }
+
+private:
+    RobotParams robot_;
+};
+
 // A whole walk of `hours` simulated hours from a seeded random start.
-std::vector<WalkStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params = {});
+std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params = {});
 
 }  // namespace bvc3d

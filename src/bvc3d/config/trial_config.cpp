@@ -1,4 +1,4 @@
-#include "bvc3d/experiment/trial_config.hpp"
+#include "bvc3d/config/trial_config.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -53,11 +53,22 @@ std::string WorldSpec::fingerprint() const {
     return fp;
 }
 
-void Protocol::validate() const {
-    auto ok = [](double h) { return std::isfinite(h) && h >= 0; };
-    if (!ok(explore_hours)) throw InputError("explore_hours must be a non-negative number of hours");
-    if (!ok(sample_hours) || sample_hours <= 0) throw InputError("sample_hours must be a positive number of hours");
+const params::Table<Protocol>& Protocol::table() {
+    using namespace params;
+    static const Table<Protocol> t(
+        "protocol",
+        {choice("kind", &Protocol::kind,
+                {{Kind::explore_then_sample, "explore_then_sample"}, {Kind::online, "online"}},
+                "explore_then_sample (learn, then record frozen) or online (record while learning)"),
+         real("explore_hours", &Protocol::explore_hours, at_least(0), "h of exploration, learning on, not recorded"),
+         real("sample_hours", &Protocol::sample_hours, above(0), "h recorded (online: the one phase)"),
+         flag("record_bvc", &Protocol::record_bvc, "also record the BVC rates")});
+    return t;
 }
+
+void Protocol::validate() const { table().check(*this); }
+
+double Protocol::seconds() const { return 3600.0 * (kind == Kind::online ? sample_hours : explore_hours + sample_hours); }
 
 std::string protocol_name(Protocol::Kind k) { return k == Protocol::Kind::online ? "online" : "explore_then_sample"; }
 
@@ -70,12 +81,11 @@ Protocol::Kind parse_protocol(const std::string& name) {
 void TrialConfig::validate() const {
     model.validate();
     protocol.validate();
-    robot.validate();
+    agent->validate();
     analysis.validate();
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
-    if (protocol.sample_hours * 3600.0 < 2.0 * robot.model_dt)
-        throw InputError("sample_hours = " + format_number(protocol.sample_hours) + " h records fewer than 2 model steps (" +
-                         format_number(robot.model_dt) + " s each)");
+    if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
+        throw InputError("sample_hours = " + format_number(protocol.sample_hours) + " h records fewer than 2 model steps");
 }
 
 std::string TrialConfig::condition_label() const {
@@ -85,24 +95,24 @@ std::string TrialConfig::condition_label() const {
 std::string TrialConfig::name() const { return condition_label() + "_seed" + std::to_string(seed); }
 
 std::string TrialConfig::walk_key() const {
-    std::ostringstream os;
-    os << "world: " << world.fingerprint() << "\nprotocol:\n  kind: " << protocol_name(protocol.kind)
-       << "\n  explore_hours: " << format_number(protocol.explore_hours) << "\n  sample_hours: " << format_number(protocol.sample_hours)
-       << "\n  record_bvc: " << (protocol.record_bvc ? "true" : "false") << "\nrobot:\n  radius: " << format_number(robot.radius)
-       << "\n  height: " << format_number(robot.height) << "\n  speed: " << format_number(robot.speed) << "\n  turn_rate: " << format_number(robot.turn_rate)
-       << "\n  model_dt: " << format_number(robot.model_dt) << "\n  n_walk: " << robot.n_walk << "\n  turn_sd: " << format_number(robot.turn_sd)
-       << "\n  min_update_move: " << format_number(robot.min_update_move) << "\nseed: " << seed << "\n";
-    return os.str();
+    return "world: " + world.fingerprint() + "\nprotocol:\n" + params::yaml_lines(Protocol::table(), protocol, "  ") +
+           agent->key() + "seed: " + std::to_string(seed) + "\n";
 }
 
 std::string TrialConfig::canonical() const {
-    std::ostringstream os;
-    os << walk_key() << config::model_to_yaml(model) << "analysis:\n  gridsize: " << analysis.gridsize
-       << "\n  quantile: " << format_number(analysis.quantile) << "\n  eps: " << format_number(analysis.dbscan.eps)
-       << "\n  min_samples: " << analysis.dbscan.min_samples << "\n  d_th: " << format_number(analysis.d_th)
-       << "\n  extent: " << (arena_extent ? "arena" : "data")
-       << "\n  decoding_templates: " << analysis::decoding_templates_name(analysis.decoding_templates) << "\n";
-    return os.str();
+    // The analysis keys, with `extent` before decoding_templates as trial files have always had it.
+    std::string lines = params::yaml_lines(analysis::AnalysisParams::table(), analysis, "  ");
+    lines.insert(lines.find("  decoding_templates:"), std::string("  extent: ") + (arena_extent ? "arena" : "data") + "\n");
+    return walk_key() + config::model_to_yaml(model) + "analysis:\n" + lines;
+}
+
+analysis::AnalysisParams TrialConfig::analysis_params(const WorldDescription& w) const {
+    analysis::AnalysisParams params = analysis;
+    if (arena_extent) {
+        const auto box = w.walkable.bounds();
+        params.extent = analysis::Extent{box.min().x(), box.max().x(), box.min().y(), box.max().y()};
+    }
+    return params;
 }
 
 std::string TrialConfig::fingerprint() const {

@@ -1,4 +1,4 @@
-#include "bvc3d/robot/body_collider.hpp"
+#include "bvc3d/agent/body_collider.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,52 @@
+#pragma once
+// Agent stage: where the agent goes.
+// Takes: a World (for collision) and a seed, or a given path. Gives: the model steps — when and at
+// which pose the model is updated — one at a time, and its state as text for checkpoints.
+// Kinds of agent: the ground robot's random walk (random_walk.hpp) and a given trajectory
+// (trajectory.hpp). The trial runner, checkpoints and walk sharing see only this interface.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "bvc3d/core/geometry.hpp"
+#include "bvc3d/world/world.hpp"
+
+namespace bvc3d {
+
+// One model update: its time and the agent's pose (a ground robot's pose is its base on the floor).
+struct ModelStep {
+    double t = 0.0;  // seconds since the agent started
+    Pose pose;
+    bool bumped = false;  // the step ended at a contact
+};
+
+class Agent {
+public:
+    virtual ~Agent() = default;
+    // The next model step, or nullopt once time() has reached t_end (a step begun before t_end is
+    // completed) or the agent has no steps left.
+    virtual std::optional<ModelStep> next(double t_end) = 0;
+    virtual double time() const = 0;
+    // No steps left at any t_end (a trajectory's end; a random walk never finishes).
+    virtual bool finished() const { return false; }
+    // Everything needed to continue exactly where it stopped.
+    virtual std::string save_state() const = 0;
+    virtual void restore_state(const std::string& state) = 0;  // InputError if it does not fit
+};
+
+// A kind of agent and its parameters: what a trial configuration holds. Trials whose agents have
+// equal key() in the same world with the same seed take the same steps, so they can share them.
+class AgentSpec {
+public:
+    virtual ~AgentSpec() = default;
+    virtual std::string kind() const = 0;  // "random_walk", "trajectory"
+    virtual void validate() const = 0;     // InputError naming the bad parameter
+    virtual std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const = 0;
+    // Configuration text that fixes the steps: the YAML a trial file records.
+    virtual std::string key() const = 0;
+    // Model steps per second of agent time, on average (for buffer sizes and duration checks).
+    virtual double steps_per_second() const = 0;
+};
+
+}  // namespace bvc3d

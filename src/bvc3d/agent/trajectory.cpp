@@ -1,0 +1,180 @@
+#include "bvc3d/agent/trajectory.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
+#include "bvc3d/core/random.hpp"
+
+namespace bvc3d {
+
+Trajectory::Trajectory(std::shared_ptr<const std::vector<ModelStep>> steps) : steps_(std::move(steps)) {}
+
+std::optional<ModelStep> Trajectory::next(double t_end) {
+    if (finished() || time() >= t_end) return std::nullopt;
+    return (*steps_)[next_++];
+}
+
+std::string Trajectory::save_state() const { return "trajectory " + std::to_string(next_); }
+
+void Trajectory::restore_state(const std::string& state) {
+    std::istringstream is(state);
+    std::string kind;
+    std::size_t next = 0;
+    is >> kind >> next;
+    if (!is || kind != "trajectory" || next > steps_->size()) throw InputError("saved state is not this trajectory's");
+    next_ = next;
+}
+
+std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std::vector<double>& x,
+                                        const std::vector<double>& y, const std::vector<double>& z,
+                                        const std::vector<double>& heading, const std::string& source) {
+    const std::size_t n = t.size();
+    if (x.size() != n || y.size() != n || heading.size() != n || (!z.empty() && z.size() != n))
+        throw InputError(source + ": t, x, y, z and heading must have the same length");
+    if (n == 0) throw InputError(source + ": the trajectory has no rows");
+    std::vector<ModelStep> steps(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double zi = z.empty() ? 0.0 : z[i];
+        const auto where = [&] { return source + ": row " + std::to_string(i) + ": "; };
+        for (double v : {t[i], x[i], y[i], zi, heading[i]})
+            if (!std::isfinite(v)) throw InputError(where() + "every value must be finite");
+        if (std::abs(x[i]) > 1e6 || std::abs(y[i]) > 1e6 || std::abs(zi) > 1e6)
+            throw InputError(where() + "coordinates must lie within ±1e6 m");
+        if (i > 0 && !(t[i] > t[i - 1]))
+            throw InputError(where() + "times must increase (" + format_number(t[i]) + " after " +
+                             format_number(t[i - 1]) + ")");
+        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), 0.0, 0.0}, false};
+    }
+    return steps;
+}
+
+namespace {
+
+std::vector<std::string> split_fields(const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : line) {
+        if (c == ',' || c == ' ' || c == '\t' || c == '\r') {
+            if (!cur.empty()) out.push_back(cur);
+            cur.clear();
+        } else {
+            cur += c;
+        }
+    }
+    if (!cur.empty()) out.push_back(cur);
+    return out;
+}
+
+bool is_number(const std::string& s) {
+    char* end = nullptr;
+    std::strtod(s.c_str(), &end);
+    return end != s.c_str() && *end == '\0';
+}
+
+}  // namespace
+
+std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
+    const std::string name = "trajectory file '" + path.string() + "'";
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw InputError(name + " is a folder, not a file");
+    std::ifstream in(path);
+    if (!in) throw InputError(name + (std::filesystem::exists(path, ec) ? " cannot be read" : " does not exist"));
+    std::vector<std::string> columns;  // from the header, if any
+    std::vector<double> t, x, y, z, heading;
+    bool degrees = false;
+    std::string line;
+    for (int line_no = 1; std::getline(in, line); ++line_no) {
+        if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+        const auto fields = split_fields(line);
+        if (fields.empty()) continue;
+        const std::string at = name + ", line " + std::to_string(line_no) + ": ";
+        if (columns.empty() && t.empty() && !is_number(fields[0])) {  // a header
+            columns = fields;
+            for (const auto& c : {"t", "x", "y"})
+                if (std::find(columns.begin(), columns.end(), c) == columns.end())
+                    throw InputError(at + "the header lacks the column '" + c + "'");
+            const bool h = std::find(columns.begin(), columns.end(), "heading") != columns.end();
+            degrees = std::find(columns.begin(), columns.end(), "heading_deg") != columns.end();
+            if (h == degrees) throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
+            continue;
+        }
+        if (columns.empty()) {
+            if (fields.size() != 4 && fields.size() != 5)
+                throw InputError(at + "expected 4 values (t x y heading) or 5 (t x y z heading), got " +
+                                 std::to_string(fields.size()));
+            columns = fields.size() == 4 ? std::vector<std::string>{"t", "x", "y", "heading"}
+                                         : std::vector<std::string>{"t", "x", "y", "z", "heading"};
+        }
+        if (fields.size() != columns.size())
+            throw InputError(at + "expected " + std::to_string(columns.size()) + " values, got " +
+                             std::to_string(fields.size()));
+        for (std::size_t c = 0; c < fields.size(); ++c) {
+            if (!is_number(fields[c])) throw InputError(at + "'" + fields[c] + "' is not a number");
+            const double v = std::strtod(fields[c].c_str(), nullptr);
+            const auto& col = columns[c];
+            if (col == "t") t.push_back(v);
+            else if (col == "x") x.push_back(v);
+            else if (col == "y") y.push_back(v);
+            else if (col == "z") z.push_back(v);
+            else if (col == "heading") heading.push_back(v);
+            else if (col == "heading_deg") heading.push_back(deg_to_rad(v));
+        }
+    }
+    return trajectory_steps(t, x, y, z, heading, name);
+}
+
+namespace {
+
+std::uint64_t hash_steps(const std::vector<ModelStep>& steps) {
+    std::uint64_t h = 0x7472616a;  // "traj"
+    auto mix = [&](double v) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        h = hash_u64(h, bits, 0x51);
+    };
+    for (const auto& s : steps)
+        for (double v : {s.t, s.pose.x, s.pose.y, s.pose.z, s.pose.heading}) mix(v);
+    return h;
+}
+
+}  // namespace
+
+TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source)
+    : steps_(std::make_shared<const std::vector<ModelStep>>(std::move(steps))), source_(std::move(source)),
+      hash_(hash_steps(*steps_)) {}
+
+TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
+    return TrajectorySpec(read_trajectory_file(path), path.string());
+}
+
+std::unique_ptr<Agent> TrajectorySpec::make(const World& world, std::uint64_t) const {
+    Eigen::AlignedBox3d box;
+    for (const auto& v : world.mesh().vertices) box.extend(v);
+    for (std::size_t i = 0; i < steps_->size(); ++i) {
+        const Pose& p = (*steps_)[i].pose;
+        if (!box.contains(p.position()))
+            throw InputError("trajectory '" + source_ + "', row " + std::to_string(i) + ": (" + format_number(p.x) +
+                             ", " + format_number(p.y) + ", " + format_number(p.z) + ") lies outside world '" +
+                             world.name() + "' (another coordinate frame?)");
+    }
+    return std::make_unique<Trajectory>(steps_);
+}
+
+std::string TrajectorySpec::key() const {
+    std::ostringstream os;
+    os << "trajectory:\n  source: " << std::filesystem::path(source_).filename().string() << "\n  rows: " << steps_->size()
+       << "\n  hash: " << std::hex << hash_ << "\n";
+    return os.str();
+}
+
+double TrajectorySpec::steps_per_second() const {
+    const double span = steps_->back().t;
+    return span > 0 ? static_cast<double>(steps_->size()) / span : static_cast<double>(steps_->size());
+}
+
+}  // namespace bvc3d

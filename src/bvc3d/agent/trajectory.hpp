@@ -1,0 +1,63 @@
+#pragma once
+// A given path as the agent: model steps at given times and poses, e.g. a real robot's or animal's
+// track, in place of the random walk (docs/experiments.md#user-trajectories).
+// Takes: rows (t, x, y, [z], heading), from arrays or a text file. Gives: one model step per row.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bvc3d/agent/agent.hpp"
+
+namespace bvc3d {
+
+// The rows' times are shifted so that the first row is at t = 0; they must increase strictly.
+// Positions are in the world frame (z: the agent's base above the floor, 0 if not given); headings
+// in radians. No collision is checked: the path is the data.
+class Trajectory : public Agent {
+public:
+    explicit Trajectory(std::shared_ptr<const std::vector<ModelStep>> steps);
+
+    std::optional<ModelStep> next(double t_end) override;
+    double time() const override { return next_ == 0 ? 0.0 : (*steps_)[next_ - 1].t; }
+    bool finished() const override { return next_ >= steps_->size(); }
+    std::string save_state() const override;
+    void restore_state(const std::string& state) override;
+
+private:
+    std::shared_ptr<const std::vector<ModelStep>> steps_;
+    std::size_t next_ = 0;
+};
+
+// Rows checked and shifted to start at t = 0. `source` names the data in errors (a file, "arrays").
+std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std::vector<double>& x,
+                                        const std::vector<double>& y, const std::vector<double>& z,
+                                        const std::vector<double>& heading, const std::string& source);
+
+// A text file, comma- or whitespace-separated, `#` comments: columns t, x, y, heading or
+// t, x, y, z, heading; an optional header line names them (then in any order, and `heading_deg`
+// may replace `heading`). Errors name the file, the line and the reason.
+std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path);
+
+// A trajectory as a trial's agent: from a file (its name and contents fix the key) or from arrays.
+class TrajectorySpec : public AgentSpec {
+public:
+    static TrajectorySpec from_file(const std::filesystem::path& path);
+    TrajectorySpec(std::vector<ModelStep> steps, std::string source);
+
+    const std::string& source() const { return source_; }
+    const std::vector<ModelStep>& steps() const { return *steps_; }
+    std::string kind() const override { return "trajectory"; }
+    void validate() const override {}
+    // Checks that every pose lies within the world's geometry (a path in another frame is a mistake).
+    std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
+    std::string key() const override;
+    double steps_per_second() const override;
+
+private:
+    std::shared_ptr<const std::vector<ModelStep>> steps_;
+    std::string source_;
+    std::uint64_t hash_ = 0;  // of the rows, for the key
+};
+
+}  // namespace bvc3d

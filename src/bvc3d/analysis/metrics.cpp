@@ -1,0 +1,40 @@
+#include "bvc3d/analysis/metrics.hpp"
+
+namespace bvc3d::analysis {
+
+const std::vector<Metric>& metric_table() {
+    static const std::vector<Metric> table{
+        {"frac_active", "MI>0 fraction", "fraction of cells with MI > 0", "Fraction of place cells with a field (MI > 0)",
+         3, [](const TrialMetrics& m) { return m.modality_summary.frac_active; }},
+        {"mean_mi_active", "mean MI (MI>0)", "mean MI of cells with MI > 0", "Mean modality index of active cells", 2,
+         [](const TrialMetrics& m) { return m.modality_summary.mean_mi_active; }},
+        {"frac_multimodal", "MI>1 fraction", "fraction of cells with MI > 1",
+         "Fraction of multimodal place cells (MI > 1)", 3,
+         [](const TrialMetrics& m) { return m.modality_summary.frac_multimodal; }},
+        {"msai", "MSAI", "MSAI", "Mean spatial aliasing index", 4, [](const TrialMetrics& m) { return m.aliasing.msai; }},
+        {"decode_median_m", "decoding median (m)", "median decoding error (m)", "Localization error (median)", 2,
+         [](const TrialMetrics& m) { return m.decoding.median_m; }},
+        {"decode_mean_m", "decoding mean (m)", "mean decoding error (m)", "", 2,
+         [](const TrialMetrics& m) { return m.decoding.mean_m; }},
+        {"n_bins", "bins", "visited bins", "", -1, [](const TrialMetrics& m) { return static_cast<double>(m.maps.bins.size()); }},
+        {"n_decoded", "decoded samples", "decoded samples", "", -1,
+         [](const TrialMetrics& m) { return static_cast<double>(m.decoding.n_decoded); }},
+        {"n_undecoded", "undecoded samples", "undecoded samples", "", -1,
+         [](const TrialMetrics& m) { return static_cast<double>(m.decoding.n_undecoded); }},
+    };
+    return table;
+}
+
+std::vector<std::string> metric_names() {
+    std::vector<std::string> names;
+    for (const auto& m : metric_table()) names.emplace_back(m.name);
+    return names;
+}
+
+std::vector<std::pair<std::string, double>> scalar_metrics(const TrialMetrics& m) {
+    std::vector<std::pair<std::string, double>> out;
+    for (const auto& metric : metric_table()) out.emplace_back(metric.name, metric.value(m));
+    return out;
+}
+
+}  // namespace bvc3d::analysis

@@ -1,0 +1,67 @@
+#include "bvc3d/config/model_spec.hpp"
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d {
+
+void ModelSpec::validate() const {
+    sensor.validate();
+    bvc.validate();
+    place.validate();
+}
+
+namespace {
+
+// A model reading the horizontal scanner (no elevation layers), 120 distances per direction.
+ModelSpec planar(const std::string& name) {
+    ModelSpec m{name, LidarSpec::horizontal(), {}, {}};
+    m.bvc.elevations.clear();
+    m.bvc.n_per_axis = 120;
+    return m;
+}
+
+// A model reading the spherical scanner's upper half with the given layers.
+ModelSpec layered(const std::string& name, std::vector<double> elevations, int n_per_axis) {
+    ModelSpec m{name, LidarSpec::spherical(), {}, {}};
+    m.bvc.elevations = std::move(elevations);
+    m.bvc.n_per_axis = n_per_axis;
+    return m;
+}
+
+}  // namespace
+
+const std::vector<ModelPreset>& model_presets() {
+    static const std::vector<ModelPreset> presets{
+        {"2d", "the paper's 2-D model: horizontal scanner, 8 directions × 120 distances", [] { return planar("2d"); }},
+        {"3d-0.1", "spherical scanner, layers 0 and 0.1 rad × 8 directions × 60 distances",
+         [] { return layered("3d-0.1", {0.0, 0.1}, 60); }},
+        {"3d-0.2", "spherical scanner, layers 0 and 0.2 rad × 8 directions × 60 distances",
+         [] { return layered("3d-0.2", {0.0, 0.2}, 60); }},
+        {"3d-3l", "spherical scanner, layers 0, 0.1 and 0.2 rad × 8 directions × 40 distances",
+         [] { return layered("3d-3l", {0.0, 0.1, 0.2}, 40); }},
+        {"2d-8beam", "the 2-D model as the authors' code computed it: the single nearest beam per direction, d_m = 0.1·m",
+         [] {
+             ModelSpec m = planar("2d-8beam");
+             m.bvc.reading = BvcReading::nearest_beam;
+             m.bvc.max_dist = 11.9;
+             return m;
+         }},
+    };
+    return presets;
+}
+
+std::vector<std::string> model_preset_names() {
+    std::vector<std::string> names;
+    for (const auto& p : model_presets()) names.push_back(p.name);
+    return names;
+}
+
+ModelSpec model_preset(const std::string& name) {
+    for (const auto& p : model_presets())
+        if (p.name == name) return p.make();
+    std::string list;
+    for (const auto& n : model_preset_names()) list += (list.empty() ? "" : ", ") + n;
+    throw InputError("unknown model '" + name + "' (presets: " + list + "; or a model YAML file)");
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,34 @@
+#pragma once
+// Config stage: a whole model — which scanner it reads, its BVC layer and its place-cell network —
+// and the named presets: the paper's four (Table I) and the authors'-code 2-D baseline
+// (docs/model-reference.md#presets).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bvc3d/bvc/boundary_vector_layer.hpp"
+#include "bvc3d/place/place_cell_network.hpp"
+#include "bvc3d/sensor/lidar.hpp"
+
+namespace bvc3d {
+
+struct ModelSpec {
+    std::string name;
+    LidarSpec sensor;
+    BvcParams bvc;
+    PlaceParams place;
+    void validate() const;
+};
+
+struct ModelPreset {
+    std::string name;
+    std::string description;
+    std::function<ModelSpec()> make;
+};
+
+// The one list of model presets, in the order help texts show them.
+const std::vector<ModelPreset>& model_presets();
+std::vector<std::string> model_preset_names();
+ModelSpec model_preset(const std::string& name);  // throws InputError for unknown names
+
+}  // namespace bvc3d

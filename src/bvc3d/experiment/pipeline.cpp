@@ -1,0 +1,126 @@
+#include "bvc3d/experiment/pipeline.hpp"
+
+#include <algorithm>
+
+#include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/recorder/checkpoint_file.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+template <class T>
+NamedArray array(const char* name, std::vector<std::size_t> shape, std::vector<T> data, bool compress = true) {
+    return NamedArray{name, std::move(shape), std::move(data), compress};
+}
+
+}  // namespace
+
+AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const GroupResult& r, std::size_t model) {
+    AnalyzedTrial a;
+    a.params = t.analysis_params(world);
+    const auto& rec = r.models.at(model);
+    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()), rec.n_place);
+    a.metrics = analysis::analyze_trial<float>(r.x, r.y, rates, a.params);
+    return a;
+}
+
+GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunControl& control) {
+    if (trials.empty()) throw InputError("a trial group needs at least one trial");
+    const World world(trials.front().world.resolve());
+    GroupOutcome out;
+    out.result = run_trial_group(world, trials, control);
+    for (std::size_t k = 0; k < trials.size(); ++k) out.trials.push_back(analyze(trials[k], world.description(), out.result, k));
+    return out;
+}
+
+GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std::vector<std::filesystem::path>& paths,
+                               const RunControl& control) {
+    if (paths.size() != trials.size()) throw std::logic_error("one path per trial");
+    GroupOutcome out = run_and_analyze(trials, control);
+    const WorldDescription world = trials.front().world.resolve();
+    for (std::size_t k = 0; k < trials.size(); ++k)
+        write_trial_file(paths[k], trial_identity(trials[k], world), out.result, k,
+                         metrics_record(out.trials[k].metrics, out.trials[k].params));
+    if (!control.checkpoint.empty()) remove_checkpoint(control.checkpoint);
+    return out;
+}
+
+TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world) {
+    TrialIdentity id;
+    id.name = t.name();
+    id.condition = t.condition_label();
+    id.swept = t.swept;
+    id.world = t.world.label();
+    id.world_source = t.world.source;
+    id.tilt_deg = world.tilt_deg.value_or(NAN);
+    id.model = t.model.name;
+    id.sensor = t.model.sensor.name;
+    id.seed = t.seed;
+    id.protocol = protocol_name(t.protocol.kind);
+    id.explore_hours = t.protocol.explore_hours;
+    id.sample_hours = t.protocol.sample_hours;
+    id.config = t.canonical();
+    id.fingerprint = t.fingerprint();
+    return id;
+}
+
+MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& p) {
+    MetricsRecord r;
+    r.scalars = analysis::scalar_metrics(m);
+    // How they were computed, so that `bvc3d analyze` starts from the same parameters.
+    for (const auto& f : analysis::AnalysisParams::table().fields()) r.parameters.emplace_back(f.key, f.get(p));
+    if (p.extent) r.arrays.push_back(array("extent", {4}, std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, false));
+    const auto& bins = m.maps.bins;
+    const std::size_t nb = static_cast<std::size_t>(bins.size()), nc = static_cast<std::size_t>(m.maps.map.cols());
+    const std::size_t dims = static_cast<std::size_t>(bins.centers.cols());
+    r.arrays.push_back(array("modality", {m.modality.size()}, std::vector<std::int64_t>(m.modality.begin(), m.modality.end())));
+    r.arrays.push_back(array("bin_centers", {nb, dims}, std::vector<double>(bins.centers.data(), bins.centers.data() + nb * dims)));
+    r.arrays.push_back(array("bin_counts", {nb}, std::vector<std::int64_t>(bins.counts.begin(), bins.counts.end())));
+    r.arrays.push_back(array("sai", {nb}, std::vector<double>(m.aliasing.sai.data(), m.aliasing.sai.data() + nb)));
+    std::vector<float> maps(nb * nc);
+    for (std::size_t i = 0; i < maps.size(); ++i) maps[i] = static_cast<float>(m.maps.map.data()[i]);
+    r.arrays.push_back(array("rate_maps", {nb, nc}, std::move(maps)));
+    r.arrays.push_back(array("peak_rate", {nc}, m.cells.peak_rate));
+    r.arrays.push_back(array("field_area", {nc}, m.cells.field_area));
+    r.arrays.push_back(array("spatial_info", {nc}, m.cells.spatial_info));
+    return r;
+}
+
+analysis::AnalysisParams stored_analysis_params(const TrialFileData& file) {
+    analysis::AnalysisParams p;
+    const auto& table = analysis::AnalysisParams::table();
+    bool any = false;
+    for (const auto& [name, value] : file.metric_attributes) {
+        const auto* f = table.find(name);
+        if (!f) continue;
+        params::Value v = value;
+        if (f->kind == params::Kind::integer && std::holds_alternative<double>(v))
+            v = static_cast<long long>(std::get<double>(v));
+        try {
+            table.set(p, *f, v);
+            any = true;
+        } catch (const std::bad_variant_access&) {
+            throw InputError("trial file '" + file.name + "': /metrics attribute '" + name + "' has the wrong type");
+        }
+    }
+    // Files from before the template choice was recorded decoded with raw means.
+    const bool has_templates = std::any_of(file.metric_attributes.begin(), file.metric_attributes.end(),
+                                           [](const auto& a) { return a.first == "decoding_templates"; });
+    if (!has_templates && !any) p.decoding_templates = analysis::DecodingTemplates::means;
+    if (file.extent && file.extent->size() == 4)
+        p.extent = analysis::Extent{(*file.extent)[0], (*file.extent)[1], (*file.extent)[2], (*file.extent)[3]};
+    return p;
+}
+
+bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t) {
+    const auto stamp = read_trial_stamp(path);
+    if (!stamp || stamp->fingerprint != t.fingerprint()) return false;
+    for (const auto& name : analysis::metric_names())
+        if (std::find(stamp->metric_attributes.begin(), stamp->metric_attributes.end(), name) == stamp->metric_attributes.end())
+            return false;
+    return true;
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,43 @@
+#pragma once
+// The trial pipeline, one for every way of running trials (`bvc3d run`, `paper`, `sweep`, Python's
+// run_trial): run a group of trials on one agent, analyze each, and write each trial file.
+// Takes: trial configurations (and file paths). Gives: their results, metrics and files.
+#include <filesystem>
+#include <vector>
+
+#include "bvc3d/analysis/trial_metrics.hpp"
+#include "bvc3d/config/trial_config.hpp"
+#include "bvc3d/experiment/trial_runner.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
+
+namespace bvc3d {
+
+struct AnalyzedTrial {
+    analysis::TrialMetrics metrics;
+    analysis::AnalysisParams params;  // what the metrics were computed with (extent resolved)
+};
+
+struct GroupOutcome {
+    GroupResult result;
+    std::vector<AnalyzedTrial> trials;  // in the order of the group's trials
+};
+
+// Runs the group (sharing one agent) and analyzes each trial.
+GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunControl& control = {});
+// The same, then writes trial k to paths[k] (atomically) and removes the group's checkpoint.
+GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std::vector<std::filesystem::path>& paths,
+                               const RunControl& control = {});
+
+// Analyzes one model of a group's result with the trial's parameters.
+AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const GroupResult& result, std::size_t model);
+
+// What a trial file records of a trial: its identity and configuration, and its metrics.
+TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world);
+MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& params);
+// The analysis parameters a trial file's metrics were computed with (defaults for what it lacks).
+analysis::AnalysisParams stored_analysis_params(const TrialFileData& file);
+
+// True if `path` holds this trial, complete, with every metric the analysis stage now reports.
+bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t);
+
+}  // namespace bvc3d
