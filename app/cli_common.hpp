@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,12 @@ struct InterruptGuard {
     ~InterruptGuard();
 };
 [[noreturn]] void exit_interrupted();
+
+// Runs trials on this machine's threads into `out`, with a progress line on a terminal; Ctrl-C or
+// SIGTERM checkpoints and exits with status 130.
+ExperimentOutcome run_local_experiment(const std::vector<TrialConfig>& trials, const std::filesystem::path& out,
+                                       int jobs, double checkpoint_minutes,
+                                       std::function<void(const std::string&)> on_done = {});
 
 // "N trials in DIR (R run, S already complete) in T s, ... steps/s".
 void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome);

@@ -83,6 +83,25 @@ void exit_interrupted() {
     std::exit(130);
 }
 
+ExperimentOutcome run_local_experiment(const std::vector<TrialConfig>& trials, const std::filesystem::path& out,
+                                       int jobs, double checkpoint_minutes, std::function<void(const std::string&)> on_done) {
+    if (jobs < 0) throw InputError("--jobs must be >= 0");
+    if (checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+    ExperimentOptions opts;
+    opts.out_dir = out;
+    opts.jobs = jobs;
+    opts.progress = ::isatty(STDERR_FILENO);
+    opts.checkpoint_minutes = checkpoint_minutes;
+    opts.stop = &stop_flag();
+    opts.on_trial_done = std::move(on_done);
+    InterruptGuard guard;
+    try {
+        return run_experiment(trials, opts);
+    } catch (const Interrupted&) {
+        exit_interrupted();
+    }
+}
+
 void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome) {
     std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", n_trials, out.c_str(), outcome.ran,
                 outcome.skipped, outcome.wall_seconds);
@@ -202,16 +221,43 @@ void add_run(CLI::App& app) {
     });
 }
 
+struct PaperOptions {
+    std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol;
+    int seeds = 1, jobs = 0;
+    std::optional<double> hours;
+    double checkpoint_minutes = 0;
+    bool no_report = false, arena_extent = false;
+};
+
+// Models × tilts × seeds, seeds slowest.
+std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
+    if (o.seeds < 1) throw InputError("--seeds must be >= 1");
+    if (o.hours && !(*o.hours > 0)) throw InputError("--hours must be a positive number of hours");
+    std::vector<ModelSpec> models;
+    for (const auto& m : split(o.models)) models.push_back(config::resolve_model(m));
+    if (models.empty()) throw InputError("--models lists no model");
+    std::vector<double> tilts;
+    for (const auto& t : split(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
+    if (tilts.empty()) throw InputError("--tilts lists no tilt");
+    std::vector<TrialConfig> trials;
+    for (int seed = 0; seed < o.seeds; ++seed)
+        for (double tilt : tilts)
+            for (const auto& m : models) {
+                TrialConfig t;
+                t.world = WorldSpec{"cross", tilt, "+x+y"};
+                t.model = m;
+                t.seed = static_cast<std::uint64_t>(seed);
+                if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
+                if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
+                t.arena_extent = o.arena_extent;
+                trials.push_back(t);
+            }
+    return trials;
+}
+
 void add_paper(CLI::App& app) {
     auto* cmd = app.add_subcommand("paper", "Run the paper's experiment: models x tilted worlds x seeds, summary, figures");
-    struct Options {
-        std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol;
-        int seeds = 1, jobs = 0;
-        std::optional<double> hours;
-        double checkpoint_minutes = 0;
-        bool no_report = false, arena_extent = false;
-    };
-    auto o = std::make_shared<Options>();
+    auto o = std::make_shared<PaperOptions>();
     cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
     cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
     cmd->add_option("--hours", o->hours, "Shorten both phases to H simulated hours (default: the paper's 4 + 4)");
@@ -227,42 +273,8 @@ void add_paper(CLI::App& app) {
         "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and (via python3 -m bvc3d.report)\n"
         "figures and report.md. Completed trials are skipped on a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
-        if (o->seeds < 1) throw InputError("--seeds must be >= 1");
-        if (o->jobs < 0) throw InputError("--jobs must be >= 0");
-        if (o->hours && !(*o->hours > 0)) throw InputError("--hours must be a positive number of hours");
-        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-        std::vector<ModelSpec> models;
-        for (const auto& m : split(o->models)) models.push_back(config::resolve_model(m));
-        if (models.empty()) throw InputError("--models lists no model");
-        std::vector<double> tilts;
-        for (const auto& t : split(o->tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
-        if (tilts.empty()) throw InputError("--tilts lists no tilt");
-        std::vector<TrialConfig> trials;
-        for (int seed = 0; seed < o->seeds; ++seed)
-            for (double tilt : tilts)
-                for (const auto& m : models) {
-                    TrialConfig t;
-                    t.world = WorldSpec{"cross", tilt, "+x+y"};
-                    t.model = m;
-                    t.seed = static_cast<std::uint64_t>(seed);
-                    if (!o->protocol.empty()) t.protocol.kind = parse_protocol(o->protocol);
-                    if (o->hours) t.protocol.explore_hours = t.protocol.sample_hours = *o->hours;
-                    t.arena_extent = o->arena_extent;
-                    trials.push_back(t);
-                }
-        ExperimentOptions opts;
-        opts.out_dir = o->out;
-        opts.jobs = o->jobs;
-        opts.progress = ::isatty(STDERR_FILENO);
-        opts.checkpoint_minutes = o->checkpoint_minutes;
-        opts.stop = &stop_flag();
-        InterruptGuard guard;
-        ExperimentOutcome outcome;
-        try {
-            outcome = run_experiment(trials, opts);
-        } catch (const Interrupted&) {
-            exit_interrupted();
-        }
+        const auto trials = paper_trials(*o);
+        const ExperimentOutcome outcome = run_local_experiment(trials, o->out, o->jobs, o->checkpoint_minutes);
         print_outcome(trials.size(), o->out, outcome);
         summarize(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());

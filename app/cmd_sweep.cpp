@@ -37,18 +37,78 @@ void copy_sweep_file(const std::string& from, const std::filesystem::path& dir) 
     out.commit();
 }
 
+struct SweepOptions {
+    std::string file, out;
+    std::optional<double> hours;
+    int jobs = 0;
+    double checkpoint_minutes = 0;
+    bool no_report = false, dry_run = false, verbose = false;
+};
+
+// The sweep's trials with the command line's overrides, checked before anything runs (and before MPI starts).
+config::Sweep checked_sweep(const SweepOptions& o) {
+    auto sweep = config::load_sweep_file(o.file);
+    if (o.hours) {
+        if (!(*o.hours > 0)) throw InputError("--hours must be a positive number of hours");
+        for (auto& t : sweep.trials) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
+    }
+    if (o.jobs < 0) throw InputError("--jobs must be >= 0");
+    if (o.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+    for (const auto& t : sweep.trials) t.world.resolve();
+    return sweep;
+}
+
+// "rank R: TRIAL" for every finished trial, one line at a time.
+std::function<void(const std::string&)> trial_printer(bool verbose, const int& rank) {
+    if (!verbose) return {};
+    auto print = std::make_shared<std::mutex>();
+    return [print, &rank](const std::string& name) {
+        std::lock_guard lock(*print);
+        std::printf("rank %d: %s\n", rank, name.c_str());
+        std::fflush(stdout);
+    };
+}
+
+#ifdef BVC3D_HAVE_MPI
+// Under mpirun: rank 0 deals groups of trials to the ranks. Returns false on ranks other than 0.
+bool run_over_mpi(const config::Sweep& sweep, const SweepOptions& o, const std::filesystem::path& out,
+                  ExperimentOutcome& outcome) {
+    int provided = 0;
+    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+    if (provided < MPI_THREAD_SERIALIZED) {
+        std::cerr << "bvc3d: the MPI library does not support MPI_THREAD_SERIALIZED\n";
+        MPI_Abort(MPI_COMM_WORLD, 3);
+    }
+    InterruptGuard guard;
+    MpiCoordinator coord(MPI_COMM_WORLD, &stop_flag());
+    const int rank = coord.rank();
+    ExperimentOptions opts;
+    opts.out_dir = out;
+    opts.jobs = o.jobs == 0 ? 1 : o.jobs;
+    opts.checkpoint_minutes = o.checkpoint_minutes;
+    opts.stop = &stop_flag();
+    opts.progress = ::isatty(STDERR_FILENO);
+    opts.on_trial_done = trial_printer(o.verbose, rank);
+    if (coord.is_root()) copy_sweep_file(o.file, out);
+    try {
+        outcome = run_experiment(sweep.trials, opts, &coord);
+    } catch (const Interrupted&) {
+        MPI_Finalize();
+        exit_interrupted();
+    } catch (const std::exception& e) {
+        std::cerr << "bvc3d: error on rank " << rank << ": " << e.what() << "\n";
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
+    MPI_Finalize();
+    return rank == 0;
+}
+#endif
+
 }  // namespace
 
 void add_sweep_command(CLI::App& app) {
     auto* cmd = app.add_subcommand("sweep", "Run a parameter sweep (conditions x seeds) on local cores or over MPI");
-    struct Options {
-        std::string file, out;
-        std::optional<double> hours;
-        int jobs = 0;
-        double checkpoint_minutes = 0;
-        bool no_report = false, dry_run = false, verbose = false;
-    };
-    auto o = std::make_shared<Options>();
+    auto o = std::make_shared<SweepOptions>();
     cmd->add_option("sweep", o->file, "Sweep YAML file (docs/sweeps.md)")->required();
     cmd->add_option("--out", o->out, "Output folder (default results/<sweep name>)");
     cmd->add_option("--hours", o->hours, "Shorten both phases of every trial to H simulated hours");
@@ -61,14 +121,7 @@ void add_sweep_command(CLI::App& app) {
         "Under `mpirun -np N bvc3d sweep FILE`, rank 0 deals trials to the ranks as they become free; the output\n"
         "folder must be shared by all ranks. Completed trials are skipped on a rerun. See docs/cluster.md.");
     cmd->callback([o] {
-        // Everything that can be wrong with the input is found here, before MPI starts.
-        auto sweep = config::load_sweep_file(o->file);
-        if (o->hours) {
-            if (!(*o->hours > 0)) throw InputError("--hours must be a positive number of hours");
-            for (auto& t : sweep.trials) t.protocol.explore_hours = t.protocol.sample_hours = *o->hours;
-        }
-        if (o->jobs < 0) throw InputError("--jobs must be >= 0");
-        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+        const auto sweep = checked_sweep(*o);
         const std::filesystem::path out =
             o->out.empty() ? std::filesystem::path("results") / sweep.name : std::filesystem::path(o->out);
         if (o->dry_run) {
@@ -76,65 +129,22 @@ void add_sweep_command(CLI::App& app) {
             std::printf("%zu trials\n", sweep.trials.size());
             return;
         }
-        for (const auto& t : sweep.trials) t.world.resolve();
         ensure_writable_directory(out);
-
-        ExperimentOptions opts;
-        opts.out_dir = out;
-        opts.jobs = o->jobs;
-        opts.checkpoint_minutes = o->checkpoint_minutes;
-        opts.stop = &stop_flag();
-        opts.progress = ::isatty(STDERR_FILENO);
-        InterruptGuard guard;
-#ifndef BVC3D_HAVE_MPI
+        ExperimentOutcome outcome;
+#ifdef BVC3D_HAVE_MPI
+        if (launched_by_mpi()) {
+            if (!run_over_mpi(sweep, *o, out, outcome)) return;
+        } else
+#else
         if (launched_by_mpi())
             throw InputError("this bvc3d was built without MPI, so under mpirun every rank would run every trial: "
                              "rebuild with MPI (libopenmpi-dev) or run `bvc3d sweep` without mpirun");
 #endif
-        bool root = true;
-        int rank = 0;
-        std::mutex print;
-        if (o->verbose)
-            opts.on_trial_done = [&](const std::string& name) {
-                std::lock_guard lock(print);
-                std::printf("rank %d: %s\n", rank, name.c_str());
-                std::fflush(stdout);
-            };
-        ExperimentOutcome outcome;
-#ifdef BVC3D_HAVE_MPI
-        if (launched_by_mpi()) {
-            int provided = 0;
-            MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
-            if (provided < MPI_THREAD_SERIALIZED) {
-                std::cerr << "bvc3d: the MPI library does not support MPI_THREAD_SERIALIZED\n";
-                MPI_Abort(MPI_COMM_WORLD, 3);
-            }
-            if (o->jobs == 0) opts.jobs = 1;
-            MpiCoordinator coord(MPI_COMM_WORLD, &stop_flag());
-            root = coord.is_root();
-            rank = coord.rank();
-            if (root) copy_sweep_file(o->file, out);
-            try {
-                outcome = run_experiment(sweep.trials, opts, &coord);
-            } catch (const Interrupted&) {
-                MPI_Finalize();
-                exit_interrupted();
-            } catch (const std::exception& e) {
-                std::cerr << "bvc3d: error on rank " << coord.rank() << ": " << e.what() << "\n";
-                MPI_Abort(MPI_COMM_WORLD, 2);
-            }
-            MPI_Finalize();
-        } else
-#endif
         {
             copy_sweep_file(o->file, out);
-            try {
-                outcome = run_experiment(sweep.trials, opts);
-            } catch (const Interrupted&) {
-                exit_interrupted();
-            }
+            static const int rank = 0;
+            outcome = run_local_experiment(sweep.trials, out, o->jobs, o->checkpoint_minutes, trial_printer(o->verbose, rank));
         }
-        if (!root) return;
         print_outcome(sweep.trials.size(), out, outcome);
         summarize(out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md\n", out.c_str());

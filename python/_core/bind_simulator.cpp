@@ -79,7 +79,7 @@ void bind_world(pyb::module_& m) {
             pyb::arg("tilt_deg") = CrossArenaParams{}.tilt_deg, pyb::arg("lean") = CrossArenaParams{}.lean,
             "The paper's cross arena")
         .def_static(
-            "from_yaml", [](const std::string& path) { return World(config::load_world_file(path)); },
+            "from_yaml", [](const std::filesystem::path& path) { return World(config::load_world_file(path.string())); },
             pyb::arg("path"))
         .def_static(
             "preset", [](const std::string& name) { return World(config::resolve_world(name)); },
@@ -145,7 +145,7 @@ void bind_simulator(pyb::module_& m) {
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
         "The paper's random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step");
     m.def(
-        "read_trajectory", [](const std::string& path) { return steps_to_dict(read_trajectory_file(path)); },
+        "read_trajectory", [](const std::filesystem::path& path) { return steps_to_dict(read_trajectory_file(path)); },
         pyb::arg("path"),
         R"doc(A trajectory file (rows t, x, y, [z], heading; docs/experiments.md#user-trajectories) as a dict of
 arrays t (shifted to start at 0), x, y, z, heading, bumped.)doc");

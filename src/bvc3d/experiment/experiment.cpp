@@ -110,132 +110,166 @@ private:
     std::atomic<std::size_t> next_{0};
 };
 
-}  // namespace
+// One call of run_experiment: the trials, their files and groups, and what the workers share.
+class ExperimentRun {
+public:
+    ExperimentRun(const std::vector<TrialConfig>& trials, const ExperimentOptions& options, Coordinator& coord)
+        : trials_(trials), options_(options), coord_(coord), ckpt_dir_(options.out_dir / ".checkpoints") {}
+    ExperimentOutcome run();
 
-ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options,
-                                 Coordinator* coordinator) {
-    const auto start = Clock::now();
-    LocalCoordinator local(0);
-    Coordinator& coord = coordinator ? *coordinator : local;
-    ExperimentOutcome outcome;
+private:
+    void check_trials() const;
+    bool complete(std::size_t i) const { return trial_file_complete(files_[i], trials_[i]); }
+    std::vector<std::size_t> unfinished_groups(int& complete_before) const;
+    void run_group(const Group& g);
+    void work();
+
+    const std::vector<TrialConfig>& trials_;
+    const ExperimentOptions& options_;
+    Coordinator& coord_;
+    std::filesystem::path ckpt_dir_;
+    std::vector<std::filesystem::path> files_;
+    std::vector<Group> groups_;
+    std::vector<std::size_t> pending_;  // indices into groups_, as the root dealt them
+    std::unique_ptr<Progress> progress_;
+    std::atomic<bool> interrupted_{false}, failed_{false}, stop_all_{false};
+    std::atomic<int> ran_{0};
+    std::exception_ptr error_;
+    std::mutex error_mutex_;
+};
+
+void ExperimentRun::check_trials() const {
     std::set<std::string> names;
-    for (const auto& t : trials) {
+    for (const auto& t : trials_) {
         if (!names.insert(t.name()).second) throw InputError("two trials would share the file name '" + t.name() + "'");
         t.validate();
         t.world.resolve();  // fail early on bad worlds
     }
-    ensure_writable_directory(options.out_dir);
-    const auto ckpt_dir = options.out_dir / ".checkpoints";
+    ensure_writable_directory(options_.out_dir);
+}
 
-    // Groups of trials that share a walk; the root decides which still have work.
-    std::vector<std::size_t> all(trials.size());
-    for (std::size_t i = 0; i < trials.size(); ++i) {
-        all[i] = i;
-        outcome.files.push_back(trial_path(options.out_dir, trials[i]));
-    }
-    const auto groups = make_groups(trials, all);
-    auto complete = [&](std::size_t i) { return trial_file_complete(outcome.files[i], trials[i]); };
+// Groups with at least one trial whose file is not complete (the root's view).
+std::vector<std::size_t> ExperimentRun::unfinished_groups(int& complete_before) const {
     std::vector<std::size_t> pending;
-    int complete_before = 0;
-    if (coord.is_root())
-        for (std::size_t g = 0; g < groups.size(); ++g) {
-            bool any = false;
-            for (std::size_t i : groups[g].members) {
-                const bool done = complete(i);
-                complete_before += done;
-                any = any || !done;
-            }
-            if (any) pending.push_back(g);
+    for (std::size_t g = 0; g < groups_.size(); ++g) {
+        bool any = false;
+        for (std::size_t i : groups_[g].members) {
+            const bool done = complete(i);
+            complete_before += done;
+            any = any || !done;
         }
-    pending = coord.agree(pending);
+        if (any) pending.push_back(g);
+    }
+    return pending;
+}
+
+void ExperimentRun::run_group(const Group& g) {
+    // Only the members whose files are missing run; they still share the agent.
+    std::vector<TrialConfig> members;
+    std::vector<std::filesystem::path> paths;
+    for (std::size_t i : g.members)
+        if (!complete(i)) {
+            members.push_back(trials_[i]);
+            paths.push_back(files_[i]);
+        }
+    if (members.empty()) return;
+    RunControl control;
+    control.stop = &stop_all_;
+    control.checkpoint = ckpt_dir_ / (g.key + ".h5");
+    control.checkpoint_minutes = options_.checkpoint_minutes;
+    double last = 0;
+    std::int64_t last_steps = 0;
+    const auto n_models = static_cast<std::int64_t>(members.size());
+    control.progress = [&](double t, std::int64_t steps) {
+        progress_->add(t - last, steps - last_steps, n_models);
+        last = t;
+        last_steps = steps;
+    };
+    const GroupOutcome done = run_analyze_write(members, paths, control);
+    for (const auto& m : members) {
+        if (options_.on_trial_done) options_.on_trial_done(m.name());
+        progress_->trial_done();
+        ++ran_;
+    }
+    progress_->add_steps(done.result.stats.explore_steps + done.result.stats.sample_steps, n_models);
+}
+
+// A worker thread: groups from the coordinator until none is left, or until a stop or an error.
+void ExperimentRun::work() {
+    while (!stop_all_.load()) {
+        const auto g = coord_.next();
+        if (!g) return;
+        try {
+            run_group(groups_[pending_[*g]]);
+        } catch (const Interrupted&) {
+            interrupted_ = true;
+        } catch (...) {
+            std::lock_guard lock(error_mutex_);
+            if (!error_) error_ = std::current_exception();
+            failed_ = true;
+        }
+    }
+    if (stop_all_.load()) interrupted_ = true;
+}
+
+ExperimentOutcome ExperimentRun::run() {
+    const auto start = Clock::now();
+    check_trials();
+    ExperimentOutcome outcome;
+    std::vector<std::size_t> all(trials_.size());
+    for (std::size_t i = 0; i < trials_.size(); ++i) {
+        all[i] = i;
+        files_.push_back(trial_path(options_.out_dir, trials_[i]));
+    }
+    outcome.files = files_;
+    // Groups of trials that share an agent; the root decides which still have work.
+    groups_ = make_groups(trials_, all);
+    int complete_before = 0;
+    pending_ = coord_.agree(coord_.is_root() ? unfinished_groups(complete_before) : std::vector<std::size_t>{});
     double total_seconds = 0;
     int todo_trials = 0;
-    for (std::size_t g : pending) {
-        total_seconds += trials[groups[g].members.front()].protocol.seconds();
-        todo_trials += static_cast<int>(groups[g].members.size());
+    for (std::size_t g : pending_) {
+        total_seconds += trials_[groups_[g].members.front()].protocol.seconds();
+        todo_trials += static_cast<int>(groups_[g].members.size());
     }
-    if (!pending.empty()) ensure_writable_directory(ckpt_dir);
-
-    Progress progress(options.progress && coord.is_root(), todo_trials, total_seconds);
-    std::atomic<bool> interrupted{false}, failed{false}, stop_all{false};
-    std::atomic<int> ran{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    // Stop everything on Ctrl-C or on the first error.
-    std::jthread watcher([&](std::stop_token st) {
-        while (!st.stop_requested()) {
-            if ((options.stop && options.stop->load()) || failed.load()) stop_all = true;
-            progress.print();
-            std::this_thread::sleep_for(std::chrono::milliseconds(200));
-        }
-    });
-
-    auto run_group = [&](const Group& g) {
-        // Only the members whose files are missing run; they still share the agent.
-        std::vector<TrialConfig> members;
-        std::vector<std::filesystem::path> paths;
-        for (std::size_t i : g.members)
-            if (!complete(i)) {
-                members.push_back(trials[i]);
-                paths.push_back(outcome.files[i]);
-            }
-        if (members.empty()) return;
-        RunControl control;
-        control.stop = &stop_all;
-        control.checkpoint = ckpt_dir / (g.key + ".h5");
-        control.checkpoint_minutes = options.checkpoint_minutes;
-        double last = 0;
-        std::int64_t last_steps = 0;
-        const auto n_models = static_cast<std::int64_t>(members.size());
-        control.progress = [&](double t, std::int64_t steps) {
-            progress.add(t - last, steps - last_steps, n_models);
-            last = t;
-            last_steps = steps;
-        };
-        const GroupOutcome done = run_analyze_write(members, paths, control);
-        for (const auto& m : members) {
-            if (options.on_trial_done) options.on_trial_done(m.name());
-            progress.trial_done();
-            ++ran;
-        }
-        const auto& stats = done.result.stats;
-        progress.add_steps(stats.explore_steps + stats.sample_steps, static_cast<std::int64_t>(members.size()));
-    };
-    auto worker = [&] {
-        while (!stop_all.load()) {
-            const auto g = coord.next();
-            if (!g) return;
-            try {
-                run_group(groups[pending[*g]]);
-            } catch (const Interrupted&) {
-                interrupted = true;
-            } catch (...) {
-                std::lock_guard lock(error_mutex);
-                if (!error) error = std::current_exception();
-                failed = true;
-            }
-        }
-        if (stop_all.load()) interrupted = true;
-    };
-    const int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    if (!pending_.empty()) ensure_writable_directory(ckpt_dir_);
+    progress_ = std::make_unique<Progress>(options_.progress && coord_.is_root(), todo_trials, total_seconds);
     {
-        std::vector<std::jthread> workers;
-        for (int j = 0; j < jobs; ++j) workers.emplace_back(worker);
+        // Stop everything on Ctrl-C or on the first error.
+        std::jthread watcher([&](std::stop_token st) {
+            while (!st.stop_requested()) {
+                if ((options_.stop && options_.stop->load()) || failed_.load()) stop_all_ = true;
+                progress_->print();
+                std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            }
+        });
+        const int jobs =
+            options_.jobs > 0 ? options_.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+        {
+            std::vector<std::jthread> workers;
+            for (int j = 0; j < jobs; ++j) workers.emplace_back([this] { work(); });
+        }
+        coord_.finish();
     }
-    coord.finish();
-    watcher.request_stop();
-    watcher.join();
-    if (error) std::rethrow_exception(error);
-    if (interrupted && !failed) throw Interrupted();
-    progress.print(true);
+    if (error_) std::rethrow_exception(error_);
+    if (interrupted_ && !failed_) throw Interrupted();
+    progress_->print(true);
     std::error_code ec;
-    std::filesystem::remove(ckpt_dir, ec);  // only if empty
+    std::filesystem::remove(ckpt_dir_, ec);  // only if empty
     outcome.skipped = complete_before;
-    outcome.ran = coord.is_root() ? static_cast<int>(trials.size()) - complete_before : ran.load();
-    outcome.steps = progress.steps();
-    outcome.model_steps = progress.model_steps();
+    outcome.ran = coord_.is_root() ? static_cast<int>(trials_.size()) - complete_before : ran_.load();
+    outcome.steps = progress_->steps();
+    outcome.model_steps = progress_->model_steps();
     outcome.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return outcome;
+}
+
+}  // namespace
+
+ExperimentOutcome run_experiment(const std::vector<TrialConfig>& trials, const ExperimentOptions& options,
+                                 Coordinator* coordinator) {
+    LocalCoordinator local(0);
+    return ExperimentRun(trials, options, coordinator ? *coordinator : local).run();
 }
 
 }  // namespace bvc3d
