@@ -23,7 +23,7 @@ namespace bvc3d::cli {
 
 namespace {
 
-// Launched by mpirun/srun? (Checked without initialising MPI, which a plain run must not need.)
+// Launched by mpirun/srun? (Checked without initializing MPI, which a plain run must not need.)
 bool launched_by_mpi() {
     for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"})
         if (std::getenv(v)) return true;

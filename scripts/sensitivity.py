@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """How the paper's findings depend on the analysis parameters (docs/reproduction.md).
 
-Re-analyses the trial files of an experiment folder with other DBSCAN min_samples and rate-map
-quantiles (one parameter at a time around the SPEC defaults) and prints, per setting, model and
+Re-analyzes the trial files of an experiment folder with other DBSCAN min_samples and rate-map
+quantiles (one parameter at a time around the default values) and prints, per setting, model and
 world, the mean over seeds of MI>0, mean MI, MI>1 and MSAI.
 
     PYTHONPATH=build/python /usr/bin/python3 scripts/sensitivity.py results/paper [--jobs 2] [--csv out.csv]
@@ -22,7 +22,7 @@ import bvc3d.analysis as an
 SETTINGS = [("min_samples", v) for v in (5, 10, 20, 40)] + [("quantile", v) for v in (0.5, 0.9, 0.95)]
 
 
-def analyse(path):
+def analyze(path):
     with h5py.File(path, "r") as f:
         x, y, rates = f["samples/x"][:], f["samples/y"][:], f["samples/rates"][:]
         model, world = f.attrs["model"], f.attrs["world"]
@@ -48,7 +48,7 @@ def main():
     if not files:
         sys.exit(f"no trial files in {args.folder}")
     with Pool(args.jobs) as pool:
-        rows = [r for per_file in pool.map(analyse, files) for r in per_file]
+        rows = [r for per_file in pool.map(analyze, files) for r in per_file]
     groups = {}
     for r in rows:
         groups.setdefault(r[:4], []).append(r[4:])

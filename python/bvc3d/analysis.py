@@ -162,7 +162,7 @@ def dbscan_cluster_count(points, eps=1.0, min_samples=20):
 
 def modality(centers, maps, eps=1.0, min_samples=20):
     """Modality index per cell: the DBSCAN cluster count (``dbscan_cluster_count``) over the
-    centres of the bins where the cell's map is > 0, in bin order.
+    centers of the bins where the cell's map is > 0, in bin order.
 
     Returns an int array (n_cells,) (an int for 1-D ``maps``).
     """
@@ -200,14 +200,14 @@ def aliasing(centers, maps, d_th=2.0):
 def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, templates="rate_maps"):
     """Localization error of a population-vector decoder (docs/analysis.md).
 
-    Templates (``templates="rate_maps"``, SPEC's decoder): the rate maps of the first ``n // 2``
+    Templates (``templates="rate_maps"``, the reference decoder): the rate maps of the first ``n // 2``
     samples, i.e. the mean rate of every cell in every bin they visit, thresholded at the cell's
     ``quantile`` and divided by the cell's maximum, exactly as ``rate_maps`` does it, but on the
     trial's grid (extent from all samples unless given). ``templates="means"`` uses the raw mean
     rates per bin instead (no threshold, no per-cell scaling; ``quantile`` is then unused).
     Each sample of the second half is decoded to the bin whose template is most cosine-similar to
     the sample's rates (ties: first bin in matplotlib's order); its error is the distance from its
-    true position to that bin's centre. Samples with no positive similarity to any template (e.g.
+    true position to that bin's center. Samples with no positive similarity to any template (e.g.
     all cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of the
     statistics. Needs at least 2 samples (ValueError otherwise; ``analyze`` copes with fewer).
 
@@ -225,7 +225,7 @@ def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
 
     * ``peak_rate``: maximum of the cell's mean-rate map;
     * ``mean_rate``: occupancy-weighted mean rate, sum_b p_b * rate_b with p_b = count_b / n;
-    * ``field_area_m2``: number of bins whose normalised map (``rate_maps``) is > 0.5 times the
+    * ``field_area_m2``: number of bins whose normalized map (``rate_maps``) is > 0.5 times the
       area of one hexagon (sx * sy / 2);
     * ``spatial_info``: Skaggs information sum_b p_b rate_b log2(rate_b / mean_rate) in bits per
       sample (bins with rate <= 0 add nothing; 0 for a silent cell);

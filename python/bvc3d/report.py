@@ -78,7 +78,7 @@ class Folder:
 
 
 def hexmap(ax, centers, values, extent=None, cmap="viridis", vmin=None, vmax=None):
-    """Draw per-bin values at their hexagon centres: each centre falls in its own bin."""
+    """Draw per-bin values at their hexagon centers: each center falls in its own bin."""
     cx, cy = centers[:, 0], centers[:, 1]
     if extent is None:
         extent = (cx.min(), cx.max(), cy.min(), cy.max())
@@ -353,7 +353,7 @@ def make_report(path):
     add("msai.png", "Mean spatial aliasing index per model and tilt: lower is better.",
         lambda p: fig_bars(folder, "msai", p))
     add("decoding.png", "Median position error when each sample of the second half is decoded to the cosine-"
-        "nearest rate-map bin of the first half: the direct measure of localisation.",
+        "nearest rate-map bin of the first half: the direct measure of localization.",
         lambda p: fig_bars(folder, "decode_median_m", p))
     write_report(folder, figures)
     return figures

@@ -1,5 +1,5 @@
 """bvc3d.analysis against its peers: matplotlib's hexbin, numpy's percentile, scikit-learn's DBSCAN,
-a brute-force numpy SAI and a dense numpy decoder (SPEC §8, issue 4)."""
+a brute-force numpy SAI and a dense numpy decoder (docs/model-reference.md#analysis, issue 4)."""
 import math
 
 import matplotlib
@@ -37,7 +37,7 @@ def assert_same_as_matplotlib(x, y, values, gridsize=50, extent=None):
     for k in range(cols.shape[1]):
         off, arr = mpl_hexbin(x, y, cols[:, k].astype(np.float64), gridsize, extent)
         assert off.shape == centers.shape, f"column {k}: {len(off)} bins in matplotlib, {len(centers)} here"
-        assert np.array_equal(off, centers), "bin centres differ"
+        assert np.array_equal(off, centers), "bin centers differ"
         np.testing.assert_allclose(means[:, k], arr, rtol=0, atol=1e-12)
     assert counts.sum() <= len(x) and np.all(counts > 0)
     return centers, means, counts
@@ -67,17 +67,17 @@ def sklearn_count(points, eps, min_samples):
     return int(DBSCAN(eps=eps, min_samples=min_samples).fit(points).labels_.max() + 1)
 
 
-def sklearn_neighbourhoods(points, eps):
+def sklearn_neighborhoods(points, eps):
     nb = NearestNeighbors(radius=eps).fit(points).radius_neighbors(points, return_distance=False)
     return [set(v.tolist()) for v in nb]
 
 
-def our_neighbourhoods(points, eps):
+def our_neighborhoods(points, eps):
     off, ind = _core.radius_neighbors(np.ascontiguousarray(points, dtype=float), eps)
     return [set(ind[off[i]:off[i + 1]].tolist()) for i in range(len(points))]
 
 
-def plain_neighbourhoods(points, eps):
+def plain_neighborhoods(points, eps):
     d2 = (points[:, None, 0] - points[None, :, 0]) ** 2 + (points[:, None, 1] - points[None, :, 1]) ** 2
     return [set(np.nonzero(row <= eps * eps)[0].tolist()) for row in d2]
 
@@ -263,7 +263,7 @@ def hex_lattice(a, rows, cols, origin=(0.0, 0.0), angle=0.0):
 
 
 def test_dbscan_hex_lattice_at_exactly_eps():
-    # Six neighbours at nominally eps: whether each counts decides core points for min_samples = 7.
+    # Six neighbors at nominally eps: whether each counts decides core points for min_samples = 7.
     rng = np.random.default_rng(2)
     n_cases = 0
     for trial in range(40):
@@ -276,12 +276,12 @@ def test_dbscan_hex_lattice_at_exactly_eps():
         for ms in (3, 5, 6, 7, 8, 20):
             assert A.dbscan_cluster_count(pts, a, ms) == sklearn_count(pts, a, ms), (trial, a, ms)
             n_cases += 1
-        assert our_neighbourhoods(pts, a) == sklearn_neighbourhoods(pts, a)
+        assert our_neighborhoods(pts, a) == sklearn_neighborhoods(pts, a)
     assert n_cases == 240
 
 
-def test_dbscan_hexbin_centres_at_exactly_eps():
-    # The bins' own lattice with eps = a centre-to-centre distance as computed in floating point.
+def test_dbscan_hexbin_centers_at_exactly_eps():
+    # The bins' own lattice with eps = a center-to-center distance as computed in floating point.
     x, y = walk(45, 1.0, 5)
     centers, _, _ = A.hexbin(x, y, np.ones(len(x)), gridsize=50)
     d = np.sqrt(((centers[:, None, :] - centers[None, :, :]) ** 2).sum(-1))
@@ -291,7 +291,7 @@ def test_dbscan_hexbin_centres_at_exactly_eps():
         sub = centers[rng.random(len(centers)) < 0.8]
         for ms in (2, 4, 7, 13, 20):
             assert A.dbscan_cluster_count(sub, eps, ms) == sklearn_count(sub, eps, ms), (eps, ms)
-        assert our_neighbourhoods(sub, eps) == sklearn_neighbourhoods(sub, eps)
+        assert our_neighborhoods(sub, eps) == sklearn_neighborhoods(sub, eps)
 
 
 def test_dbscan_kd_tree_node_tests_are_reproduced():
@@ -307,9 +307,9 @@ def test_dbscan_kd_tree_node_tests_are_reproduced():
         p[:, 1] = rng.integers(-1, 2, n) * 2.0**-26 + 3.0 * rng.integers(0, 3, n) * (trial % 3 == 0)
         if trial % 4 == 1:
             p = p[:, ::-1].copy()
-        sk = sklearn_neighbourhoods(p, 1.0)
-        assert our_neighbourhoods(p, 1.0) == sk, trial
-        differs_from_plain += sk != plain_neighbourhoods(p, 1.0)
+        sk = sklearn_neighborhoods(p, 1.0)
+        assert our_neighborhoods(p, 1.0) == sk, trial
+        differs_from_plain += sk != plain_neighborhoods(p, 1.0)
         for ms in (2, 3, int(rng.integers(1, 30))):
             assert A.dbscan_cluster_count(p, 1.0, ms) == sklearn_count(p, 1.0, ms), (trial, ms)
     assert differs_from_plain > 10, "the set must exercise sklearn's node-level acceptance"
@@ -325,9 +325,9 @@ def test_dbscan_small_sets_use_sklearns_brute_force_rule():
         base = rng.uniform(-6, 6, 2)
         ij = rng.integers(-2, 3, (n, 2))
         pts = np.column_stack([base[0] + a * (ij[:, 0] + 0.5 * (ij[:, 1] % 2)), base[1] + a * ij[:, 1] * math.sqrt(3) / 2])
-        sk = sklearn_neighbourhoods(pts, a)
-        assert our_neighbourhoods(pts, a) == sk
-        differs_from_plain += sk != plain_neighbourhoods(pts, a)
+        sk = sklearn_neighborhoods(pts, a)
+        assert our_neighborhoods(pts, a) == sk
+        differs_from_plain += sk != plain_neighborhoods(pts, a)
         for ms in range(1, n + 2):
             assert A.dbscan_cluster_count(pts, a, ms) == sklearn_count(pts, a, ms)
     assert differs_from_plain > 10
@@ -376,7 +376,7 @@ def test_sai_matches_brute_force_double_loop(seed):
     rng = np.random.default_rng(seed)
     rates = place_population(x, y, 12, rng, sigma=1.0)
     centers, maps = A.rate_maps(x, y, rates, gridsize=16)
-    # A d_th equal to a centre distance: pairs at exactly d_th are near (not > d_th).
+    # A d_th equal to a center distance: pairs at exactly d_th are near (not > d_th).
     d = np.sqrt(((centers[:, None, :] - centers[None, :, :]) ** 2).sum(-1))
     for d_th in (2.0, 0.0, float(d[0, len(d) // 2]), 100.0):
         sai, msai = A.aliasing(centers, maps, d_th)
@@ -400,7 +400,7 @@ def test_sai_random_maps_with_zero_rows_and_negative_entries():
 
 
 def numpy_rate_maps(means, quantile):
-    """SPEC §8 maps from per-bin means, written out in numpy: per cell, values below
+    """docs/model-reference.md#analysis maps from per-bin means, written out in numpy: per cell, values below
     numpy.percentile(cell, 100 q) set to 0, then divided by the cell's maximum (silent: zeros)."""
     maps = means.copy()
     for k in range(maps.shape[1]):
@@ -412,7 +412,7 @@ def numpy_rate_maps(means, quantile):
 
 
 def dense_decoder(x, y, rates, templates="rate_maps", quantile=0.1, gridsize=50):
-    """SPEC's decoder in plain numpy: templates from the first half on the whole trial's grid,
+    """the reference decoder in plain numpy: templates from the first half on the whole trial's grid,
     cosine similarity of every second-half sample with every template, argmax."""
     n = len(x)
     half = n // 2
@@ -447,7 +447,7 @@ def test_decoding_matches_a_dense_numpy_decoder(floor, quantile, templates):
 
 
 def test_decoding_default_templates_are_the_spec_rate_maps():
-    """SPEC §8: the templates are the thresholded, max-normalised rate maps of the first half."""
+    """docs/model-reference.md#analysis: the templates are the thresholded, max-normalized rate maps of the first half."""
     x, y = walk(45, 1.0, 8)
     rates = place_population(x, y, 120, np.random.default_rng(8), sigma=0.7)  # peak rates 0.3-1: scaling matters
     d = A.decoding_error(x, y, rates)
@@ -455,7 +455,7 @@ def test_decoding_default_templates_are_the_spec_rate_maps():
     assert (d["n_decoded"], d["n_undecoded"]) == (n_ok, n_bad)
     assert abs(d["median_m"] - med) < 1e-9 and abs(d["mean_m"] - mean) < 1e-9
     assert d == A.decoding_error(x, y, rates, templates="rate_maps", quantile=0.1)
-    # ... and not the raw means: the per-cell normalisation changes which bins win.
+    # ... and not the raw means: the per-cell normalization changes which bins win.
     med_m, mean_m, _, _ = dense_decoder(x, y, rates, "means")
     assert abs(mean - mean_m) > 1e-6
     means = A.decoding_error(x, y, rates, templates="means")
@@ -478,7 +478,7 @@ def test_decoding_gaussian_fields_is_accurate_and_shuffled_is_chance(templates):
     assert good["median_m"] < 0.35 and good["mean_m"] < 0.5 and good["n_undecoded"] == 0
     shuffled = rates[rng.permutation(len(x))]
     bad = A.decoding_error(x, y, shuffled, templates=templates)
-    # Chance: the distance from the true positions to the centres of random samples' positions.
+    # Chance: the distance from the true positions to the centers of random samples' positions.
     half = len(x) // 2
     pick = rng.integers(0, half, len(x) - half)
     chance = np.median(np.hypot(x[half:] - x[pick], y[half:] - y[pick]))

@@ -208,7 +208,7 @@ def test_trial_yaml(tmp_path):
         assert f.attrs["model"] == "3d-0.1" and f.attrs["seed"] == 3 and f.attrs["tilt_deg"] == 30
         assert f["samples/bvc_rates"].shape[1] == 960
         c = f["metrics/bin_centers"][:]
-        # Binned over the arena [-5, 5]²: centres sit on its lattice (steps 10/50 in x, 10/28 in y,
+        # Binned over the arena [-5, 5]²: centers sit on its lattice (steps 10/50 in x, 10/28 in y,
         # the second lattice offset by half a step), not on the trajectory's.
         for v, step in ((c[:, 0], 10 / 50), (c[:, 1], 10 / 28)):
             k = (v + 5) / step * 2

@@ -9,7 +9,7 @@ from conftest import run_cli
 
 
 def reference_raw(returns, elevations, n_dir, n_per_axis, max_dist, sr, st, sp):
-    """SPEC §5 written with numpy broadcasting over every return and every cell."""
+    """docs/model-reference.md#boundary-vector-cells written with numpy broadcasting over every return and every cell."""
     g = lambda x, s: np.exp(-x ** 2 / (2 * s * s)) / math.sqrt(2 * math.pi * s * s)
     r, th, ph = returns[:, 0], returns[:, 1], returns[:, 2]
     theta = np.arange(n_dir) * 2 * math.pi / n_dir

@@ -1,10 +1,10 @@
-"""Time every SPEC §8 metric of one trial-sized input with bvc3d and with the straightforward
+"""Time every docs/model-reference.md#analysis metric of one trial-sized input with bvc3d and with the straightforward
 numpy / scikit-learn computation of the same metric, and check that they agree.
 
     PYTHONPATH=build/python /usr/bin/python3 test/ubench/analysis_bench.py [--samples 50000]
         [--cells 250] [--repeats 3] [--seed 1] [--dense]
 
-Input: a random walk in the 45° cross arena (SPEC §4) cut to --samples steps, and --cells sparse
+Input: a random walk in the 45° cross arena (docs/model-reference.md#robot-and-random-walk) cut to --samples steps, and --cells sparse
 place-field-like rates (1-3 Gaussian fields per cell, sigma 0.6 m, values below 0.05 set to 0,
 10 % silent cells), float32 as a trial records them. Times are the median of --repeats runs
 (references slower than 5 s run once). --dense replaces the rates by uniform random ones, all
@@ -92,7 +92,7 @@ def np_means(flat, centers, n_bins, values):
     return centers[visited], sums[visited] / counts[visited, None], counts[visited]
 
 
-def np_threshold_normalise(means, quantile=0.1):
+def np_threshold_normalize(means, quantile=0.1):
     maps = means.copy()
     for k in range(maps.shape[1]):
         col = maps[:, k]
@@ -105,7 +105,7 @@ def np_threshold_normalise(means, quantile=0.1):
 def np_rate_maps(x, y, rates, quantile=0.1):
     flat, centers, n_bins, area = np_bins(x, y)
     c, means, counts = np_means(flat, centers, n_bins, rates)
-    return c, np_threshold_normalise(means, quantile), means, counts, area
+    return c, np_threshold_normalize(means, quantile), means, counts, area
 
 
 def mpl_hexbin_cells(x, y, rates, cells):
@@ -136,11 +136,11 @@ def np_sai(centers, maps, d_th=2.0):
 
 
 def np_decoding(x, y, rates, templates="rate_maps"):
-    """SPEC's decoder: templates = the first half's rate maps on the trial's grid (or raw means)."""
+    """the reference decoder: templates = the first half's rate maps on the trial's grid (or raw means)."""
     half = len(x) // 2
     flat, centers, n_bins, _ = np_bins(x, y)
     c, means, _ = np_means(flat[:half], centers, n_bins, rates[:half])
-    tmpl = np_threshold_normalise(means) if templates == "rate_maps" else means
+    tmpl = np_threshold_normalize(means) if templates == "rate_maps" else means
     norms = np.linalg.norm(tmpl, axis=1, keepdims=True)
     unit = np.divide(tmpl, norms, out=np.zeros_like(tmpl), where=norms > 0)
     errors = []

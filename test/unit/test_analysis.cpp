@@ -1,5 +1,5 @@
-// Analysis stage (SPEC §8): hexagonal bins by matplotlib's rule, numpy's percentile, DBSCAN by
-// scikit-learn's neighbourhood rule, SAI against a double loop, decoding of a synthetic population.
+// Analysis stage (docs/model-reference.md#analysis): hexagonal bins by matplotlib's rule, numpy's percentile, DBSCAN by
+// scikit-learn's neighborhood rule, SAI against a double loop, decoding of a synthetic population.
 // The exact comparisons against matplotlib, numpy and scikit-learn themselves are in
 // test/python/test_analysis.py; here the rules are checked on cases worked out by hand.
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@ using namespace bvc3d::analysis;
 
 namespace {
 
-// A grid whose lattice units are metres, so index coordinates are the coordinates themselves.
+// A grid whose lattice units are meters, so index coordinates are the coordinates themselves.
 HexGrid unit_grid(int nx, int ny) {
     HexGrid g;
     g.nx = nx;
@@ -55,10 +55,10 @@ TEST(AnalysisHexbin, GridFromExtentPadsXOnly) {
 }
 
 TEST(AnalysisHexbin, BinRuleRoundingTiesAndEdges) {
-    const HexGrid g = unit_grid(4, 2);  // lattice 1: 5 × 3 centres, lattice 2 starts at 15
+    const HexGrid g = unit_grid(4, 2);  // lattice 1: 5 × 3 centers, lattice 2 starts at 15
     EXPECT_EQ(g.bin_of(0.0, 0.0), 0);
     EXPECT_EQ(g.bin_of(2.0, 1.0), 2 * 3 + 1);
-    EXPECT_EQ(g.bin_of(0.5, 0.5), 15);      // a lattice-2 centre
+    EXPECT_EQ(g.bin_of(0.5, 0.5), 15);      // a lattice-2 center
     EXPECT_EQ(g.bin_of(0.25, 0.25), 15);    // d1 == d2: lattice 2 wins
     EXPECT_EQ(g.bin_of(0.2, 0.25), 0);      // d1 < d2
     EXPECT_EQ(g.bin_of(0.5, 0.0), 0);       // numpy.round(0.5) = 0 (half to even)
@@ -203,7 +203,7 @@ TEST(AnalysisAliasing, MatchesDoubleLoop) {
 }
 
 TEST(AnalysisDecoding, GaussianPlaceFieldsDecodeWell) {
-    // A sweep over the arena and one Gaussian field per cell on a 10 × 10 grid of centres.
+    // A sweep over the arena and one Gaussian field per cell on a 10 × 10 grid of centers.
     std::mt19937_64 rng(9);
     std::uniform_real_distribution<double> u(-5, 5);
     const int n = 20000, cells = 100;
@@ -228,10 +228,10 @@ TEST(AnalysisDecoding, GaussianPlaceFieldsDecodeWell) {
     }
 }
 
-TEST(AnalysisDecoding, DefaultTemplatesAreTheNormalisedRateMaps) {
+TEST(AnalysisDecoding, DefaultTemplatesAreTheNormalizedRateMaps) {
     // First half: x = 0 with rates (10, 1), x = 1 with (1, 0.6), x = 2 silent (three bins; the 10 %
     // quantile of each cell is then below its smaller rate and removes nothing). Raw means are the
-    // templates (10, 1) and (1, 0.6); the SPEC rate maps, normalised per cell, are (1, 1) and
+    // templates (10, 1) and (1, 0.6); the rate maps, normalized per cell, are (1, 1) and
     // (0.1, 0.6). Second half, cosines with x = 0's and x = 1's template:
     //   (10, 1) at x = 0:  means 1.00 / 0.90, maps 0.77 / 0.26: x = 0 either way;
     //   (1, 1) at x = 1:   means 0.77 / 0.97, maps 1.00 / 0.81: the maps decode it 1 m off;
@@ -244,7 +244,7 @@ TEST(AnalysisDecoding, DefaultTemplatesAreTheNormalisedRateMaps) {
     r << 10, 1, 1, 0.6, 0, 0, 0, 0,  // first half
         10, 1, 1, 1, 0.1, 1, 0, 0;   // second half
     DecodingParams params;
-    params.gridsize = 4;  // bin centres at x = 0, 1, 2 (to 1e-9)
+    params.gridsize = 4;  // bin centers at x = 0, 1, 2 (to 1e-9)
     const DecodingResult by_default = decoding_error<double>(x, y, r, params);
     params.templates = DecodingTemplates::means;
     const DecodingResult means = decoding_error<double>(x, y, r, params);

@@ -1,4 +1,4 @@
-// Boundary vector cells (SPEC §5) against the literal equations.
+// Boundary vector cells (docs/model-reference.md#boundary-vector-cells) against the literal equations.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +14,7 @@ using namespace bvc3d;
 
 namespace {
 
-// |fast - reference| <= 1e-6 of the step's largest reference rate, for every cell (SPEC §5).
+// |fast - reference| <= 1e-6 of the step's largest reference rate, for every cell (docs/model-reference.md#boundary-vector-cells).
 void expect_matches_reference(const BvcParams& p, const Scan& returns, const std::string& what) {
     const BoundaryVectorLayer layer(p);
     std::vector<double> fast(layer.n_cells());

@@ -1,4 +1,4 @@
-// Trials (SPEC §7): shared walks, protocols, checkpoints and trial files.
+// Trials (docs/model-reference.md#trial-protocol): shared walks, protocols, checkpoints and trial files.
 #include <gtest/gtest.h>
 
 #include <filesystem>

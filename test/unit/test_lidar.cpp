@@ -1,4 +1,4 @@
-// Beam layout of the scanners (SPEC §3) and the allocentric return convention (SPEC §1).
+// Beam layout of the scanners (docs/model-reference.md#sensors) and the allocentric return convention (docs/model-reference.md#conventions).
 #include <gtest/gtest.h>
 
 #include <cmath>

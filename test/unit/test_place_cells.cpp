@@ -1,4 +1,4 @@
-// The place-cell network (SPEC §6): dynamics, Oja learning, determinism.
+// The place-cell network (docs/model-reference.md#place-cell-network): dynamics, Oja learning, determinism.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -71,10 +71,10 @@ TEST(PlaceCellNetwork, WeightsStayBoundedOverALongRandomStream) {
     float max_w = 0;
     int active_steps = 0;
     for (int t = 0; t < 20000; ++t) {
-        // Sparse, bump-like BVC activity in [0, 0.5], as normalised layers give.
-        const int centre = static_cast<int>(u(gen) * 960);
+        // Sparse, bump-like BVC activity in [0, 0.5], as normalized layers give.
+        const int center = static_cast<int>(u(gen) * 960);
         for (int j = 0; j < 960; ++j) {
-            const int d = std::min(std::abs(j - centre), 960 - std::abs(j - centre));
+            const int d = std::min(std::abs(j - center), 960 - std::abs(j - center));
             vb[j] = 0.5 * std::exp(-0.5 * d * d / 100.0) * (0.5 + 0.5 * u(gen));
         }
         bool any = false;

@@ -1,4 +1,4 @@
-// The robot's random walk (SPEC §4): stays in the arena, never overlaps a wall, turns as specified,
+// The robot's random walk (docs/model-reference.md#robot-and-random-walk): stays in the arena, never overlaps a wall, turns as specified,
 // covers the floor, and is deterministic by seed.
 #include <gtest/gtest.h>
 
@@ -24,7 +24,7 @@ double distance_to_rect(double x, double y, double x0, double x1, double y0, dou
     return std::hypot(dx, dy);
 }
 
-// Distance from the body's centre to the nearest geometry minus the radius (negative: overlap).
+// Distance from the body's center to the nearest geometry minus the radius (negative: overlap).
 double oracle_clearance(double x, double y, double tilt_deg) {
     const double a = deg_to_rad(tilt_deg), h = 0.15 / std::cos(a), reach = h + 0.1 * std::tan(a);
     double d = std::min({5 - x, 5 + x, 5 - y, 5 + y});
@@ -80,7 +80,7 @@ TEST_P(PaperWorldWalk, FourHoursCoverEveryReachableHalfMetreCell) {
     const double tilt = GetParam();
     const World world = World::cross({.tilt_deg = tilt});
     const auto steps = random_walk(world, 4.0, 5);
-    // 30-50 thousand samples per 4-hour phase (SPEC §7).
+    // 30-50 thousand samples per 4-hour phase (docs/model-reference.md#trial-protocol).
     EXPECT_GT(steps.size(), 30000u);
     EXPECT_LT(steps.size(), 50000u);
     std::set<std::pair<int, int>> visited;
@@ -230,7 +230,7 @@ TEST(BodyCollider, ExactContactDistances) {
     w.mesh = box_mesh(Vec3(1.0, 1.0, 2.0));  // a 1 m post from z = -1 to 1, so 0 < z <= 0.1 is inside it
     w.walkable = Polygon2::rectangle(-5, -5, 5, 5);
     const BodyCollider body(w, R, 0.1);
-    // Head-on into the face x = -0.5 from x = -2: contact when the centre reaches -0.75.
+    // Head-on into the face x = -0.5 from x = -2: contact when the center reaches -0.75.
     EXPECT_NEAR(body.free_distance(Vec2(-2, 0), Vec2(1, 0), 5.0), 1.25, 1e-12);
     // Grazing the corner (-0.5, 0.5) from y = 0.6: contact where |c - corner| = R.
     const double dy = 0.1;
@@ -272,7 +272,7 @@ TEST(RandomWalk, NeverStartsInsideASolidObstacle) {
     EXPECT_FALSE(body.can_start_at(Vec2(0, 0)));
     EXPECT_TRUE(body.can_start_at(Vec2(3, 3)));
     const auto [inside, largest] = body.free_area(Vec2(0, 0));
-    EXPECT_NEAR(inside, 1.5 * 1.5, 0.3);  // the body's centre can roam |x|, |y| <= 0.75 in there
+    EXPECT_NEAR(inside, 1.5 * 1.5, 0.3);  // the body's center can roam |x|, |y| <= 0.75 in there
     EXPECT_NEAR(largest, 64 - 2.5 * 2.5 - (8 * 8 - 7.5 * 7.5), 1.5);
     // An explicit start point inside the box, or a start region that lies entirely inside it.
     try {

@@ -1,4 +1,4 @@
-// Ray distances in the paper's arenas against hand-solved intersections (SPEC §2.1).
+// Ray distances in the paper's arenas against hand-solved intersections (docs/model-reference.md#the-cross-arena).
 //
 // The oracle is written independently of the triangle mesh: each central wall is the box
 // |u| <= 3.5, |w| <= h, 0 <= z <= 2.5 in sheared coordinates (u along the wall, w = across - z·tan a),

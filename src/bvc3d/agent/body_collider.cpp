@@ -181,13 +181,13 @@ const BodyCollider::FreeSpace& BodyCollider::free_space() const {
         f.step = std::clamp(radius_ / 4, 0.02, 0.1);
         f.nx = std::max(1, static_cast<int>(std::ceil(f.box.sizes().x() / f.step)));
         f.ny = std::max(1, static_cast<int>(std::ceil(f.box.sizes().y() / f.step)));
-        const auto centre = [&](int i, int j) {
+        const auto center = [&](int i, int j) {
             return Vec2(f.box.min().x() + (i + 0.5) * f.step, f.box.min().y() + (j + 0.5) * f.step);
         };
         std::vector<char> clear(static_cast<std::size_t>(f.nx) * f.ny);
         for (int j = 0; j < f.ny; ++j)
-            for (int i = 0; i < f.nx; ++i) clear[static_cast<std::size_t>(j) * f.nx + i] = is_free(centre(i, j));
-        // Flood fill over moves between neighbouring centres that the body can make.
+            for (int i = 0; i < f.nx; ++i) clear[static_cast<std::size_t>(j) * f.nx + i] = is_free(center(i, j));
+        // Flood fill over moves between neighboring centers that the body can make.
         f.label.assign(clear.size(), -1);
         std::vector<int> stack;
         const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
@@ -207,7 +207,7 @@ const BodyCollider::FreeSpace& BodyCollider::free_space() const {
                     if (ni < 0 || nj < 0 || ni >= f.nx || nj >= f.ny) continue;
                     const int n = nj * f.nx + ni;
                     if (!clear[n] || f.label[n] >= 0) continue;
-                    if (free_distance(centre(i, j), Vec2(di[d], dj[d]), f.step) < f.step) continue;
+                    if (free_distance(center(i, j), Vec2(di[d], dj[d]), f.step) < f.step) continue;
                     f.label[n] = comp;
                     stack.push_back(n);
                 }
@@ -223,7 +223,7 @@ int BodyCollider::component_at(const Vec2& p) const {
     if (!is_free(p)) return -1;
     const int i0 = static_cast<int>(std::floor((p.x() - f.box.min().x()) / f.step));
     const int j0 = static_cast<int>(std::floor((p.y() - f.box.min().y()) / f.step));
-    // The cell holding p, or a neighbour whose centre p can reach in a straight line.
+    // The cell holding p, or a neighbor whose center p can reach in a straight line.
     for (int dj = -1; dj <= 1; ++dj)
         for (int di = -1; di <= 1; ++di) {
             const int i = i0 + di, j = j0 + dj;

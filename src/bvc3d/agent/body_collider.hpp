@@ -23,14 +23,14 @@ public:
     double radius() const { return radius_; }
     const std::vector<Segment2>& segments() const { return segments_; }
 
-    // How far the body can move from centre p along the unit direction u, up to max_dist, before
+    // How far the body can move from center p along the unit direction u, up to max_dist, before
     // it touches geometry. 0 if it already touches and u points into the contact.
     double free_distance(const Vec2& p, const Vec2& u, double max_dist) const;
 
-    // Distance from the centre p to the nearest segment, minus the radius (< 0: overlap).
+    // Distance from the center p to the nearest segment, minus the radius (< 0: overlap).
     double clearance(const Vec2& p) const;
 
-    // Inside the walkable region and not touching any wall. (A centre deep inside a solid obstacle is
+    // Inside the walkable region and not touching any wall. (A center deep inside a solid obstacle is
     // far from its walls too: see can_start_at.)
     bool is_free(const Vec2& p) const { return walkable_.contains(p) && clearance(p) >= 0.0; }
 
@@ -57,7 +57,7 @@ private:
     mutable std::vector<unsigned> stamp_;
     mutable unsigned epoch_ = 0;
 
-    // Connected free areas on a grid of body-centre positions, built on first use.
+    // Connected free areas on a grid of body-center positions, built on first use.
     struct FreeSpace {
         Eigen::AlignedBox2d box;
         double step = 0;
@@ -67,7 +67,7 @@ private:
         double largest = 0;
     };
     const FreeSpace& free_space() const;
-    int component_at(const Vec2& p) const;  // -1 if p cannot reach a free cell centre next to it
+    int component_at(const Vec2& p) const;  // -1 if p cannot reach a free cell center next to it
     mutable std::once_flag free_once_;
     mutable FreeSpace free_;
 };

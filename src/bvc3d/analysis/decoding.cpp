@@ -113,7 +113,7 @@ DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& 
     const std::size_t half = n / 2;
     const Bins first = bin_positions(grid, positions.topRows(static_cast<Eigen::Index>(half)));
     RowMatrixXd tmpl = bin_means<T>(first, rates.topRows(static_cast<Eigen::Index>(half)));
-    // SPEC §8: the first half's rate maps (threshold, then per-cell max-normalisation).
+    // docs/model-reference.md#analysis: the first half's rate maps (threshold, then per-cell max-normalization).
     if (templates == DecodingTemplates::rate_maps) threshold_and_normalize(tmpl, quantile);
     const RowMatrixXd unit = unit_rows(tmpl);  // score_b = t̂_b · r: r's norm does not change the best bin
     const auto second = rates.bottomRows(static_cast<Eigen::Index>(n - half));

@@ -17,8 +17,8 @@ namespace bvc3d::analysis {
 
 // What a bin's template is.
 enum class DecodingTemplates {
-    rate_maps,  // SPEC §8 (default): the first half's rate maps, thresholded at each cell's quantile
-                // and normalised to a maximum of 1 per cell
+    rate_maps,  // docs/model-reference.md#analysis (default): the first half's rate maps, thresholded at each cell's quantile
+                // and normalized to a maximum of 1 per cell
     means,      // option: the first half's raw mean rates per bin (hexbin means), no threshold or scaling
 };
 std::string decoding_templates_name(DecodingTemplates t);  // "rate_maps" | "means"

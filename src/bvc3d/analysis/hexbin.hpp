@@ -3,7 +3,7 @@
 // reduce_C_function=numpy.mean) does it (docs/analysis.md), for many value columns in one pass:
 // the 2-D Grid.
 // Takes: sample positions (x, y) and values (one row per sample). Gives: the visited bins in
-// matplotlib's order, their centres, sample counts and per-column means.
+// matplotlib's order, their centers, sample counts and per-column means.
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -17,8 +17,8 @@ namespace bvc3d::analysis {
 // matplotlib.transforms.nonsingular(vmin, vmax, expander, tiny=1e-15, increasing=True).
 std::array<double, 2> nonsingular(double vmin, double vmax, double expander);
 
-// Two interleaved rectangular lattices of hexagon centres. Lattice 1 has (nx+1)·(ny+1) centres at
-// (i·sx + xmin, j·sy + ymin); lattice 2 has nx·ny centres offset by half a step in x and y.
+// Two interleaved rectangular lattices of hexagon centers. Lattice 1 has (nx+1)·(ny+1) centers at
+// (i·sx + xmin, j·sy + ymin); lattice 2 has nx·ny centers offset by half a step in x and y.
 // A flat bin index runs over lattice 1 (i·(ny+1) + j) and then lattice 2 (offset + i·ny + j):
 // matplotlib's order of bins.
 struct HexGrid : Grid {

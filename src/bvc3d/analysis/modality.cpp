@@ -180,20 +180,20 @@ int cluster_count(const PointSet& pts, const DbscanParams& params) {
     // sklearn's dbscan_inner. Its neighborhoods need not be symmetric (see the KD-tree), so the
     // count follows the same expansion: a new cluster at each unlabeled core point in index order,
     // grown through the neighborhoods of core points only.
-    std::vector<char> labelled(n, 0);
+    std::vector<char> labeled(n, 0);
     std::vector<int> stack;
     int clusters = 0;
     for (std::size_t start = 0; start < n; ++start) {
-        if (labelled[start] || !core[start]) continue;
+        if (labeled[start] || !core[start]) continue;
         stack.push_back(static_cast<int>(start));
         while (!stack.empty()) {
             const auto i = static_cast<std::size_t>(stack.back());
             stack.pop_back();
-            if (labelled[i]) continue;
-            labelled[i] = 1;
+            if (labeled[i]) continue;
+            labeled[i] = 1;
             if (!core[i]) continue;
             for (int k = nb.offsets[i]; k < nb.offsets[i + 1]; ++k)
-                if (!labelled[static_cast<std::size_t>(nb.indices[static_cast<std::size_t>(k)])])
+                if (!labeled[static_cast<std::size_t>(nb.indices[static_cast<std::size_t>(k)])])
                     stack.push_back(nb.indices[static_cast<std::size_t>(k)]);
         }
         ++clusters;

@@ -13,12 +13,12 @@
 namespace bvc3d::analysis {
 
 struct DbscanParams {
-    double eps = 1.0;      // m, neighbourhood radius (distance <= eps)
-    int min_samples = 20;  // neighbours, the point itself included, that make a core point
+    double eps = 1.0;      // m, neighborhood radius (distance <= eps)
+    int min_samples = 20;  // neighbors, the point itself included, that make a core point
     void validate() const;
 };
 
-// Radius neighbourhoods in compressed rows: the neighbours of point i are
+// Radius neighborhoods in compressed rows: the neighbors of point i are
 // indices[offsets[i] .. offsets[i+1]), in no particular order.
 struct Neighborhoods {
     std::vector<int> offsets{0};
@@ -34,10 +34,10 @@ struct Neighborhoods {
 Neighborhoods sklearn_radius_neighbors(const Eigen::Ref<const Centers>& points, double eps);
 
 // Number of clusters of DBSCAN(eps, min_samples).fit(points) (labels >= 0), by scikit-learn's own
-// expansion order over its neighbourhoods. 0 for no points (where scikit-learn would refuse).
+// expansion order over its neighborhoods. 0 for no points (where scikit-learn would refuse).
 int dbscan_cluster_count(const Eigen::Ref<const Centers>& points, const DbscanParams& params = {});
 
-// Cluster count per cell (column of `maps`) over the centres of its bins with value > 0.
+// Cluster count per cell (column of `maps`) over the centers of its bins with value > 0.
 std::vector<int> modality(const Eigen::Ref<const Centers>& centers, const Eigen::Ref<const RowMatrixXd>& maps,
                           const DbscanParams& params = {});
 

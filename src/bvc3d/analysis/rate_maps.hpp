@@ -2,7 +2,7 @@
 // Rate maps (docs/analysis.md): per cell, the mean rate in each visited bin, then values below the
 // cell's q-quantile set to 0 and the map divided by its maximum.
 // Takes: positions (N × D, or x and y) and rates (one row per sample, one column per cell).
-// Gives: the bins, the raw mean rates and the thresholded, normalised maps (bins × cells).
+// Gives: the bins, the raw mean rates and the thresholded, normalized maps (bins × cells).
 #include <memory>
 #include <optional>
 #include <span>

@@ -14,7 +14,8 @@ namespace {
 
 // A factor exp(-x²/2σ²) below tiny_* (relative to its peak) is treated as zero. raw_pruned bounds
 // what that drops with the step's own weight sums and checks that it cannot reach 1e-7 of the
-// step's largest sum (SPEC §5 asks for 1e-6 of the largest rate); otherwise the full sum is used.
+// step's largest sum (the model asks for 1e-6 of the largest rate, docs/model-reference.md#exactness);
+// otherwise the full sum is used.
 // Elevation has two tiers: a (return, layer) below tiny_row is not summed but its exact weight
 // enters the bound; below tiny_phi it is not even evaluated and a worst case enters the bound.
 constexpr double tiny_r = 1e-9;

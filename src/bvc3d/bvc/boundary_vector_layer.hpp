@@ -52,9 +52,9 @@ public:
     // Input hygiene: a return whose range is NaN or +inf means "no return" and is skipped; a
     // negative range, -inf, or a non-finite angle throws InputError naming the return.
     //
-    // Unnormalised sums raw_i (SPEC §5), to within 1e-7 of the largest raw_i: terms whose factors
-    // are all but zero are pruned, and a per-step bound on what was pruned is checked; when it is
-    // not small enough the full sum is computed instead.
+    // Unnormalized sums raw_i (docs/model-reference.md#rates), to within 1e-7 of the largest raw_i:
+    // terms whose factors are all but zero are pruned, and a per-step bound on what was pruned is
+    // checked; when it is not small enough the full sum is computed instead.
     void raw(std::span<const LidarReturn> returns, std::span<double> out) const;
     // Normalized rates (per_step_max: raw / (2·max raw), so the largest is exactly 0.5).
     void rates(std::span<const LidarReturn> returns, std::span<double> out) const;
@@ -85,7 +85,7 @@ private:
     static void check_return(const LidarReturn& r, std::size_t index);
 
     BvcParams p_;
-    double c_r_, c_theta_, c_phi_;      // Gaussian normalisation constants 1/sqrt(2π σ²)
+    double c_r_, c_theta_, c_phi_;      // Gaussian normalization constants 1/sqrt(2π σ²)
     double cut_r_, cut_theta_, cut_phi_, cut_row_;  // factor windows: exp(-x²/2σ²) >= tiny inside
     std::vector<double> dist_decay_;    // exp(-n²Δ²/2σ_r²), n = 0..n_per_axis-1, zero-padded
     // The directions an azimuth reaches and their angular factors c_θ·exp(-x²/2σ_θ²): a pure

@@ -1,5 +1,5 @@
 #pragma once
-// Angle helpers shared by every stage (SPEC §1: radians inside the code).
+// Angle helpers shared by every stage (docs/model-reference.md#conventions: radians inside the code).
 #include <cmath>
 #include <numbers>
 

@@ -15,7 +15,7 @@ namespace bvc3d {
 
 class MpiCoordinator : public Coordinator {
 public:
-    // MPI must be initialised with at least MPI_THREAD_SERIALIZED.
+    // MPI must be initialized with at least MPI_THREAD_SERIALIZED.
     MpiCoordinator(MPI_Comm comm, const std::atomic<bool>* stop);
     ~MpiCoordinator() override;
 

@@ -1,5 +1,5 @@
 #pragma once
-// Place-cell stage (docs/model-reference.md#place-cells): a rate network driven by BVCs, learning
+// Place-cell stage (docs/model-reference.md#place-cell-network): a rate network driven by BVCs, learning
 // with Oja's rule.
 // Takes: BVC rates, one vector per model step. Gives: place-cell rates.
 //

@@ -80,8 +80,9 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
     const Vec3 origin(pose.x, pose.y, pose.z + spec_.height);
     const bool noisy = spec_.range_noise_sd > 0 || spec_.dropout > 0;
 
-    // Allocentric azimuths (exact, SPEC §1) and the horizontal unit vectors of the columns: the
-    // robot-frame table rotated by the heading, which saves a sin and cos per beam.
+    // Allocentric azimuths (exact; docs/model-reference.md#conventions) and the horizontal unit
+    // vectors of the columns: the robot-frame table rotated by the heading, which saves a sin and
+    // cos per beam.
     azimuths_.resize(n_cols);
     horizontal_.resize(n_cols);
     const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);

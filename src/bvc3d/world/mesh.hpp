@@ -33,7 +33,7 @@ TriangleMesh box_mesh(const Vec3& size);
 // A straight wall standing on z = 0 whose horizontal cross-section slides sideways with height:
 // at height z it is the rectangle of the given length and thickness centered on
 // center + z·tan(tilt)·left_normal, with left_normal = (-sin yaw, cos yaw). The footprint stays put
-// and the horizontal thickness is thickness / cos(tilt) (SPEC §2.1), so the wall's true
+// and the horizontal thickness is thickness / cos(tilt) (docs/model-reference.md#the-cross-arena), so the wall's true
 // thickness measured perpendicular to its faces is `thickness`.
 struct TiltedWall {
     Vec2 center{0.0, 0.0};

@@ -26,7 +26,7 @@ struct WorldDescription {
     StartRegion start;
 };
 
-// The paper's arena (SPEC §2.1).
+// The paper's arena (docs/model-reference.md#the-cross-arena).
 struct CrossArenaParams {
     double tilt_deg = 0.0;
     std::string lean = "+x+y";  // the corner the central walls lean toward
