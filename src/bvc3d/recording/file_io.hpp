@@ -1,0 +1,30 @@
+#pragma once
+// Internal to the recording stage: whole-file reads, all-or-nothing writes, and the one shape of
+// error every reader throws. Takes: paths and bytes. Gives: file contents, files on disk, and
+// InputErrors worded "<file>: <where>: <reason>" (where = "line 12", "point 7", ... or nothing).
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "bvc3d/core/error.hpp"
+
+namespace bvc3d::recording::detail {
+
+// The error to throw for bad input in `file`; `where` may be empty.
+InputError input_error(const std::filesystem::path& file, std::string_view where, std::string_view reason);
+InputError input_error(const std::filesystem::path& file, std::string_view reason);
+
+// "line 12", "point 7": the place part of an error message.
+std::string line_ref(std::size_t line);
+std::string point_ref(std::size_t point);
+
+// The whole file in memory. Throws InputError for a missing file, a directory, an unreadable
+// file or an empty one, naming the file and the reason.
+std::string read_file(const std::filesystem::path& file);
+
+// Writes `bytes` to a temporary file beside `file` and renames it into place, so that `file` is
+// either the old one or the complete new one. Write errors (a full disk, a missing folder) throw
+// InputError naming `file` and strerror.
+void write_file_atomically(const std::filesystem::path& file, std::string_view bytes);
+
+}  // namespace bvc3d::recording::detail
