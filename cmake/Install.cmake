@@ -17,7 +17,13 @@ set(BVC3D_PRIVATE_HEADERS
   bvc3d/core/simd.hpp
   bvc3d/analysis/point_grid.hpp
   bvc3d/recorder/hdf5_io.hpp
+  bvc3d/recording/file_io.hpp
+  bvc3d/recording/parsing.hpp
+  bvc3d/recording/cloud_builder.hpp
   bvc3d/experiment/mpi_coordinator.hpp)
+# The list, for test/install/run.sh to check that none of them is installed.
+string(REPLACE ";" "\n" BVC3D_PRIVATE_LINES "${BVC3D_PRIVATE_HEADERS}")
+file(WRITE ${PROJECT_BINARY_DIR}/private-headers.txt "${BVC3D_PRIVATE_LINES}\n")
 
 # Every other header under src/bvc3d is public: a new header is installed unless listed above.
 file(GLOB_RECURSE BVC3D_PUBLIC_HEADERS CONFIGURE_DEPENDS RELATIVE ${PROJECT_SOURCE_DIR}/src

@@ -13,14 +13,13 @@ prefix="$scratch/prefix"
 cmake --install "$build" --prefix "$prefix" >"$scratch/install.log"
 echo "install: installed into a scratch prefix: $(find "$prefix" -type f | wc -l) files"
 
-# Kernels and internals stay private (cmake/Install.cmake lists them).
-for header in bvc/bvc_kernels.hpp place/place_kernels.hpp core/simd.hpp analysis/point_grid.hpp \
-              recorder/hdf5_io.hpp experiment/mpi_coordinator.hpp; do
-  if [ -e "$prefix/include/bvc3d/$header" ]; then
-    echo "install: private header installed: include/bvc3d/$header" >&2
+# Kernels and internals stay private (cmake/Install.cmake lists them and writes the list to the build).
+while read -r header; do
+  if [ -e "$prefix/include/$header" ]; then
+    echo "install: private header installed: include/$header" >&2
     exit 1
   fi
-done
+done < "$build/private-headers.txt"
 # The installed package must not point back into the source or build tree.
 if grep -rl -e "$source_dir" -e "$build" "$prefix/lib/cmake/bvc3d"; then
   echo "install: the installed CMake package names the source or build tree (files above)" >&2
