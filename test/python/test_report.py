@@ -59,3 +59,39 @@ def test_pick_example_cell():
     assert report.pick_example_cell([0, 2, 2, 1], maps, "unimodal") == (3, "unimodal")
     assert report.pick_example_cell([0, 1, 1, 0], maps, "multimodal") == (2, "no multimodal cell; showing a unimodal one")
     assert report.pick_example_cell([0, 0], maps[:, :2], "unimodal")[0] is None
+
+
+def test_failed_report_hint_works_as_printed(tmp_path):
+    """When the figures fail, the error prints the command that redoes them; run verbatim in a shell
+    with nothing of ours in its environment (no PYTHONPATH; `python3` on PATH may lack numpy), it
+    works."""
+    import os
+    import shlex
+    import subprocess
+
+    from conftest import run_cli
+
+    out = tmp_path / "exp"
+    out.mkdir()
+    (out / "figures").write_text("a file where the figures folder goes: the report fails")
+    proc = run_cli("paper", "--hours", "0.02", "--models", "2d", "--tilts", "0", "--out", "exp", cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.splitlines()
+    i = next(k for k, line in enumerate(lines) if line.endswith("rerun it with:"))
+    command = lines[i + 1].strip()
+    assert command.startswith("PYTHONPATH=") and " -m bvc3d.report exp" in command
+    interpreter = shlex.split(command)[1]
+    assert os.path.isabs(interpreter), command  # an interpreter by path, not whatever `python3` is first on PATH
+    (out / "figures").unlink()
+    env = {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": str(tmp_path)}
+    done = subprocess.run(["bash", "-c", command], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert (out / "report.md").exists() and (out / "figures" / "msai.png").exists()
+    # The interpreter the program is told to use is the one it names.
+    env = dict(os.environ, BVC3D_PYTHON="/usr/bin/python3.11" if os.path.exists("/usr/bin/python3.11") else "/usr/bin/python3")
+    (out / "report.md").unlink()
+    (out / "figures" / "msai.png").unlink()
+    (out / "figures").rename(out / "figures.old")
+    (out / "figures").write_text("blocker")
+    proc = run_cli("summarize", "exp", cwd=tmp_path, env=env)
+    assert proc.returncode == 2 and f" {env['BVC3D_PYTHON']} -m bvc3d.report exp" in proc.stderr, proc.stderr
