@@ -186,3 +186,19 @@ def test_the_rounded_default_check_can_fail(tmp_path):
     with pytest.raises(AssertionError, match="turn_sd"):
         check_config("trial", {"robot": {"turn_sd": 0.5236}}, tmp_path, "test")
     check_config("model", {"base": "3d-0.2", "place": {"alpha_pb": 0.5}}, tmp_path, "test")  # a choice, not a rounding
+
+
+def test_documented_defaults_run_the_presets_bit_for_bit(tmp_path):
+    """The default trial of docs/experiments.md and the 3d-0.2 model of docs/model.md, saved as files,
+    give byte-identical trial files to the built-in defaults (shortened to 0.02 h per phase)."""
+    trial = next(b[3] for b in by_kind("bvc3d config") if b[2] == "bvc3d config")
+    model = next(b[3] for b in by_kind("bvc3d config") if b[2] == "bvc3d config --model 3d-0.2")
+    short = re.sub(r"(explore_hours|sample_hours): 4 ", r"\1: 0.02 ", trial)
+    assert short.count(": 0.02 ") == 2
+    (tmp_path / "trial.yaml").write_text(short)
+    (tmp_path / "model.yaml").write_text(model)
+    run_cli("run", "--config", tmp_path / "trial.yaml", "--out", tmp_path / "from_docs.h5", check=True)
+    run_cli("run", "--hours", "0.02", "--out", tmp_path / "builtin.h5", check=True)
+    run_cli("run", "--model", tmp_path / "model.yaml", "--hours", "0.02", "--out", tmp_path / "model_docs.h5", check=True)
+    for name in ("from_docs.h5", "model_docs.h5"):
+        assert (tmp_path / name).read_bytes() == (tmp_path / "builtin.h5").read_bytes(), name
