@@ -228,8 +228,10 @@ def bars_figure(folder, metric):
         ax.set_ylim(0, 1)
     elif clip:
         ax.set_ylim(bottom=min(lo, 0.0))
-    for bars, means, tops in drawn:
-        mark_small_bars(ax, bars, means, tops, DIGITS.get(metric, 3))
+    marks = [m for bars, means, tops in drawn for m in mark_small_bars(ax, bars, means, tops, DIGITS.get(metric, 3))]
+    lo, hi = ax.get_ylim()
+    if any(m.xy[1] > lo + 0.8 * (hi - lo) for m in marks):  # a value label high up: room for its text
+        ax.set_ylim(top=hi + 0.15 * (hi - lo))
     if folder.tilt_axis():
         ax.set_xticks(x, [f"{folder.tilt[w]:g}" for w in folder.worlds])
         ax.set_xlabel("tilt of the central walls (°), cross arena")
