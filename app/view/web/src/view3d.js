@@ -1,0 +1,155 @@
+// The 3-D view of one pane: the world (triangles, a recording's point-cloud map), the trajectory,
+// the agent, and the sensor's returns at the selected step, with orbit/zoom (three.js).
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { turbo } from './colormap.js';
+
+export class View3D {
+  constructor(container) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(1);
+    this.renderer.setClearColor(0xfcfcfc);
+    container.appendChild(this.renderer.domElement);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(50, 1, 0.05, 500);
+    this.camera.up.set(0, 0, 1);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.addEventListener('change', () => { this.dirty = true; });
+    this.scene.add(new THREE.AmbientLight(0xffffff, 1.6));
+    const sun = new THREE.DirectionalLight(0xffffff, 1.8);
+    sun.position.set(3, -5, 8);
+    this.scene.add(sun);
+    this.world = new THREE.Group();
+    this.scene.add(this.world);
+    this.dirty = true;
+    this.frames = 0;
+    new ResizeObserver(() => this.resize()).observe(container);
+    this.resize();
+  }
+
+  resize() {
+    const w = Math.max(1, this.container.clientWidth), h = Math.max(1, this.container.clientHeight);
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.dirty = true;
+  }
+
+  // A world blob: triangles as a light, see-through surface with its edges, and any points.
+  setWorld(blob) {
+    this.world.clear();
+    const { header, arrays } = blob;
+    if (arrays.triangles && arrays.triangles.length) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(arrays.triangles, 3));
+      g.computeVertexNormals();
+      const surface = new THREE.Mesh(g, new THREE.MeshLambertMaterial({
+        color: 0xb0bec5, transparent: true, opacity: 0.35, side: THREE.DoubleSide, depthWrite: false,
+      }));
+      this.world.add(surface);
+      this.world.add(new THREE.LineSegments(new THREE.EdgesGeometry(g, 25), new THREE.LineBasicMaterial({ color: 0x546e7a })));
+    }
+    if (arrays.points && arrays.points.length) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(arrays.points, 3));
+      this.world.add(new THREE.Points(g, new THREE.PointsMaterial({ color: 0x90a4ae, size: 1.5, sizeAttenuation: false })));
+    }
+    if (header.walkable && header.walkable.length > 2) {
+      const pts = header.walkable.map(([x, y]) => new THREE.Vector3(x, y, 0.001));
+      pts.push(pts[0].clone());
+      this.world.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(pts), new THREE.LineBasicMaterial({ color: 0x8d6e63 })));
+    }
+    if (header.bounds) this.frame(header.bounds);
+    this.dirty = true;
+  }
+
+  frame([[x0, y0, z0], [x1, y1, z1]]) {
+    const c = new THREE.Vector3((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2);
+    const size = Math.max(x1 - x0, y1 - y0, z1 - z0, 1);
+    this.camera.position.set(c.x + 0.15 * size, c.y - 1.05 * size, c.z + 0.85 * size);
+    this.controls.target.copy(c);
+    this.controls.update();
+  }
+
+  setTrajectory(x, y, z) {
+    if (this.trajectory) this.scene.remove(this.trajectory);
+    const n = x.length, pos = new Float32Array(3 * n);
+    for (let i = 0; i < n; i++) {
+      pos[3 * i] = x[i];
+      pos[3 * i + 1] = y[i];
+      pos[3 * i + 2] = (z ? z[i] : 0) + 0.01;
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+    this.trajectory = new THREE.Line(g, new THREE.LineBasicMaterial({ color: 0x3949ab, transparent: true, opacity: 0.35 }));
+    this.scene.add(this.trajectory);
+    this.dirty = true;
+  }
+
+  // The agent: a cone along its heading at (x, y, z).
+  setAgent(x, y, z, heading) {
+    if (!this.agent) {
+      this.agent = new THREE.Mesh(new THREE.ConeGeometry(0.12, 0.4, 16), new THREE.MeshLambertMaterial({ color: 0xc0392b }));
+      this.scene.add(this.agent);
+    }
+    this.agent.position.set(x, y, z + 0.12);
+    this.agent.rotation.set(0, 0, heading - Math.PI / 2);  // the cone points along +y before turning
+    this.dirty = true;
+  }
+
+  // Returns: world-frame points colored by range (turbo, 0 .. maxRange); the rows the model keeps
+  // drawn larger, the others small and faded.
+  setReturns(points, range, kept, maxRange) {
+    const n = range.length;
+    if (!this.returns) {
+      this.returns = [true, false].map((isKept) => {
+        const g = new THREE.BufferGeometry();
+        const m = new THREE.PointsMaterial({ size: isKept ? 4 : 1.5, sizeAttenuation: false, vertexColors: true,
+          transparent: !isKept, opacity: isKept ? 1 : 0.4, depthWrite: isKept });
+        const p = new THREE.Points(g, m);
+        p.frustumCulled = false;
+        this.scene.add(p);
+        return { points: p, capacity: 0 };
+      });
+    }
+    let nk = 0;
+    for (let i = 0; i < n; i++) nk += kept[i] ? 1 : 0;
+    const counts = [nk, n - nk];
+    this.returns.forEach((r, which) => {
+      const need = Math.max(counts[which], 1);
+      if (r.capacity < need) {
+        r.capacity = Math.max(need, 2 * r.capacity);
+        r.position = new THREE.BufferAttribute(new Float32Array(3 * r.capacity), 3);
+        r.color = new THREE.BufferAttribute(new Float32Array(3 * r.capacity), 3);
+        r.position.setUsage(THREE.DynamicDrawUsage);
+        r.color.setUsage(THREE.DynamicDrawUsage);
+        r.points.geometry.setAttribute('position', r.position);
+        r.points.geometry.setAttribute('color', r.color);
+      }
+      r.fill = 0;
+    });
+    for (let i = 0; i < n; i++) {
+      const r = this.returns[kept[i] ? 0 : 1];
+      const j = r.fill++;
+      r.position.array[3 * j] = points[3 * i];
+      r.position.array[3 * j + 1] = points[3 * i + 1];
+      r.position.array[3 * j + 2] = points[3 * i + 2];
+      turbo(range[i] / maxRange, r.color.array, 3 * j);
+    }
+    for (const r of this.returns) {
+      r.points.geometry.setDrawRange(0, r.fill);
+      r.position.needsUpdate = true;
+      r.color.needsUpdate = true;
+    }
+    this.dirty = true;
+  }
+
+  render() {
+    if (!this.dirty) return false;
+    this.renderer.render(this.scene, this.camera);
+    this.dirty = false;
+    this.frames++;
+    return true;
+  }
+}

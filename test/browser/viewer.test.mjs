@@ -1,0 +1,225 @@
+// End-to-end tests of `bvc3d view` in headless Chromium: a short trial made here is opened, the
+// page's numbers are checked against the trial file read with h5py, the returns against
+// `bvc3d scan`, the BVC rates against the rates the trial recorded; a world YAML with a mesh, a
+// recording, two trials side by side and the static export are opened too. Screenshots are kept
+// in the folder printed at the start (test artifacts).
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { writeFileSync, copyFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { pathToFileURL } from 'node:url';
+import { artifacts, scratch, run, h5, serve, launch, openPage, waitReady, paintedPixels, source } from './helpers.mjs';
+
+let dir, server, browser;
+
+before(async () => {
+  console.log(`# screenshots: ${artifacts}`);
+  dir = scratch('viewer');
+  run(['run', '--tilt', '45', '--hours', '0.05', '--record-bvc', '--out', join(dir, 't45.h5')]);
+  run(['run', '--tilt', '45', '--model', '2d', '--hours', '0.05', '--out', join(dir, 't45-2d.h5')]);
+  server = await serve([dir]);
+  browser = await launch();
+});
+
+after(async () => {
+  if (browser) await browser.close();
+  if (server) await server.stop();
+});
+
+async function shot(page, name) {
+  const file = join(artifacts, `${name}.png`);
+  await page.screenshot({ path: file, fullPage: true });
+  return file;
+}
+
+// The numbers of the step the page shows.
+const shownStep = (page, pane = 0) => page.evaluate((p) => {
+  const s = window.bvc3dViewer.panes[p].step;
+  return { header: s.header, place: s.arrays.place ? Array.from(s.arrays.place) : [], bvc: Array.from(s.arrays.bvc),
+    firstPoints: Array.from(s.arrays.points.subarray(0, 30)), returns: s.arrays.range.length,
+    readout: window.bvc3dViewer.panes[p].readout.textContent };
+}, pane);
+
+async function moveSlider(page, i) {
+  await page.locator('#slider').fill(String(i));
+  await page.waitForFunction((k) => window.bvc3dViewer.panes.every((p) => p.readout.dataset.sample === String(k)) &&
+    window.bvc3dViewer.idle(), i);
+}
+
+function sensorYaml() {
+  const file = join(dir, 'spherical-all.yaml');
+  writeFileSync(file, 'preset: spherical\nkeep_rows: all\n');
+  return file;
+}
+
+test('a trial opens: the 3-D view is drawn and the step numbers are the file\'s', async () => {
+  const page = await openPage(browser, `${server.url}?a=t45.h5`);
+  await waitReady(page);
+  const pixels = await paintedPixels(page, '.view3d canvas');
+  const area = await page.$eval('.view3d canvas', (c) => c.width * c.height);
+  assert.ok(pixels > 0.05 * area, `the 3-D view is nearly blank: ${pixels} of ${area} pixels drawn`);
+  const file = join(dir, 't45.h5');
+  const want = h5(file, '{k: float(f["samples/" + k][0]) for k in ["t", "x", "y", "heading"]}');
+  const step = await shownStep(page);
+  for (const k of ['t', 'x', 'y', 'heading']) assert.equal(step.header[k], want[k], `${k} of sample 0`);
+  assert.match(step.readout, new RegExp(`x ${want.x.toFixed(4)}\\s+y ${want.y.toFixed(4)}`));
+  assert.deepEqual(page.foreignRequests, [], 'the page asked for something elsewhere');
+  assert.deepEqual(page.consoleErrors, []);
+  await shot(page, 'trial');
+  await page.close();
+});
+
+test('moving the slider changes the returns and the numbers, which match the file and bvc3d scan', async () => {
+  const page = await openPage(browser, `${server.url}?a=t45.h5`);
+  await waitReady(page);
+  const before0 = await shownStep(page);
+  const canvasBefore = await page.$eval('.view3d canvas', (c) => c.toDataURL());
+  const n = h5(join(dir, 't45.h5'), 'int(f["samples/x"].shape[0])');
+  const i = Math.floor((2 * n) / 3);
+  await moveSlider(page, i);
+  const step = await shownStep(page);
+  const file = join(dir, 't45.h5');
+  const want = h5(file, `{"t": float(f["samples/t"][${i}]), "x": float(f["samples/x"][${i}]), "y": float(f["samples/y"][${i}]), ` +
+    `"heading": float(f["samples/heading"][${i}]), "rates": f["samples/rates"][${i}].astype(float).tolist(), ` +
+    `"bvc": f["samples/bvc_rates"][${i}].astype(float).tolist()}`);
+  for (const k of ['t', 'x', 'y', 'heading']) assert.equal(step.header[k], want[k], `${k} of sample ${i}`);
+  assert.deepEqual(step.place, want.rates, 'place-cell rates are the recorded ones');
+  const bvcError = Math.max(...step.bvc.map((v, k) => Math.abs(v - want.bvc[k])));
+  assert.ok(bvcError < 1e-6, `BVC rates differ from the recorded ones by ${bvcError}`);
+  assert.notDeepEqual(step.firstPoints, before0.firstPoints, 'the returns did not change');
+  const canvasAfter = await page.$eval('.view3d canvas', (c) => c.toDataURL());
+  assert.notEqual(canvasAfter, canvasBefore, 'the 3-D view did not change');
+  // The returns drawn are the full spherical scan at that pose: as many as `bvc3d scan` gives.
+  const csv = run(['scan', '--world', 'cross', '--tilt', '45', '--sensor', sensorYaml(), '--pose', `${want.x},${want.y},${want.heading}`]);
+  assert.equal(step.returns, csv.trim().split('\n').length - 1, 'returns differ from bvc3d scan');
+  assert.match(step.readout, new RegExp(`returns ${step.returns} `));
+  await shot(page, 'trial-scrubbed');
+  await page.close();
+});
+
+test('clicking a place cell shows its rate map and MI', async () => {
+  const file = join(dir, 't45.h5');
+  const modality = h5(file, 'f["metrics/modality"][:].tolist()');
+  const cell = Math.max(0, modality.findIndex((m) => m > 0));
+  const page = await openPage(browser, `${server.url}?a=t45.h5`);
+  await waitReady(page);
+  const blank = await paintedPixels(page, '.cell-map canvas');
+  const [cx, cy] = await page.evaluate((k) => window.bvc3dViewer.panes[0].population.cellCenter(k), cell);
+  await page.locator('canvas.population').click({ position: { x: cx, y: cy } });
+  await page.waitForFunction((k) => document.querySelector('.cell-map .cell-info').dataset.cell === String(k), cell);
+  const info = await page.$eval('.cell-map .cell-info', (e) => ({ mi: e.dataset.mi, text: e.textContent }));
+  assert.equal(Number(info.mi), modality[cell]);
+  assert.match(info.text, new RegExp(`cell ${cell} · MI \\(modality\\) ${modality[cell]}`));
+  const painted = await paintedPixels(page, '.cell-map canvas');
+  assert.ok(painted > blank + 50, `the rate map is not drawn (${painted} pixels)`);
+  assert.ok((await paintedPixels(page, '.sai-map canvas')) > 50, 'the SAI map is not drawn');
+  await shot(page, 'cell');
+  await page.close();
+});
+
+test('two trials side by side follow one slider', async () => {
+  const page = await openPage(browser, `${server.url}?a=t45.h5&b=t45-2d.h5&cell=0`);
+  await waitReady(page);
+  assert.equal(await page.locator('.pane').count(), 2);
+  await moveSlider(page, 123);
+  const a = await shownStep(page, 0), b = await shownStep(page, 1);
+  assert.equal(a.header.sample, 123);
+  assert.equal(b.header.sample, 123);
+  // Same seed, same world: the walks are the same; the 2-D model's scanner is the horizontal one.
+  assert.equal(a.header.x, b.header.x);
+  assert.ok(b.returns <= 720 && a.returns > 720);
+  for (const canvas of await page.locator('.view3d canvas').all()) {
+    const n = await canvas.evaluate((c) => c.width * c.height);
+    assert.ok(n > 0);
+  }
+  await shot(page, 'side-by-side');
+  await page.close();
+});
+
+test('a world YAML with a mesh renders', async () => {
+  const world = await serve([join(source, 'configs', 'worlds', 'two-rooms.yaml')]);
+  try {
+    const page = await openPage(browser, world.url);
+    await waitReady(page);
+    await page.waitForTimeout(200);
+    const pixels = await paintedPixels(page, '.view3d canvas');
+    assert.ok(pixels > 20000, `the world is not drawn (${pixels} pixels)`);
+    // 54 triangles from two_rooms.obj, 5 boxes of 12, one tilted wall of 12.
+    assert.equal(await page.$eval('.readout', (e) => Number(e.dataset.triangles)), 54 + 5 * 12 + 12);
+    assert.deepEqual(page.foreignRequests, []);
+    await shot(page, 'world-two-rooms');
+    await page.close();
+  } finally {
+    await world.stop();
+  }
+});
+
+// A recording made here: three ASCII PCD scans of points on a 4 m square at sensor height, and
+// KITTI poses that move the sensor along x.
+function makeRecording() {
+  const rec = scratch('recording');
+  const poses = [];
+  for (let s = 0; s < 3; s++) {
+    const pts = [];
+    for (let k = 0; k < 200 + 50 * s; k++) {
+      const a = (2 * Math.PI * k) / (200 + 50 * s);
+      pts.push(`${(4 * Math.cos(a)).toFixed(4)} ${(4 * Math.sin(a)).toFixed(4)} ${(0.5 * Math.sin(3 * a)).toFixed(4)}`);
+    }
+    writeFileSync(join(rec, `${s}.pcd`), `# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n` +
+      `WIDTH ${pts.length}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ${pts.length}\nDATA ascii\n${pts.join('\n')}\n`);
+    poses.push(`1 0 0 ${s} 0 1 0 0 0 0 1 1`);
+  }
+  writeFileSync(join(rec, 'poses.txt'), poses.join('\n') + '\n');
+  return rec;
+}
+
+test('a recording: scans step with the slider, in the world frame', async () => {
+  const rec = makeRecording();
+  const srv = await serve(['--scans', rec, '--poses', join(rec, 'poses.txt')]);
+  try {
+    const page = await openPage(browser, srv.url);
+    await waitReady(page);
+    let s = await shownStep(page);
+    assert.equal(s.returns, 200);
+    await moveSlider(page, 2);
+    s = await shownStep(page);
+    assert.equal(s.returns, 300);
+    assert.deepEqual(s.header.sensor_origin, [2, 0, 1]);
+    // The first point, (4, 0, 0) in the sensor frame, lies at (6, 0, 1) in the world.
+    assert.deepEqual(s.firstPoints.slice(0, 3), [6, 0, 1]);
+    assert.ok((await paintedPixels(page, '.view3d canvas')) > 2000);
+    await shot(page, 'recording');
+    await page.close();
+  } finally {
+    await srv.stop();
+  }
+});
+
+test('the exported page opens from disk and shows the same data', async () => {
+  const out = join(scratch('export'), 'page');
+  const printed = run(['view', '--export', out, '--export-steps', '5', join(dir, 't45.h5')]);
+  assert.match(printed, /5 steps/);
+  const page = await openPage(browser, pathToFileURL(join(out, 'index.html')).href);
+  await waitReady(page);
+  assert.ok((await paintedPixels(page, '.view3d canvas')) > 20000);
+  const n = h5(join(dir, 't45.h5'), 'int(f["samples/x"].shape[0])');
+  // Exported steps are evenly spaced; the slider shows the nearest one.
+  const last = n - 1;
+  await page.locator('#slider').fill(String(last));
+  await page.waitForFunction((k) => window.bvc3dViewer.panes[0].readout.dataset.sample === String(k), last);
+  const step = await shownStep(page);
+  const want = h5(join(dir, 't45.h5'), `float(f["samples/x"][${last}])`);
+  assert.equal(step.header.x, want);
+  assert.deepEqual(page.foreignRequests, []);
+  assert.deepEqual(page.consoleErrors, []);
+  await shot(page, 'export');
+  await page.close();
+});
+
+test('README screenshot', { skip: !process.env.BVC3D_UPDATE_FIGURES && 'set BVC3D_UPDATE_FIGURES=1 to update docs/figures/viewer.png' }, async () => {
+  const page = await openPage(browser, `${server.url}?a=t45.h5&b=t45-2d.h5&i=300&cell=0`, { width: 1600, height: 1100 });
+  await waitReady(page);
+  await page.waitForTimeout(300);
+  copyFileSync(await shot(page, 'readme'), join(source, 'docs', 'figures', 'viewer.png'));
+  await page.close();
+});
