@@ -73,7 +73,11 @@ test('moving the slider changes the returns and the numbers, which match the fil
   const page = await openPage(browser, `${server.url}?a=t45.h5`);
   await waitReady(page);
   const before0 = await shownStep(page);
-  const canvasBefore = await page.$eval('.view3d canvas', (c) => c.toDataURL());
+  const canvasImage = () => page.$eval('.view3d canvas', (c) => {
+    window.bvc3dViewer.panes[0].view.render(true);
+    return c.toDataURL();
+  });
+  const canvasBefore = await canvasImage();
   const n = h5(join(dir, 't45.h5'), 'int(f["samples/x"].shape[0])');
   const i = Math.floor((2 * n) / 3);
   await moveSlider(page, i);
@@ -87,7 +91,7 @@ test('moving the slider changes the returns and the numbers, which match the fil
   const bvcError = Math.max(...step.bvc.map((v, k) => Math.abs(v - want.bvc[k])));
   assert.ok(bvcError < 1e-6, `BVC rates differ from the recorded ones by ${bvcError}`);
   assert.notDeepEqual(step.firstPoints, before0.firstPoints, 'the returns did not change');
-  const canvasAfter = await page.$eval('.view3d canvas', (c) => c.toDataURL());
+  const canvasAfter = await canvasImage();
   assert.notEqual(canvasAfter, canvasBefore, 'the 3-D view did not change');
   // The returns drawn are the full spherical scan at that pose: as many as `bvc3d scan` gives.
   const csv = run(['scan', '--world', 'cross', '--tilt', '45', '--sensor', sensorYaml(), '--pose', `${want.x},${want.y},${want.heading}`]);

@@ -24,3 +24,19 @@ export const turbo = (v, out = [0, 0, 0], offset = 0) => lookup(turboStops, v, o
 export function css(rgb) {
   return `rgb(${Math.round(rgb[0] * 255)},${Math.round(rgb[1] * 255)},${Math.round(rgb[2] * 255)})`;
 }
+
+// 256-entry tables as bytes, for drawing many pixels: table[3·i .. 3·i+2] is the color of i/255.
+function table(fn) {
+  const t = new Uint8ClampedArray(256 * 3), rgb = [0, 0, 0];
+  for (let i = 0; i < 256; i++) {
+    fn(i / 255, rgb);
+    t[3 * i] = Math.round(255 * rgb[0]);
+    t[3 * i + 1] = Math.round(255 * rgb[1]);
+    t[3 * i + 2] = Math.round(255 * rgb[2]);
+  }
+  return t;
+}
+export const viridisTable = table(viridis);
+
+// The table entry of v in [0, 1] (clamped; NaN → 0).
+export const entry = (v) => (v > 0 ? (v < 1 ? Math.round(v * 255) : 255) : 0);

@@ -1,7 +1,7 @@
 // The 2-D panels of a pane, drawn on canvases: BVC activity per layer as polar heat maps
 // (distance × direction), the place-cell population, a cell's rate map (hexagons as in the
 // figures, or voxel slices) and the SAI map.
-import { viridis, css } from './colormap.js';
+import { viridis, css, viridisTable, entry } from './colormap.js';
 
 
 function canvas(w, h, cls = 'map') {
@@ -32,27 +32,41 @@ export class BvcMaps {
     }
   }
 
-  // Per pixel: its distance picks the ring (nearest preferred distance), its angle the direction
-  // (nearest preferred azimuth), as in the BVCs' own indexing (l·n_dir + k)·n_per_axis + m.
+  // Which BVC each pixel shows, computed once: its distance picks the ring (nearest preferred
+  // distance), its angle the direction (nearest preferred azimuth), as in the BVCs' own indexing
+  // (l·n_dir + k)·n_per_axis + m; -1 outside the disc.
+  pixelCells(size) {
+    if (this.cells && this.cells.size === size) return this.cells.index;
+    const { n_dir: nd, n_per_axis: nm } = this.bvc;
+    const index = new Int32Array(size * size), c = size / 2, R = size / 2 - 3;
+    for (let row = 0; row < size; row++) {
+      for (let col = 0; col < size; col++) {
+        const dx = col + 0.5 - c, dy = c - (row + 0.5), r = Math.hypot(dx, dy);
+        if (r > R) { index[row * size + col] = -1; continue; }
+        const m = Math.min(nm - 1, Math.round((r / R) * (nm - 1)));
+        let a = Math.atan2(dy, dx);
+        if (a < 0) a += 2 * Math.PI;
+        const k = Math.round((a * nd) / (2 * Math.PI)) % nd;
+        index[row * size + col] = k * nm + m;
+      }
+    }
+    this.cells = { size, index };
+    return index;
+  }
+
   draw(rates, heading) {
     const { n_dir: nd, n_per_axis: nm, max_dist: maxDist } = this.bvc;
-    const rgb = [0, 0, 0];
     this.canvases.forEach((c, l) => {
       const g = c.getContext('2d');
       const size = c.width, cx = size / 2, cy = size / 2, R = size / 2 - 3;
+      const index = this.pixelCells(size);
       const image = g.createImageData(size, size), px = image.data;
-      const ok = rates && rates.length >= (l + 1) * nd * nm;
-      for (let row = 0; row < size; row++) {
-        for (let col = 0; col < size; col++) {
-          const dx = col + 0.5 - cx, dy = cy - (row + 0.5), r = Math.hypot(dx, dy), o = 4 * (row * size + col);
-          if (r > R) { px[o] = px[o + 1] = px[o + 2] = 255; px[o + 3] = 255; continue; }
-          const m = Math.min(nm - 1, Math.round((r / R) * (nm - 1)));
-          let a = Math.atan2(dy, dx);
-          if (a < 0) a += 2 * Math.PI;
-          const k = Math.round((a * nd) / (2 * Math.PI)) % nd;
-          viridis(ok ? rates[(l * nd + k) * nm + m] / 0.5 : 0, rgb);
-          px[o] = 255 * rgb[0]; px[o + 1] = 255 * rgb[1]; px[o + 2] = 255 * rgb[2]; px[o + 3] = 255;
-        }
+      const ok = rates && rates.length >= (l + 1) * nd * nm, layer = l * nd * nm;
+      for (let p = 0; p < index.length; p++) {
+        const o = 4 * p, cell = index[p];
+        if (cell < 0) { px[o] = px[o + 1] = px[o + 2] = 255; px[o + 3] = 255; continue; }
+        const e = 3 * entry(ok ? rates[layer + cell] / 0.5 : 0);
+        px[o] = viridisTable[e]; px[o + 1] = viridisTable[e + 1]; px[o + 2] = viridisTable[e + 2]; px[o + 3] = 255;
       }
       g.putImageData(image, 0, 0);
       g.strokeStyle = 'rgba(255,255,255,0.5)';
@@ -120,14 +134,33 @@ export class Population {
 export class BinMap {
   constructor(container, title) {
     this.title = Object.assign(document.createElement('h3'), { textContent: title });
-    this.canvas = canvas(300, 220);
+    this.canvas = canvas(360, 280);
+    this.base = canvas(360, 280);
+    this.key = null;
     this.info = Object.assign(document.createElement('div'), { className: 'cell-info' });
     container.append(this.title, this.canvas, this.info);
   }
 
-  // centers: B × D; values: B (NaN: no value); extent from the trajectory.
-  draw({ centers, dims, values, grid, bounds, marker, vmax, slice }) {
-    const c = this.canvas, g = c.getContext('2d'), rgb = [0, 0, 0];
+  // centers: B × D; values: B (NaN: no value); bounds: [x0, x1, y0, y1]. The map is drawn again
+  // only when `key` changes; each call draws the marker (the agent) on it.
+  draw({ key, centers, dims, values, grid, bounds, marker, vmax, slice }) {
+    const c = this.canvas, g = c.getContext('2d');
+    if (key !== this.key) {
+      this.key = key;
+      this.paint({ centers, dims, values, grid, bounds, vmax, slice });
+    }
+    g.drawImage(this.base, 0, 0);
+    if (marker && values) {
+      const [px, py] = this.project(marker[0], marker[1]);
+      g.fillStyle = '#c0392b';
+      g.beginPath();
+      g.arc(px, py, 4, 0, 2 * Math.PI);
+      g.fill();
+    }
+  }
+
+  paint({ centers, dims, values, grid, bounds, vmax, slice }) {
+    const c = this.base, g = c.getContext('2d'), rgb = [0, 0, 0];
     g.fillStyle = '#fff';
     g.fillRect(0, 0, c.width, c.height);
     if (!centers || !values) return;
@@ -135,6 +168,7 @@ export class BinMap {
     const scale = Math.min((c.width - 2 * pad) / (x1 - x0), (c.height - 2 * pad) / (y1 - y0));
     const ox = (c.width - scale * (x1 - x0)) / 2, oy = (c.height - scale * (y1 - y0)) / 2;
     const px = (x) => ox + (x - x0) * scale, py = (y) => c.height - oy - (y - y0) * scale;
+    this.project = (x, y) => [px(x), py(y)];
     const top = vmax > 0 ? vmax : 1;
     const B = values.length;
     const hex = grid && grid.kind === 'hex' ? [[0.5, -0.5], [0.5, 0.5], [0, 1], [-0.5, 0.5], [-0.5, -0.5], [0, -1]]
@@ -155,12 +189,6 @@ export class BinMap {
         const s = Math.max(2, voxel * scale);
         g.fillRect(px(x) - s / 2, py(y) - s / 2, s, s);
       }
-    }
-    if (marker) {
-      g.fillStyle = '#c0392b';
-      g.beginPath();
-      g.arc(px(marker[0]), py(marker[1]), 4, 0, 2 * Math.PI);
-      g.fill();
     }
   }
 }

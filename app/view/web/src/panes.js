@@ -166,18 +166,21 @@ export class TrialPane extends Pane {
     this.grid = grid;
   }
 
-  mapArgs(values, vmax) {
+  mapArgs(key, values, vmax) {
     const a = this.trial.arrays;
-    return { centers: a.bin_centers, dims: this.dims, values, grid: this.grid, bounds: this.bounds,
+    return { key: `${key}@${this.slice}`, centers: a.bin_centers, dims: this.dims, values, grid: this.grid, bounds: this.bounds,
       marker: this.step ? [this.step.header.x, this.step.header.y] : null, vmax, slice: this.slice };
   }
 
   drawSai() {
     const sai = this.trial.arrays.sai;
     if (!sai) return;
-    let top = 0;
-    for (const v of sai) if (Number.isFinite(v)) top = Math.max(top, v);
-    this.saiMap.draw(this.mapArgs(sai, top));
+    if (this.saiTop === undefined) {
+      this.saiTop = 0;
+      for (const v of sai) if (Number.isFinite(v)) this.saiTop = Math.max(this.saiTop, v);
+    }
+    const top = this.saiTop;
+    this.saiMap.draw(this.mapArgs('sai', sai, top));
     this.saiMap.info.textContent = `MSAI ${fmt(this.trial.header.metrics.msai)} (mean over bins); color 0 – ${fmt(top)}`;
   }
 
@@ -191,14 +194,17 @@ export class TrialPane extends Pane {
   drawCell() {
     const k = this.selected, a = this.trial.arrays, h = this.trial.header;
     if (k < 0 || !a.rate_maps) return;
-    const B = a.rate_maps.shape[0], n = h.n_place, values = new Float32Array(B);
-    let top = 0;
-    for (let b = 0; b < B; b++) {
-      values[b] = a.rate_maps[b * n + k];
-      top = Math.max(top, values[b]);
+    if (!this.cellValues || this.cellValues.cell !== k) {
+      const B = a.rate_maps.shape[0], n = h.n_place, values = new Float32Array(B);
+      let top = 0;
+      for (let b = 0; b < B; b++) {
+        values[b] = a.rate_maps[b * n + k];
+        top = Math.max(top, values[b]);
+      }
+      this.cellValues = { cell: k, values, top };
     }
     this.cellMap.title.textContent = `rate map of cell ${k}`;
-    this.cellMap.draw(this.mapArgs(values, top));
+    this.cellMap.draw(this.mapArgs(`cell ${k}`, this.cellValues.values, this.cellValues.top));
     const mi = a.modality ? a.modality[k] : null;
     this.cellMap.info.dataset.cell = k;
     this.cellMap.info.dataset.mi = mi;
@@ -211,6 +217,7 @@ export class TrialPane extends Pane {
     if (!this.trial) return;
     i = Math.max(0, Math.min(this.length - 1, i));
     this.target = i;
+    this.view.moving();
     const a = this.trial.arrays;
     this.view.setAgent(a.x[i], a.y[i], a.z ? a.z[i] : 0, a.heading[i]);
     this.loader.request(this.steps ? nearest(this.steps, i) : i);
@@ -238,7 +245,7 @@ export class TrialPane extends Pane {
       `most active cell ${best} at ${top.toFixed(4)}` + (this.steps ? `  [exported step nearest to sample ${this.target}]` : '');
     if (model) this.readout.title = `${model.bvc.n_cells} BVCs in ${model.bvc.n_layers} layers`;
     if (this.selected >= 0) this.drawCell();
-    else this.cellMap.draw(this.mapArgs(null, 1));
+    else this.cellMap.draw(this.mapArgs('none', null, 1));
     this.drawSai();
     this.view.dirty = true;
   }
@@ -310,6 +317,7 @@ export class RecordingPane extends Pane {
     if (!this.rec) return;
     i = Math.max(0, Math.min(this.length - 1, i));
     const p = this.rec.arrays.position;
+    this.view.moving();
     this.view.setAgent(p[3 * i], p[3 * i + 1], p[3 * i + 2] - 0.12, this.heading_of(i));
     this.loader.request(this.steps ? nearest(this.steps, i) : i);
   }

@@ -7,7 +7,9 @@ import { turbo } from './colormap.js';
 export class View3D {
   constructor(container) {
     this.container = container;
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    // No multisampling and no preserved drawing buffer: in software rendering each costs a
+    // large share of a frame. Readers of the pixels (tests) call render(true) first, in the same task.
+    this.renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: false });
     this.renderer.setPixelRatio(1);
     this.renderer.setClearColor(0xfcfcfc);
     container.appendChild(this.renderer.domElement);
@@ -24,12 +26,17 @@ export class View3D {
     this.scene.add(this.world);
     this.dirty = true;
     this.frames = 0;
+    // While the slider moves (or plays), draw at a reduced resolution: a software renderer's time
+    // goes with the pixels. Full resolution returns when the motion stops.
+    this.motionScale = new URLSearchParams(window.location.search).get('motion_scale') === '1' ? 1 : 0.6;
+    this.scale = 1;
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
   }
 
   resize() {
     const w = Math.max(1, this.container.clientWidth), h = Math.max(1, this.container.clientHeight);
+    this.renderer.setPixelRatio(this.scale);
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
@@ -72,17 +79,21 @@ export class View3D {
     this.controls.update();
   }
 
+  // The path, thinned to at most 4000 vertices: a software renderer draws a 50 000-vertex line at
+  // a few frames per second, and at this scale the thinned path looks the same.
   setTrajectory(x, y, z) {
     if (this.trajectory) this.scene.remove(this.trajectory);
-    const n = x.length, pos = new Float32Array(3 * n);
-    for (let i = 0; i < n; i++) {
-      pos[3 * i] = x[i];
-      pos[3 * i + 1] = y[i];
-      pos[3 * i + 2] = (z ? z[i] : 0) + 0.01;
+    const stride = Math.max(1, Math.ceil(x.length / 4000));
+    const n = Math.ceil(x.length / stride), pos = new Float32Array(3 * n);
+    for (let j = 0; j < n; j++) {
+      const i = Math.min(x.length - 1, j * stride);
+      pos[3 * j] = x[i];
+      pos[3 * j + 1] = y[i];
+      pos[3 * j + 2] = (z ? z[i] : 0) + 0.01;
     }
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    this.trajectory = new THREE.Line(g, new THREE.LineBasicMaterial({ color: 0x3949ab, transparent: true, opacity: 0.35 }));
+    this.trajectory = new THREE.Line(g, new THREE.LineBasicMaterial({ color: 0x9fa8da }));
     this.scene.add(this.trajectory);
     this.dirty = true;
   }
@@ -145,8 +156,19 @@ export class View3D {
     this.dirty = true;
   }
 
-  render() {
-    if (!this.dirty) return false;
+  // Called on each move of the slider: lower the resolution now, restore it 250 ms after the last move.
+  moving() {
+    if (this.motionScale >= 1) return;
+    clearTimeout(this.still);
+    this.still = setTimeout(() => { this.scale = 1; this.resize(); }, 250);
+    if (this.scale !== this.motionScale) {
+      this.scale = this.motionScale;
+      this.resize();
+    }
+  }
+
+  render(force = false) {
+    if (!this.dirty && !force) return false;
     this.renderer.render(this.scene, this.camera);
     this.dirty = false;
     this.frames++;
