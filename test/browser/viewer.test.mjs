@@ -5,7 +5,7 @@
 // in the folder printed at the start (test artifacts).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { writeFileSync, copyFileSync } from 'node:fs';
+import { writeFileSync, copyFileSync, existsSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { artifacts, scratch, run, h5, serve, launch, openPage, waitReady, paintedPixels, source } from './helpers.mjs';
@@ -191,8 +191,37 @@ test('a recording: scans step with the slider, in the world frame', async () => 
     assert.deepEqual(s.header.sensor_origin, [2, 0, 1]);
     // The first point, (4, 0, 0) in the sensor frame, lies at (6, 0, 1) in the world.
     assert.deepEqual(s.firstPoints.slice(0, 3), [6, 0, 1]);
-    assert.ok((await paintedPixels(page, '.view3d canvas')) > 2000);
+    // The returns are drawn: hiding them takes pixels away.
+    const painted = await paintedPixels(page, '.view3d canvas');
+    await page.evaluate(() => window.bvc3dViewer.panes[0].view.returns.forEach((r) => { r.points.visible = false; }));
+    const without = await paintedPixels(page, '.view3d canvas');
+    assert.ok(painted > without + 100, `${painted} pixels drawn, ${without} without the returns`);
+    await page.evaluate(() => window.bvc3dViewer.panes[0].view.returns.forEach((r) => { r.points.visible = true; }));
     await shot(page, 'recording');
+    await page.close();
+  } finally {
+    await srv.stop();
+  }
+});
+
+test('the real recording (hall-lidar), when present: map and scans', async (t) => {
+  const hall = join(source, '..', 'shared', 'data', 'hall-lidar');
+  if (!existsSync(join(hall, 'poses.csv'))) return t.skip(`no recording at ${hall}`);
+  const srv = await serve(['--scans', hall, '--poses', join(hall, 'poses.csv')]);
+  try {
+    const page = await openPage(browser, srv.url);
+    await waitReady(page);
+    await moveSlider(page, 10);
+    const s = await shownStep(page);
+    // Every point of the scan is drawn: as many as its PCD header counts, less non-finite ones.
+    const header = readFileSync(join(hall, '0010.pcd')).subarray(0, 400).toString('latin1');
+    const points = Number(header.match(/POINTS (\d+)/)[1]);
+    assert.equal(s.returns + s.header.dropped_nonfinite, points);
+    const map = await page.evaluate(() => window.bvc3dViewer.panes[0].view.world.children
+      .filter((c) => c.isPoints).reduce((n, c) => n + c.geometry.attributes.position.count, 0));
+    assert.ok(map > 100000, `map of ${map} points`);
+    assert.ok((await paintedPixels(page, '.view3d canvas')) > 20000);
+    await shot(page, 'recording-hall');
     await page.close();
   } finally {
     await srv.stop();

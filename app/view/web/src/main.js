@@ -82,9 +82,10 @@ async function main() {
   const world = params.get('world') || index.world;
   const container = $('panes');
   const trialMode = a && !params.get('world');
+  const recordingMode = !trialMode && index.recording && !params.get('world');
   fillSelect($('pick-a'), index.trials, a);
   fillSelect($('pick-b'), index.trials, b, '—');
-  fillSelect($('pick-world'), index.worlds, trialMode ? '' : world, trialMode ? '—' : undefined);
+  fillSelect($('pick-world'), index.worlds, trialMode || recordingMode ? '' : world, trialMode || recordingMode ? '—' : undefined);
   if (!index.trials.length) { $('pick-a-label').classList.add('hidden'); $('pick-b-label').classList.add('hidden'); }
   if (!index.worlds.length) $('pick-world-label').classList.add('hidden');
   $('pick-a').addEventListener('change', (e) => navigate({ a: e.target.value, world: '' }));
@@ -94,7 +95,7 @@ async function main() {
   if (trialMode) {
     viewer.panes.push(new TrialPane(container, a));
     if (b) viewer.panes.push(new TrialPane(container, b));
-  } else if (index.recording && !params.get('world')) {
+  } else if (recordingMode) {
     viewer.panes.push(new RecordingPane(container));
   } else if (world) {
     viewer.panes.push(new WorldPane(container, world));

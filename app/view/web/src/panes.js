@@ -294,11 +294,21 @@ export class RecordingPane extends Pane {
     this.heading.textContent = `recording: ${h.scans} scans`;
     this.sub.textContent = `poses paired ${h.paired_by_time ? 'by time' : 'in order'} · BVCs of model ${h.model.name}`;
     this.addView();
-    get('world', { recording: 1 }).then((w) => this.view.setWorld(w)).catch((e) => showError(this.root, e.message));
     const p = this.rec.arrays.position;
     const n = h.scans, x = new Float32Array(n), y = new Float32Array(n), z = new Float32Array(n);
-    for (let i = 0; i < n; i++) { x[i] = p[3 * i]; y[i] = p[3 * i + 1]; z[i] = p[3 * i + 2]; }
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < n; i++) {
+      x[i] = p[3 * i]; y[i] = p[3 * i + 1]; z[i] = p[3 * i + 2];
+      for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p[3 * i + k]); hi[k] = Math.max(hi[k], p[3 * i + k]); }
+    }
     this.view.setTrajectory(x, y, z);
+    // Frame the path and 10 m around it: a map's far returns would push the camera away.
+    const around = [[lo[0] - 10, lo[1] - 10, lo[2] - 2], [hi[0] + 10, hi[1] + 10, hi[2] + 2]];
+    this.view.frame(around);
+    get('world', { recording: 1 }).then((w) => {
+      this.view.setWorld(w);
+      this.view.frame(around);
+    }).catch((e) => showError(this.root, e.message));
     this.legend.textContent = 'returns colored by range; large = near a BVC layer\'s elevation';
     const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: `BVC activity per layer (model ${h.model.name})` }));
     this.root.appendChild(el('div', { className: 'row' }, bvcBox));

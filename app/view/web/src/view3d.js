@@ -60,7 +60,9 @@ export class View3D {
     if (arrays.points && arrays.points.length) {
       const g = new THREE.BufferGeometry();
       g.setAttribute('position', new THREE.BufferAttribute(arrays.points, 3));
-      this.world.add(new THREE.Points(g, new THREE.PointsMaterial({ color: 0x90a4ae, size: 1.5, sizeAttenuation: false })));
+      // A map stays in the background: the step's own returns are drawn over it.
+      this.world.add(new THREE.Points(g, new THREE.PointsMaterial({ color: 0xb0bec5, size: 1, sizeAttenuation: false,
+        transparent: true, opacity: 0.5, depthWrite: false })));
     }
     if (header.walkable && header.walkable.length > 2) {
       const pts = header.walkable.map(([x, y]) => new THREE.Vector3(x, y, 0.001));
