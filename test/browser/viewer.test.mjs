@@ -191,9 +191,11 @@ test('a recording: scans step with the slider, in the world frame', async () => 
     assert.deepEqual(s.header.sensor_origin, [2, 0, 1]);
     // The first point, (4, 0, 0) in the sensor frame, lies at (6, 0, 1) in the world.
     assert.deepEqual(s.firstPoints.slice(0, 3), [6, 0, 1]);
-    // The returns are drawn: hiding them takes pixels away.
+    // The returns are drawn: hiding them takes pixels away (seen from close by).
+    await page.evaluate(() => window.bvc3dViewer.panes[0].view.frame([[-3, -5, 0], [7, 5, 2]]));
     const painted = await paintedPixels(page, '.view3d canvas');
     await page.evaluate(() => window.bvc3dViewer.panes[0].view.returns.forEach((r) => { r.points.visible = false; }));
+    await shot(page, 'recording-close');
     const without = await paintedPixels(page, '.view3d canvas');
     assert.ok(painted > without + 100, `${painted} pixels drawn, ${without} without the returns`);
     await page.evaluate(() => window.bvc3dViewer.panes[0].view.returns.forEach((r) => { r.points.visible = true; }));
