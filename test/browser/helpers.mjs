@@ -90,7 +90,7 @@ export async function waitReady(page, timeout = 30000) {
 export async function paintedPixels(page, selector) {
   return page.$eval(selector, (c) => {
     // A WebGL canvas keeps its pixels only until they are shown: draw it again in this task.
-    for (const p of window.bvc3dViewer.panes) if (p.view && p.view.renderer.domElement === c) p.view.render(true);
+    for (const p of window.bvc3dViewer.panes) if (p.view && p.view.renderer.domElement === c) { p.view.settle(); p.view.render(true); }
     const w = c.width, h = c.height;
     let data;
     const gl = c.getContext('webgl2') || c.getContext('webgl');

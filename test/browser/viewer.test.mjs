@@ -74,6 +74,7 @@ test('moving the slider changes the returns and the numbers, which match the fil
   await waitReady(page);
   const before0 = await shownStep(page);
   const canvasImage = () => page.$eval('.view3d canvas', (c) => {
+    window.bvc3dViewer.panes[0].view.settle();
     window.bvc3dViewer.panes[0].view.render(true);
     return c.toDataURL();
   });
@@ -195,7 +196,6 @@ test('a recording: scans step with the slider, in the world frame', async () => 
     await page.evaluate(() => window.bvc3dViewer.panes[0].view.frame([[-3, -5, 0], [7, 5, 2]]));
     const painted = await paintedPixels(page, '.view3d canvas');
     await page.evaluate(() => window.bvc3dViewer.panes[0].view.returns.forEach((r) => { r.points.visible = false; }));
-    await shot(page, 'recording-close');
     const without = await paintedPixels(page, '.view3d canvas');
     assert.ok(painted > without + 100, `${painted} pixels drawn, ${without} without the returns`);
     await page.evaluate(() => window.bvc3dViewer.panes[0].view.returns.forEach((r) => { r.points.visible = true; }));

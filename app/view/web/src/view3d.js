@@ -169,6 +169,15 @@ export class View3D {
     }
   }
 
+  // Full resolution now (for reading the pixels).
+  settle() {
+    clearTimeout(this.still);
+    if (this.scale !== 1) {
+      this.scale = 1;
+      this.resize();
+    }
+  }
+
   render(force = false) {
     if (!this.dirty && !force) return false;
     this.renderer.render(this.scene, this.camera);
