@@ -26,9 +26,9 @@ after(async () => {
   if (server) await server.stop();
 });
 
-async function shot(page, name) {
+async function shot(page, name, fullPage = true) {
   const file = join(artifacts, `${name}.png`);
-  await page.screenshot({ path: file, fullPage: true });
+  await page.screenshot({ path: file, fullPage });
   return file;
 }
 
@@ -251,10 +251,22 @@ test('the exported page opens from disk and shows the same data', async () => {
   await page.close();
 });
 
+// docs/figures/viewer.png: the 2-D model beside the 3-D three-layer one at 60°, half an hour each,
+// with the most informative cell of the first picked.
 test('README screenshot', { skip: !process.env.BVC3D_UPDATE_FIGURES && 'set BVC3D_UPDATE_FIGURES=1 to update docs/figures/viewer.png' }, async () => {
-  const page = await openPage(browser, `${server.url}?a=t45.h5&b=t45-2d.h5&i=300&cell=0`, { width: 1600, height: 1100 });
-  await waitReady(page);
-  await page.waitForTimeout(300);
-  copyFileSync(await shot(page, 'readme'), join(source, 'docs', 'figures', 'viewer.png'));
-  await page.close();
+  const readme = scratch('readme');
+  run(['run', '--tilt', '60', '--model', '3d-3l', '--hours', '0.5', '--out', join(readme, 'cross-60_3d-3l.h5')]);
+  run(['run', '--tilt', '60', '--model', '2d', '--hours', '0.5', '--out', join(readme, 'cross-60_2d.h5')]);
+  const cell = h5(join(readme, 'cross-60_3d-3l.h5'), 'int(np.argmax(f["metrics/spatial_info"][:]))');
+  const srv = await serve([readme]);
+  try {
+    const page = await openPage(browser, `${srv.url}?a=cross-60_3d-3l.h5&b=cross-60_2d.h5&i=2000&cell=${cell}`,
+      { width: 1600, height: 1320 });
+    await waitReady(page);
+    await page.evaluate(() => window.bvc3dViewer.panes.forEach((p) => { p.view.settle(); p.view.render(true); }));
+    copyFileSync(await shot(page, 'readme', false), join(source, 'docs', 'figures', 'viewer.png'));
+    await page.close();
+  } finally {
+    await srv.stop();
+  }
 });

@@ -24,7 +24,7 @@ export class BvcMaps {
     this.canvases = [];
     for (let l = 0; l < bvc.n_layers; l++) {
       const fig = document.createElement('figure');
-      const c = canvas(150, 150);
+      const c = canvas(124, 124);
       const label = bvc.elevations.length ? `elevation ${(bvc.elevations[l] * 180 / Math.PI).toFixed(1)}°` : '2-D (no elevation)';
       fig.append(c, Object.assign(document.createElement('figcaption'), { textContent: label }));
       this.el.appendChild(fig);
