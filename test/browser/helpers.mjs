@@ -42,9 +42,14 @@ export function serve(args, options = {}) {
       const m = out.match(/http:\/\/127\.0\.0\.1:(\d+)\//);
       if (m) {
         clearTimeout(timer);
+        // Ctrl-C; a server that has not stopped 15 s later is killed, and stop() says so.
         const stop = () => new Promise((done) => {
-          if (child.exitCode !== null) return done(child.exitCode);
-          child.once('exit', (code) => done(code));
+          if (child.exitCode !== null || child.signalCode !== null) return done(child.exitCode);
+          const killer = setTimeout(() => child.kill('SIGKILL'), 15000);
+          child.once('exit', (code, signal) => {
+            clearTimeout(killer);
+            done(signal === 'SIGKILL' ? 'killed: did not stop on SIGINT' : code);
+          });
           child.kill('SIGINT');
         });
         resolvePromise({ url: m[0], port: Number(m[1]), child, stop, output: () => out + err });

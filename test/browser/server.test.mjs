@@ -21,13 +21,13 @@ before(async () => {
 });
 
 after(async () => {
-  if (server) await server.stop();
+  if (server) assert.equal(await server.stop(), 0);
 });
 
 // A raw GET: the path goes out exactly as written (no URL normalization on the client's side).
 function get(path, method = 'GET') {
   return new Promise((resolve, reject) => {
-    const req = request({ host: '127.0.0.1', port: server.port, path, method }, (res) => {
+    const req = request({ host: '127.0.0.1', port: server.port, path, method, agent: false }, (res) => {
       const chunks = [];
       res.on('data', (c) => chunks.push(c));
       res.on('end', () => resolve({ status: res.statusCode, type: res.headers['content-type'], body: Buffer.concat(chunks) }));

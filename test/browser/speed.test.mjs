@@ -28,7 +28,7 @@ after(async () => {
   writeFileSync(join(artifacts, 'speed.json'), JSON.stringify(results, null, 2));
   console.log(`# speed: ${JSON.stringify(results)}`);
   if (browser) await browser.close();
-  if (server) await server.stop();
+  if (server) assert.equal(await server.stop(), 0);
 });
 
 async function openTimes(url) {

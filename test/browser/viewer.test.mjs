@@ -23,7 +23,7 @@ before(async () => {
 
 after(async () => {
   if (browser) await browser.close();
-  if (server) await server.stop();
+  if (server) assert.equal(await server.stop(), 0);
 });
 
 async function shot(page, name, fullPage = true) {
