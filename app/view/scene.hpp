@@ -3,8 +3,6 @@
 // ran in, and at any recorded sample the sensor's returns and the BVC and place-cell rates; a world
 // on its own; a recording (scans + poses). Each is encoded once as a blob (blob.hpp).
 // Takes: files (trial files, world YAML or presets, scan lists and pose files). Gives: blobs.
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <memory>
 #include <optional>
