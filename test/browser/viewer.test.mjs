@@ -8,7 +8,8 @@ import assert from 'node:assert/strict';
 import { writeFileSync, copyFileSync, existsSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
-import { artifacts, scratch, run, h5, serve, launch, openPage, waitReady, paintedPixels, source } from './helpers.mjs';
+import { execFileSync } from 'node:child_process';
+import { artifacts, scratch, run, h5, serve, launch, openPage, waitReady, paintedPixels, source, python } from './helpers.mjs';
 
 let dir, server, browser;
 
@@ -138,6 +139,41 @@ test('two trials side by side follow one slider', async () => {
     assert.ok(n > 0);
   }
   await shot(page, 'side-by-side');
+  await page.close();
+});
+
+// A trial binned in 3-D (as flying agents' trials will be): the trial made above with heights and a
+// voxel lattice written into it by h5py. The rate map shows one slice of voxels at a time.
+test('voxel slices for trials binned in 3-D', async () => {
+  const code = `import h5py, numpy as np, shutil
+shutil.copy(${JSON.stringify(join(dir, 't45.h5'))}, ${JSON.stringify(join(dir, 'flying.h5'))})
+with h5py.File(${JSON.stringify(join(dir, 'flying.h5'))}, 'r+') as f:
+    n = f['samples/x'].shape[0]
+    f['samples'].create_dataset('z', data=np.linspace(0.5, 1.5, n))
+    g = f['metrics']
+    xs = np.arange(-4.5, 5, 1.0)
+    centers = np.array([[x, y, z] for z in (0.5, 1.0, 1.5) for y in xs for x in xs])
+    maps = np.zeros((len(centers), 250), np.float32)
+    maps[:, 0] = (centers[:, 2] == 1.0) * np.exp(-(centers[:, 0] ** 2 + centers[:, 1] ** 2) / 4)
+    for k in ('bin_centers', 'rate_maps', 'sai', 'bin_counts'):
+        del g[k]
+    g['bin_centers'], g['rate_maps'] = centers, maps
+    g['sai'], g['bin_counts'] = np.linspace(0, 1, len(centers)), np.ones(len(centers), np.int64)
+`;
+  execFileSync(python, ['-c', code]);
+  const page = await openPage(browser, `${server.url}?a=flying.h5&cell=0`);
+  await waitReady(page);
+  const slices = await page.$$eval('.cell-map select.slice option', (o) => o.map((e) => Number(e.value)));
+  assert.deepEqual(slices, [0.5, 1, 1.5]);
+  const image = () => page.$eval('.cell-map canvas', (c) => c.toDataURL());
+  await page.selectOption('.cell-map select.slice', '1');
+  const middle = await image();
+  assert.ok((await paintedPixels(page, '.cell-map canvas')) > 5000, 'no voxels drawn');
+  await page.selectOption('.cell-map select.slice', '0.5');
+  assert.notEqual(await image(), middle, 'the slices look the same');
+  const z = await page.evaluate(() => window.bvc3dViewer.panes[0].step.header.z);
+  assert.equal(z, 0.5);
+  await shot(page, 'voxels');
   await page.close();
 });
 

@@ -76,7 +76,7 @@ export class View3D {
   frame([[x0, y0, z0], [x1, y1, z1]]) {
     const c = new THREE.Vector3((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2);
     const size = Math.max(x1 - x0, y1 - y0, z1 - z0, 1);
-    this.camera.position.set(c.x + 0.15 * size, c.y - 1.05 * size, c.z + 0.85 * size);
+    this.camera.position.set(c.x + 0.1 * size, c.y - 0.8 * size, c.z + 0.65 * size);
     this.controls.target.copy(c);
     this.controls.update();
   }
