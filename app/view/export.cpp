@@ -2,6 +2,7 @@
 
 #include <openssl/evp.h>
 
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -110,7 +111,20 @@ ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::pat
         }
         step_index[trial] = kept;
     }
-    if (!shown.world.empty()) w.add("world", {{"source", shown.world}});
+    if (!shown.world.empty()) {
+        w.add("world", {{"source", shown.world}});
+        // The probe at the pose the world's reply proposes (the page cannot cast rays itself).
+        const Reply world = data.get("world", {{"source", shown.world}});
+        if (world.status == 200) {
+            std::uint32_t length = 0;
+            std::memcpy(&length, world.body.data() + 4, 4);
+            const auto header = json::parse(world.body.substr(8, length));
+            if (header.contains("probe")) {
+                const auto& p = header["probe"];
+                w.add("probe", {{"source", shown.world}, {"x", p["x"]}, {"y", p["y"]}, {"heading", p["heading"]}});
+            }
+        }
+    }
     if (const std::size_t n = data.recording_scans(); n > 0) {
         w.add("recording", {});
         w.add("world", {{"recording", "1"}});

@@ -9,6 +9,7 @@
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/recording/pairing.hpp"
 #include "bvc3d/recording/scan_file.hpp"
 #include "bvc3d/sensor/lidar.hpp"
@@ -96,6 +97,12 @@ std::string world_blob(const WorldDescription& w, const std::string& source, con
     json header = {{"kind", "world"}, {"name", w.name}, {"source", source}, {"triangles", w.mesh.size()},
                    {"walkable", walkable}, {"start_points", starts}, {"points", points.size() / 3}};
     if (w.tilt_deg) header["tilt_deg"] = *w.tilt_deg;
+    // Where the page first probes the world: a start point, or the middle of the walkable region.
+    // As text, so that the page asks for exactly this pose (an export holds the reply under it).
+    if (!w.walkable.points.empty() || !w.start.points.empty()) {
+        Vec2 at = w.start.points.empty() ? Vec2(w.walkable.bounds().center()) : w.start.points.front();
+        header["probe"] = {{"x", format_number(at.x())}, {"y", format_number(at.y())}, {"heading", "0"}};
+    }
     if (!box.isEmpty())
         header["bounds"] = {{box.min().x(), box.min().y(), box.min().z()}, {box.max().x(), box.max().y(), box.max().z()}};
     std::vector<BlobArray> arrays{f32_array("triangles", std::span<const float>(tri), {w.mesh.size() * 3, 3})};
@@ -229,39 +236,53 @@ Pose TrialScene::pose(std::size_t i) const {
     return Pose{data_.x[i], data_.y[i], data_.z.empty() ? 0.0 : data_.z[i], heading_[i], 0.0, 0.0};
 }
 
+std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model, const Pose& p, json& header) {
+    const LidarSpec drawn = drawn_sensor(model.sensor);
+    const auto rows = kept_rows(drawn, model);
+    const Scan all = Lidar(drawn).scan(world, p);
+    const Vec3 origin = p.position() + p.rotation() * Vec3(0, 0, drawn.height);
+    std::vector<float> xyz, range;
+    std::vector<std::uint8_t> kept;
+    xyz.reserve(all.size() * 3);
+    for (const auto& r : all) {
+        add_point(xyz, origin, r);
+        range.push_back(static_cast<float>(r.range));
+        kept.push_back(static_cast<std::uint8_t>(rows[nearest_row(drawn.elevations, r.elevation)]));
+    }
+    // The BVC rates from the model's own scanner, as the model computed them (without noise).
+    const Scan seen = Lidar(model.sensor).scan(world, p);
+    const BoundaryVectorLayer layer(model.bvc);
+    std::vector<double> rates(layer.n_cells());
+    layer.rates(seen, rates);
+    header["returns"] = all.size();
+    header["model_returns"] = seen.size();
+    header["sensor_origin"] = {origin.x(), origin.y(), origin.z()};
+    return {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),
+            f32_array("range", std::span<const float>(range)), u8_array("kept", kept),
+            f32_array("bvc", std::span<const double>(rates))};
+}
+
+std::string probe_blob(const World& world, const ModelSpec& model, const Pose& p) {
+    json header = {{"kind", "probe"}, {"x", p.x}, {"y", p.y}, {"z", p.z}, {"heading", p.heading},
+                   {"model", model_json(model)}, {"drawn_sensor", sensor_json(drawn_sensor(model.sensor))}};
+    auto arrays = sensed_arrays(world, model, p, header);
+    return encode_blob(std::move(header), arrays);
+}
+
 std::string TrialScene::step_blob(std::size_t i) const {
     if (i >= samples()) throw InputError("sample " + std::to_string(i) + " is past the trial's " + std::to_string(samples()));
     const Pose p = pose(i);
     json header = {{"kind", "step"}, {"sample", i}, {"t", t_[i]}, {"x", p.x}, {"y", p.y}, {"z", p.z}, {"heading", p.heading}};
-    std::vector<float> xyz, range, bvc;
-    std::vector<std::uint8_t> kept;
+    std::vector<BlobArray> arrays;
     if (world_ && model_) {
-        const LidarSpec drawn = drawn_sensor(model_->sensor);
-        const auto rows = kept_rows(drawn, *model_);
-        const Scan all = Lidar(drawn).scan(*world_, p);
-        const Vec3 origin = p.position() + p.rotation() * Vec3(0, 0, drawn.height);
-        xyz.reserve(all.size() * 3);
-        for (const auto& r : all) {
-            add_point(xyz, origin, r);
-            range.push_back(static_cast<float>(r.range));
-            kept.push_back(static_cast<std::uint8_t>(rows[nearest_row(drawn.elevations, r.elevation)]));
-        }
-        // The BVC rates from the model's own scanner, as the model computed them (without noise).
-        const Scan seen = Lidar(model_->sensor).scan(*world_, p);
-        const BoundaryVectorLayer layer(model_->bvc);
-        std::vector<double> rates(layer.n_cells());
-        layer.rates(seen, rates);
-        bvc.assign(rates.begin(), rates.end());
-        header["returns"] = all.size();
-        header["model_returns"] = seen.size();
-        header["sensor_origin"] = {origin.x(), origin.y(), origin.z()};
+        arrays = sensed_arrays(*world_, *model_, p, header);
+    } else {
+        const std::vector<float> none;
+        arrays = {f32_array("points", std::span<const float>(none), {0, 3}), f32_array("range", std::span<const float>(none)),
+                  u8_array("kept", {}), f32_array("bvc", std::span<const float>(none))};
     }
-    const float* row = data_.rates.data() + i * data_.n_place;
-    return encode_blob(std::move(header),
-                       {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),
-                        f32_array("range", std::span<const float>(range)), u8_array("kept", kept),
-                        f32_array("bvc", std::span<const float>(bvc)),
-                        f32_array("place", std::span<const float>(row, data_.n_place))});
+    arrays.push_back(f32_array("place", std::span<const float>(data_.rates.data() + i * data_.n_place, data_.n_place)));
+    return encode_blob(std::move(header), arrays);
 }
 
 // ---- recordings ----

@@ -14,6 +14,7 @@
 #include "bvc3d/recording/pose_file.hpp"
 #include "bvc3d/recording/scan_list.hpp"
 #include "bvc3d/world/world.hpp"
+#include "view/blob.hpp"
 
 namespace bvc3d::view {
 
@@ -21,6 +22,13 @@ namespace bvc3d::view {
 // cloud (a recording's map).
 std::string world_blob(const WorldDescription& world, const std::string& source,
                        const std::vector<float>& points = {});
+
+// What a model's scanner sees at a pose: the drawn scan's points (world frame), their ranges, which
+// of them are in rows the model keeps, and the model's BVC rates (arrays points, range, kept, bvc);
+// the header gains returns, model_returns and sensor_origin.
+std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model, const Pose& pose, nlohmann::json& header);
+// The same at a pose of the page's choosing, in a world shown on its own.
+std::string probe_blob(const World& world, const ModelSpec& model, const Pose& pose);
 
 // The scanner drawn at each step: the model's own, except that a spherical scanner is drawn with
 // all its rows (the model keeps some), so the page shows the full scan.

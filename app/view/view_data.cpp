@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
@@ -31,6 +32,15 @@ std::size_t index_param(const Query& q, const char* name) {
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (ec != std::errc() || end != text.data() + text.size())
         throw RequestError(400, std::string("parameter '") + name + "' must be a whole number, not '" + text + "'");
+    return v;
+}
+
+double number_param(const Query& q, const char* name) {
+    const std::string& text = param(q, name);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+        throw RequestError(400, std::string("parameter '") + name + "' must be a finite number, not '" + text + "'");
     return v;
 }
 
@@ -73,6 +83,11 @@ Reply ViewData::route(const std::string& endpoint, const Query& query) {
         return blob_reply(scene->step_blob(i));
     }
     if (endpoint == "world") return blob_reply(world_reply(query));
+    if (endpoint == "probe") {
+        const auto world = world_by_source(param(query, "source"));
+        const Pose pose = Pose::on_floor(number_param(query, "x"), number_param(query, "y"), number_param(query, "heading"));
+        return blob_reply(probe_blob(*world, config::resolve_model(target_.model), pose));
+    }
     if (endpoint == "recording") return blob_reply(recording().blob());
     if (endpoint == "scan") {
         const std::size_t i = index_param(query, "i");
@@ -118,23 +133,27 @@ std::string ViewData::world_reply(const Query& query) {
     }
     if (query.count("recording")) return recording().map_blob();
     const std::string& source = param(query, "source");
+    return world_blob(world_by_source(source)->description(), source);
+}
+
+std::shared_ptr<const World> ViewData::world_by_source(const std::string& source) {
     {
         std::lock_guard lock(mutex_);
         if (auto it = worlds_.find(source); it != worlds_.end()) return it->second;
     }
     const auto presets = config::world_preset_names();
-    std::string blob;
+    std::shared_ptr<const World> world;
     if (std::find(presets.begin(), presets.end(), source) != presets.end()) {
-        blob = world_blob(config::resolve_world(source), source);
+        world = std::make_shared<World>(config::resolve_world(source));
     } else {
         const auto file = path_inside(target_.root, source);
         if (target_.root.empty() || !file) throw RequestError(403, "'" + source + "' is not inside the served folder");
         std::error_code ec;
         if (!fs::is_regular_file(*file, ec)) throw RequestError(404, "world file '" + source + "' does not exist");
-        blob = world_blob(config::load_world_file(file->string()), source);
+        world = std::make_shared<World>(config::load_world_file(file->string()));
     }
     std::lock_guard lock(mutex_);
-    return worlds_.emplace(source, std::move(blob)).first->second;
+    return worlds_.emplace(source, std::move(world)).first->second;
 }
 
 const RecordingScene& ViewData::recording() {

@@ -40,7 +40,7 @@ public:
     const ViewTarget& target() const { return target_; }
 
     // index, trial?path=, step?path=&i=, world?source= | world?trial= | world?recording=1,
-    // recording, scan?i=. Errors are replies with a status and {"error": message}: 400 bad
+    // probe?source=&x=&y=&heading= (the default model's view at that pose), recording, scan?i=. Errors are replies with a status and {"error": message}: 400 bad
     // request, 403 a path outside the served folder, 404 missing, 422 a file that cannot be read.
     Reply get(const std::string& endpoint, const Query& query);
 
@@ -52,6 +52,7 @@ public:
 private:
     Reply route(const std::string& endpoint, const Query& query);
     std::string world_reply(const Query& query);
+    std::shared_ptr<const World> world_by_source(const std::string& source);
     const RecordingScene& recording();
 
     ViewTarget target_;
@@ -62,7 +63,7 @@ private:
     };
     std::map<std::filesystem::path, Cached> trials_;
     std::uint64_t clock_ = 0;
-    std::map<std::string, std::string> worlds_;  // blobs by source
+    std::map<std::string, std::shared_ptr<const World>> worlds_;  // by source (ray casting is built once)
     std::unique_ptr<const RecordingScene> recording_;
 };
 

@@ -74,6 +74,7 @@ export async function launch() {
 // A page that records every request it makes that is not to `origin` (there must be none).
 export async function openPage(browser, url, viewport = { width: 1400, height: 1000 }) {
   const page = await browser.newPage({ viewport });
+  page.setDefaultTimeout(90000);  // a loaded 2-core machine renders in software slowly
   const origin = new URL(url).origin;
   page.foreignRequests = [];
   page.consoleErrors = [];
@@ -87,7 +88,7 @@ export async function openPage(browser, url, viewport = { width: 1400, height: 1
   return page;
 }
 
-export async function waitReady(page, timeout = 30000) {
+export async function waitReady(page, timeout = 90000) {
   await page.waitForFunction(() => window.bvc3dViewer && window.bvc3dViewer.ready, null, { timeout });
 }
 

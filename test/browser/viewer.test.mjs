@@ -177,21 +177,38 @@ with h5py.File(${JSON.stringify(join(dir, 'flying.h5'))}, 'r+') as f:
   await page.close();
 });
 
-test('a world YAML with a mesh renders', async () => {
-  const world = await serve([join(source, 'configs', 'worlds', 'two-rooms.yaml')]);
+test('a world YAML with a mesh renders, and a click probes the floor', async () => {
+  const yaml = join(source, 'configs', 'worlds', 'two-rooms.yaml');
+  const world = await serve([yaml]);
   try {
     const page = await openPage(browser, world.url);
     await waitReady(page);
-    await page.waitForTimeout(200);
     const pixels = await paintedPixels(page, '.view3d canvas');
     assert.ok(pixels > 20000, `the world is not drawn (${pixels} pixels)`);
     // 54 triangles from two_rooms.obj, 5 boxes of 12, one tilted wall of 12.
     assert.equal(await page.$eval('.readout', (e) => Number(e.dataset.triangles)), 54 + 5 * 12 + 12);
+    // The probe: the default model (3d-0.2) at the world's first start point; as many returns as
+    // `bvc3d scan` gives there with all 90 rows of the spherical scanner.
+    const count = async () => {
+      const s = await shownStep(page);
+      const csv = run(['scan', '--world', yaml, '--sensor', sensorYaml(), '--pose', `${s.header.x},${s.header.y},${s.header.heading}`]);
+      assert.equal(s.returns, csv.trim().split('\n').length - 1, `returns at ${s.header.x}, ${s.header.y}`);
+      return s;
+    };
+    const first = await count();
+    assert.ok(first.returns > 10000);
+    assert.ok((await paintedPixels(page, '.bvc-maps canvas')) > 5000, 'no BVC map');
+    const box = await page.locator('.view3d canvas').boundingBox();
+    await page.mouse.click(box.x + box.width * 0.6, box.y + box.height * 0.55);
+    await page.waitForFunction((x) => window.bvc3dViewer.panes[0].readout.dataset.x !== String(x) && window.bvc3dViewer.idle(), first.header.x);
+    const second = await count();
+    assert.notDeepEqual([second.header.x, second.header.y], [first.header.x, first.header.y]);
     assert.deepEqual(page.foreignRequests, []);
+    assert.deepEqual(page.consoleErrors, []);
     await shot(page, 'world-two-rooms');
     await page.close();
   } finally {
-    await world.stop();
+    assert.equal(await world.stop(), 0);
   }
 });
 
@@ -285,6 +302,14 @@ test('the exported page opens from disk and shows the same data', async () => {
   assert.deepEqual(page.consoleErrors, []);
   await shot(page, 'export');
   await page.close();
+  // A world exports with its probe at the proposed pose.
+  const worldOut = join(scratch('export-world'), 'page');
+  run(['view', '--export', worldOut, join(source, 'configs', 'worlds', 'two-rooms.yaml')]);
+  const worldPage = await openPage(browser, pathToFileURL(join(worldOut, 'index.html')).href);
+  await waitReady(worldPage);
+  assert.ok((await shownStep(worldPage)).returns > 10000);
+  assert.deepEqual(worldPage.consoleErrors, []);
+  await worldPage.close();
 });
 
 // docs/figures/viewer.png: the 2-D model beside the 3-D three-layer one at 60°, half an hour each,

@@ -136,6 +136,10 @@ TEST(ViewData, ErrorsAreRepliesWithAStatus) {
     EXPECT_EQ(data.get("trial", {{"path", "missing.h5"}}).status, 404);
     EXPECT_EQ(data.get("trial", {{"path", "broken.h5"}}).status, 422);
     EXPECT_EQ(data.get("world", {{"source", "/etc/passwd"}}).status, 403);
+    EXPECT_EQ(data.get("probe", {{"source", "cross-45"}, {"x", "1"}, {"y", "-2.5"}, {"heading", "0.3"}}).status, 200);
+    EXPECT_EQ(data.get("probe", {{"source", "cross-45"}, {"x", "nan"}, {"y", "0"}, {"heading", "0"}}).status, 400);
+    EXPECT_EQ(data.get("probe", {{"source", "cross-45"}, {"x", "1m"}, {"y", "0"}, {"heading", "0"}}).status, 400);
+    EXPECT_EQ(data.get("probe", {{"source", "../w.yaml"}, {"x", "1"}, {"y", "0"}, {"heading", "0"}}).status, 403);
     EXPECT_EQ(data.get("recording", {}).status, 404);
     EXPECT_EQ(data.get("nothing", {}).status, 404);
     const auto error = nlohmann::json::parse(data.get("trial", {{"path", "broken.h5"}}).body);

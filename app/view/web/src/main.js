@@ -42,7 +42,7 @@ function setSample(i) {
 }
 viewer.setSample = setSample;
 
-// Every pane's steps have arrived (or failed).
+// Every pane's steps (or probes) have arrived (or failed).
 viewer.idle = () => viewer.panes.every((p) => !p.loader || p.loader.idle());
 
 function loop() {

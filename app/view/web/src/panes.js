@@ -251,6 +251,8 @@ export class TrialPane extends Pane {
   }
 }
 
+// A world on its own, with a probe: the default model's scanner and BVCs at a pose on the floor.
+// Click the floor (without dragging) to move the probe there; the heading field turns it.
 export class WorldPane extends Pane {
   constructor(container, source) {
     super(container, source);
@@ -259,19 +261,62 @@ export class WorldPane extends Pane {
 
   async open() {
     this.addView();
+    let w;
     try {
-      const w = await get('world', { source: this.source });
-      this.view.setWorld(w);
-      this.heading.textContent = `world ${w.header.name}`;
-      this.sub.textContent = `${this.source} · ${w.header.triangles} triangles` +
-        (w.header.tilt_deg !== undefined ? ` · tilt ${w.header.tilt_deg}°` : '');
-      this.readout.dataset.triangles = w.header.triangles;
-      this.readout.textContent = 'orbit: drag · zoom: wheel · pan: right-drag';
-      return true;
+      w = await get('world', { source: this.source });
     } catch (e) {
       this.error(`cannot open world ${this.source}: ${e.message}`);
       return false;
     }
+    this.view.setWorld(w);
+    this.heading.textContent = `world ${w.header.name}`;
+    this.sub.textContent = `${this.source} · ${w.header.triangles} triangles` +
+      (w.header.tilt_deg !== undefined ? ` · tilt ${w.header.tilt_deg}°` : '') + ' · click the floor to probe there';
+    this.readout.dataset.triangles = w.header.triangles;
+    this.readout.textContent = 'orbit: drag · zoom: wheel · pan: right-drag';
+    if (!w.header.probe) return true;
+    const headingInput = el('input', { type: 'number', value: '0', step: '15', className: 'probe-heading', title: 'heading, degrees' });
+    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: 'BVC activity per layer at the probe (distance × direction)' }),
+      el('label', { textContent: 'heading ° ' }, headingInput));
+    this.root.appendChild(el('div', { className: 'row' }, bvcBox));
+    this.bvcBox = bvcBox;
+    this.pose = { ...w.header.probe };
+    headingInput.addEventListener('change', () => {
+      this.pose.heading = ((Number(headingInput.value) || 0) * Math.PI / 180).toFixed(4);
+      this.loader.request(this.pose);
+    });
+    this.loader = new StepLoader((pose) => get('probe', { source: this.source, ...pose }), (s, e) => this.applyProbe(s, e));
+    this.view.onFloorClick = (x, y) => {
+      this.pose = { x: x.toFixed(3), y: y.toFixed(3), heading: this.pose.heading };
+      this.loader.request(this.pose);
+    };
+    this.loader.request(this.pose);
+    return true;
+  }
+
+  applyProbe(probe, error) {
+    if (!probe) {
+      showError(this.root, `probe: ${error.message}`);
+      return;
+    }
+    this.step = probe;
+    const h = probe.header, a = probe.arrays;
+    if (!this.bvcMaps) {
+      this.bvcMaps = new BvcMaps(this.bvcBox, h.model.bvc);
+      this.legend.textContent = `probe: model ${h.model.name}, ${h.drawn_sensor.name} scanner, ${h.drawn_sensor.rows} rows; ` +
+        `colored by range 0–${h.drawn_sensor.max_range} m; large = rows the model keeps`;
+    }
+    this.maxRange = h.drawn_sensor.max_range;
+    this.view.setAgent(h.x, h.y, h.z, h.heading);
+    this.view.setReturns(a.points, a.range, a.kept, this.maxRange);
+    this.bvcMaps.draw(a.bvc, h.heading);
+    let kept = 0;
+    for (const k of a.kept) kept += k;
+    this.readout.dataset.x = h.x;
+    this.readout.dataset.y = h.y;
+    this.readout.dataset.returns = h.returns;
+    this.readout.textContent = `probe at x ${h.x.toFixed(3)}  y ${h.y.toFixed(3)}  heading ${h.heading.toFixed(4)} rad: ` +
+      `returns ${h.returns} (${kept} in rows the model keeps; the model saw ${h.model_returns})`;
   }
 
   moveTo() {}

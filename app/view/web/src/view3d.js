@@ -30,6 +30,18 @@ export class View3D {
     // goes with the pixels. Full resolution returns when the motion stops.
     this.motionScale = new URLSearchParams(window.location.search).get('motion_scale') === '1' ? 1 : 0.6;
     this.scale = 1;
+    // A click without a drag on the floor (z = 0) calls onFloorClick(x, y), when set.
+    const canvasEl = this.renderer.domElement;
+    canvasEl.addEventListener('pointerdown', (e) => { this.down = [e.clientX, e.clientY]; });
+    canvasEl.addEventListener('pointerup', (e) => {
+      if (!this.onFloorClick || !this.down || Math.hypot(e.clientX - this.down[0], e.clientY - this.down[1]) > 4) return;
+      const r = canvasEl.getBoundingClientRect();
+      const ndc = new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1);
+      const ray = new THREE.Raycaster();
+      ray.setFromCamera(ndc, this.camera);
+      const hit = new THREE.Vector3();
+      if (ray.ray.intersectPlane(new THREE.Plane(new THREE.Vector3(0, 0, 1), 0), hit)) this.onFloorClick(hit.x, hit.y);
+    });
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
   }
