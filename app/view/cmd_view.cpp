@@ -90,12 +90,10 @@ view::ViewTarget make_target(const std::vector<std::string>& args, const std::st
             if (std::find(presets.begin(), presets.end(), a) != presets.end() && args.size() == 1) {
                 t.world = a;
             } else {
-                throw InputError("'" + a + "' does not exist (expected a trial file, a results folder, a world YAML or a world preset: " +
-                                 [&] {
-                                     std::string s;
-                                     for (const auto& n : presets) s += (s.empty() ? "" : ", ") + n;
-                                     return s;
-                                 }() + ")");
+                std::string names;
+                for (const auto& n : presets) names += (names.empty() ? "" : ", ") + n;
+                throw InputError("'" + a + "' does not exist (expected a trial file, a results folder, a world YAML or "
+                                 "a world preset: " + names + ")");
             }
         }
     }
@@ -139,7 +137,7 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--port", o->port, "Port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
     cmd->add_option("--scans", o->scans, "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");
-    cmd->add_option("--model", o->model, "Model whose BVCs a recording's page shows")->capture_default_str();
+    cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")->capture_default_str();
     cmd->add_option("--export", o->export_dir, "Write the page as static files into this (new) folder instead of serving it");
     cmd->add_option("--export-steps", o->export_steps, "Samples per trial (or scans) whose returns and rates are exported")
         ->capture_default_str()
