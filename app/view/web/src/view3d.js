@@ -85,12 +85,18 @@ export class View3D {
     this.dirty = true;
   }
 
+  // Looks at the box from the south, above, far enough that its bounding sphere fits the view.
   frame([[x0, y0, z0], [x1, y1, z1]]) {
     const c = new THREE.Vector3((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2);
-    const size = Math.max(x1 - x0, y1 - y0, z1 - z0, 1);
-    this.camera.position.set(c.x + 0.1 * size, c.y - 0.8 * size, c.z + 0.65 * size);
+    const radius = 0.5 * Math.hypot(x1 - x0, y1 - y0, z1 - z0) || 1;
+    const half = THREE.MathUtils.degToRad(this.camera.fov / 2);
+    const halfH = Math.atan(Math.tan(half) * this.camera.aspect);
+    const distance = (0.85 * radius) / Math.sin(Math.min(half, halfH));
+    const direction = new THREE.Vector3(0.1, -0.8, 0.75).normalize();
+    this.camera.position.copy(c).addScaledVector(direction, distance);
     this.controls.target.copy(c);
     this.controls.update();
+    this.framed = [[x0, y0, z0], [x1, y1, z1]];
   }
 
   // The path, thinned to at most 4000 vertices: a software renderer draws a 50 000-vertex line at
