@@ -10,8 +10,8 @@ import { writeFileSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { artifacts, scratch, run, serve, launch, openPage, waitReady, h5 } from './helpers.mjs';
 
-const maxOpenSeconds = Number(process.env.BVC3D_VIEWER_MAX_OPEN_S || 6);
-const minFps = Number(process.env.BVC3D_VIEWER_MIN_FPS || 10);
+const maxOpenSeconds = Number(process.env.BVC3D_VIEWER_MAX_OPEN_S || 10);
+const minFps = Number(process.env.BVC3D_VIEWER_MIN_FPS || 5);
 let dir, server, browser;
 const results = {};
 

@@ -42,8 +42,8 @@ function setSample(i) {
 }
 viewer.setSample = setSample;
 
-// Every pane's steps (or probes) have arrived (or failed).
-viewer.idle = () => viewer.panes.every((p) => !p.loader || p.loader.idle());
+// Every pane's world, steps (or probes) have arrived (or failed).
+viewer.idle = () => viewer.panes.every((p) => !p.loadingWorld && (!p.loader || p.loader.idle()));
 
 function loop() {
   let drew = false;

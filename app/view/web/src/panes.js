@@ -111,7 +111,8 @@ export class TrialPane extends Pane {
     this.steps = exportedSteps(this.path);
     if (h.world_problem) showError(this.root, h.world_problem);
     else {
-      get('world', { trial: this.path }).then((w) => this.view.setWorld(w)).catch((e) => showError(this.root, e.message));
+      this.loadingWorld = get('world', { trial: this.path }).then((w) => this.view.setWorld(w))
+        .catch((e) => showError(this.root, e.message)).finally(() => { this.loadingWorld = null; });
     }
     if (h.model_problem) showError(this.root, h.model_problem);
     this.legend.textContent = h.drawn_sensor
@@ -350,10 +351,10 @@ export class RecordingPane extends Pane {
     // Frame the path and 10 m around it: a map's far returns would push the camera away.
     const around = [[lo[0] - 10, lo[1] - 10, lo[2] - 2], [hi[0] + 10, hi[1] + 10, hi[2] + 2]];
     this.view.frame(around);
-    get('world', { recording: 1 }).then((w) => {
+    this.loadingWorld = get('world', { recording: 1 }).then((w) => {
       this.view.setWorld(w);
       this.view.frame(around);
-    }).catch((e) => showError(this.root, e.message));
+    }).catch((e) => showError(this.root, e.message)).finally(() => { this.loadingWorld = null; });
     this.legend.textContent = 'returns colored by range; large = near a BVC layer\'s elevation';
     const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: `BVC activity per layer (model ${h.model.name})` }));
     this.root.appendChild(el('div', { className: 'row' }, bvcBox));
