@@ -153,16 +153,20 @@ TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
 }
 
 std::unique_ptr<Agent> TrajectorySpec::make(const World& world, std::uint64_t) const {
+    check_world(world.description());
+    return std::make_unique<Trajectory>(steps_);
+}
+
+void TrajectorySpec::check_world(const WorldDescription& world) const {
     Eigen::AlignedBox3d box;
-    for (const auto& v : world.mesh().vertices) box.extend(v);
+    for (const auto& v : world.mesh.vertices) box.extend(v);
     for (std::size_t i = 0; i < steps_->size(); ++i) {
         const Pose& p = (*steps_)[i].pose;
         if (!box.contains(p.position()))
             throw InputError("trajectory '" + source_ + "', row " + std::to_string(i) + ": (" + format_number(p.x) +
                              ", " + format_number(p.y) + ", " + format_number(p.z) + ") lies outside world '" +
-                             world.name() + "' (another coordinate frame?)");
+                             world.name + "' (another coordinate frame?)");
     }
-    return std::make_unique<Trajectory>(steps_);
 }
 
 std::string TrajectorySpec::key() const {

@@ -3,6 +3,7 @@
 #include "bvc3d/core/format.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,9 +12,12 @@
 namespace bvc3d::config {
 
 YamlView YamlView::load_file(const std::string& file) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw ConfigError(file, "", "is a folder, not a file");
+    if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec))
+        throw ConfigError(file, "", "is not a regular file");
     std::ifstream in(file);
     if (!in) {
-        std::error_code ec;
         throw ConfigError(file, "", std::filesystem::exists(file, ec) ? "cannot be opened for reading" : "file does not exist");
     }
     std::stringstream text;
@@ -114,6 +118,16 @@ long long YamlView::as_int() const {
     } catch (const YAML::Exception&) {
         fail("expected an integer, got '" + node_.Scalar() + "'");
     }
+}
+
+std::uint64_t YamlView::as_uint64() const {
+    if (!node_.IsScalar()) fail("expected a whole number from 0 to 18446744073709551615");
+    const std::string& text = node_.Scalar();
+    std::uint64_t v = 0;
+    const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size())
+        fail("expected a whole number from 0 to 18446744073709551615 (2^64 - 1), got '" + text + "'");
+    return v;
 }
 
 bool YamlView::as_bool() const {
