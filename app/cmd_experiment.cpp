@@ -50,11 +50,11 @@ std::vector<std::string> split(const std::string& s) {
 // signal) and the last line it printed on standard error.
 struct ReportRun {
     int status = -1;
-    std::string last_error_line;
+    std::string error_text, last_error_line;  // all it wrote to standard error, and its last line
 };
 
 // Runs the report module, `python3 -m bvc3d.report DIR`, as a child process (no shell). Its standard
-// error passes through and is also kept, to say why it failed.
+// error is kept, to say why it failed (report_failure); the caller decides what of it to show.
 ReportRun run_report(const std::filesystem::path& dir) {
     const char* py_env = std::getenv("BVC3D_PYTHON");
     const std::string python = py_env ? py_env : BVC3D_PYTHON;
@@ -82,24 +82,23 @@ ReportRun run_report(const std::filesystem::path& dir) {
     }
     ::close(pipe_fds[1]);
     ReportRun run;
-    std::string text;
+    std::string& text = run.error_text;
     char buf[4096];
     for (;;) {
         const ssize_t n = ::read(pipe_fds[0], buf, sizeof buf);
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) break;
         text.append(buf, static_cast<std::size_t>(n));
-        if (::write(STDERR_FILENO, buf, static_cast<std::size_t>(n)) < 0) {
-        }
     }
     ::close(pipe_fds[0]);
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
     run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
-    const auto nl = text.rfind('\n');
-    run.last_error_line = nl == std::string::npos ? text : text.substr(nl + 1);
+    std::string tail = text;
+    while (!tail.empty() && (tail.back() == '\n' || tail.back() == '\r')) tail.pop_back();
+    const auto nl = tail.rfind('\n');
+    run.last_error_line = nl == std::string::npos ? tail : tail.substr(nl + 1);
     return run;
 }
 
@@ -114,8 +113,9 @@ bool png_complete(const std::filesystem::path& file) {
 }
 
 // After a failed report: nothing half-written stays. Temporary files, and figures that do not end
-// where a PNG ends, are removed; complete figures stay.
-void remove_partial_report(const std::filesystem::path& dir) {
+// where a PNG ends, are removed (and returned); complete figures stay.
+std::vector<std::filesystem::path> remove_partial_report(const std::filesystem::path& dir) {
+    std::vector<std::filesystem::path> removed;
     std::error_code ec;
     for (const auto& folder : {dir, dir / "figures"}) {
         if (!std::filesystem::is_directory(folder, ec)) continue;
@@ -123,27 +123,31 @@ void remove_partial_report(const std::filesystem::path& dir) {
             const auto name = e.path().filename().string();
             const bool temporary = name.find(".tmp") != std::string::npos;
             const bool broken_png = e.path().extension() == ".png" && !png_complete(e.path());
-            if (e.is_regular_file(ec) && (temporary || broken_png)) std::filesystem::remove(e.path(), ec);
+            if (e.is_regular_file(ec) && (temporary || broken_png) && std::filesystem::remove(e.path(), ec))
+                removed.push_back(e.path());
         }
     }
+    return removed;
 }
 
-// The reason a report failed, from its last line: Python's "OSError: [Errno 28] No space left on
-// device: 'DIR/figures/msai.png'" becomes "'DIR/figures/msai.png': No space left on device".
-std::string report_failure(const ReportRun& run) {
+// Why a report failed, from its last line: Python's "OSError: [Errno 28] No space left on device"
+// becomes "cannot write 'DIR/figures/msai.png': No space left on device" (the file from the error,
+// or the half-written figure that was removed). Empty `os_error` for any other failure.
+std::string report_failure(const ReportRun& run, const std::vector<std::filesystem::path>& removed, bool& os_error) {
     const std::string& line = run.last_error_line;
     const auto errno_at = line.find("[Errno ");
-    if (errno_at != std::string::npos) {
-        const auto close = line.find("] ", errno_at);
-        if (close != std::string::npos) {
-            std::string reason = line.substr(close + 2), file;
-            const auto quote = reason.find(": '");
-            if (quote != std::string::npos && reason.back() == '\'') {
-                file = reason.substr(quote + 3, reason.size() - quote - 4);
-                reason.resize(quote);
-            }
-            return file.empty() ? "writing the figures failed: " + reason : "cannot write '" + file + "': " + reason;
+    const auto close = errno_at == std::string::npos ? std::string::npos : line.find("] ", errno_at);
+    os_error = close != std::string::npos;
+    if (os_error) {
+        std::string reason = line.substr(close + 2), file;
+        const auto quote = reason.find(": '");
+        if (quote != std::string::npos && reason.back() == '\'') {
+            file = reason.substr(quote + 3, reason.size() - quote - 4);
+            reason.resize(quote);
+        } else if (!removed.empty()) {
+            file = removed.front().string();
         }
+        return file.empty() ? "writing the figures failed: " + reason : "cannot write '" + file + "': " + reason;
     }
     if (run.status < 0) return "the report process could not run or was killed";
     return line.empty() ? "the report exited with status " + std::to_string(run.status) : printable(line);
@@ -212,11 +216,16 @@ void summarize(const std::filesystem::path& out, const std::vector<std::filesyst
     write_summary_markdown(out / "summary.md", rows);
     if (!report) return;
     const ReportRun run = run_report(out);
-    if (run.status != 0) {
-        remove_partial_report(out);
-        throw InputError("the report (figures) failed: " + report_failure(run) + "; the trial files and summary are in '" +
-                         out.string() + "'; rerun with: python3 -m bvc3d.report " + out.string());
+    if (run.status == 0) {
+        std::fputs(run.error_text.c_str(), stderr);  // the report's own warnings
+        return;
     }
+    const auto removed = remove_partial_report(out);
+    bool os_error = false;
+    const std::string why = report_failure(run, removed, os_error);
+    if (!os_error) std::fputs(run.error_text.c_str(), stderr);  // a bug's traceback is worth showing
+    throw InputError("the report (figures) failed: " + why + "; the trial files and summary are in '" + out.string() +
+                     "'; rerun with: python3 -m bvc3d.report " + out.string());
 }
 
 namespace {

@@ -197,7 +197,7 @@ TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
     auto far = std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {100, 101}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
     EXPECT_THROW(run_trial_group({trial_with(far, "2d", 0.0001)}), InputError);
     // In trial YAML, next to the random walk's robot.
-    const auto yaml = temp_file("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.0002}\n");
+    const auto yaml = temp_file("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.001}\n");
     EXPECT_EQ(config::load_trial_file(yaml.string()).agent->kind(), "trajectory");
     const auto both = temp_file("both.yaml", "trajectory: " + header.string() + "\nrobot: {speed: 1}\n");
     EXPECT_THROW(config::load_trial_file(both.string()), ConfigError);

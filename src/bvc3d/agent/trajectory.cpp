@@ -82,6 +82,8 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
     const std::string name = "trajectory file '" + path.string() + "'";
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw InputError(name + " is a folder, not a file");
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw InputError(name + " is not a regular file");
     std::ifstream in(path);
     if (!in) throw InputError(name + (std::filesystem::exists(path, ec) ? " cannot be read" : " does not exist"));
     std::vector<std::string> columns;  // from the header, if any

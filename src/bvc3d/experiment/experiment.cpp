@@ -63,7 +63,7 @@ public:
     std::int64_t model_steps() const { return model_steps_.load(); }
     void trial_done(const std::string& name) {
         trials_.fetch_add(1);
-        if (style_ == ProgressStyle::lines) line("finished " + name);
+        if (style_ == ProgressStyle::lines) line(name);
     }
     // From the watcher thread, every fraction of a second.
     void tick() {
@@ -100,14 +100,20 @@ private:
                      final ? std::to_string(static_cast<long long>(w + 0.5)).c_str() : left().c_str(), final ? "\n" : "");
         std::fflush(stderr);
     }
+    // "bvc3d: 3/16 trials done (cross-30_2d_seed0), 0.40/1.60 simulated hours (25%), ~95 s left"
     void line(const std::string& what) {
         std::lock_guard lock(mutex_);
         const double done = std::min(seconds_.load(), total_seconds_);
-        std::fprintf(stderr, "bvc3d: %d/%d trials, %.2f/%.2f simulated hours (%.0f%%), %s%s%s s\n", trials_.load(),
-                     total_trials_, done / 3600, total_seconds_ / 3600, total_seconds_ > 0 ? 100 * done / total_seconds_ : 100.0,
-                     what == "done" ? "took " : "~", what == "done" ? std::to_string(static_cast<long long>(wall() + 0.5)).c_str()
-                                                                    : (left() + " left,").c_str(),
-                     what.empty() || what == "done" ? "" : (" " + what).c_str());
+        std::string text = "bvc3d: " + std::to_string(trials_.load()) + "/" + std::to_string(total_trials_) + " trials done";
+        if (!what.empty() && what != "done") text += " (" + what + ")";
+        char buf[160];
+        if (what == "done") {
+            std::snprintf(buf, sizeof buf, ", %.2f simulated hours in %.0f s", total_seconds_ / 3600, wall());
+        } else {
+            std::snprintf(buf, sizeof buf, ", %.2f/%.2f simulated hours (%.0f%%), ~%s s left", done / 3600,
+                          total_seconds_ / 3600, total_seconds_ > 0 ? 100 * done / total_seconds_ : 100.0, left().c_str());
+        }
+        std::fprintf(stderr, "%s%s\n", text.c_str(), buf);
         std::fflush(stderr);
     }
 

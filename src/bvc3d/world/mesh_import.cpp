@@ -90,6 +90,7 @@ TriangleMesh load_mesh_file(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw InputError(where + ": file does not exist");
     if (std::filesystem::is_directory(path, ec)) throw InputError(where + ": is a folder, not a file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(where + ": is not a regular file");
     const auto size = std::filesystem::file_size(path, ec);
     if (ec) throw InputError(where + ": cannot be read (" + ec.message() + ")");
     if (static_cast<double>(size) > max_mesh_file_bytes)
