@@ -121,7 +121,10 @@ std::vector<std::filesystem::path> remove_partial_report(const std::filesystem::
         if (!std::filesystem::is_directory(folder, ec)) continue;
         for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
             const auto name = e.path().filename().string();
-            const bool temporary = name.find(".tmp") != std::string::npos;
+            // The report's own temporaries ("report.md.tmp") and ours ("x.csv.tmp<pid>-<n>").
+            const auto at = name.rfind(".tmp");
+            const bool temporary = at != std::string::npos &&
+                                   name.find_first_not_of("0123456789-", at + 4) == std::string::npos;
             const bool broken_png = e.path().extension() == ".png" && !png_complete(e.path());
             if (e.is_regular_file(ec) && (temporary || broken_png) && std::filesystem::remove(e.path(), ec))
                 removed.push_back(e.path());

@@ -1,4 +1,6 @@
 // bvc3d scan / bvc3d walk: the simulator stage on its own.
+#include <cerrno>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -35,6 +37,8 @@ void emit(const std::string& out, const std::string& header, WriteRows&& write_r
     if (out.empty() || out == "-") {
         std::cout << header << "\n";
         write_rows(std::cout);
+        std::cout.flush();
+        if (!std::cout) throw InputError(std::string("cannot write to standard output: ") + std::strerror(errno ? errno : EIO));
         return;
     }
     AtomicFile file(out);

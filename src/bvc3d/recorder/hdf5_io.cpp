@@ -56,8 +56,8 @@ std::vector<T> read_any(hid_t loc, const std::string& name, hid_t mem_type) {
     Handle space(check(H5Dget_space(ds), "space " + name), H5Sclose);
     const hssize_t n = H5Sget_simple_extent_npoints(space);
     // A damaged or hostile file may claim any size: refuse what cannot fit before allocating it.
-    check_memory(static_cast<double>(std::max<hssize_t>(n, 0)) * sizeof(T), "dataset '" + name + "'",
-                 "the file is probably damaged");
+    if (const double bytes = static_cast<double>(std::max<hssize_t>(n, 0)) * sizeof(T); bytes > 1e8)
+        check_memory(bytes, "dataset '" + name + "'", "the file is probably damaged");
     std::vector<T> out(static_cast<std::size_t>(std::max<hssize_t>(n, 0)));
     if (n > 0) check(H5Dread(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), "read " + name);
     return out;
