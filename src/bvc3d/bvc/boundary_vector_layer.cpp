@@ -1,7 +1,5 @@
 #include "bvc3d/bvc/boundary_vector_layer.hpp"
 
-#include "bvc3d/core/format.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -9,6 +7,7 @@
 #include "bvc3d/bvc/bvc_kernels.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 

@@ -1,8 +1,7 @@
 #include "bvc3d/config/model_spec.hpp"
 
-#include "bvc3d/core/format.hpp"
-
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 

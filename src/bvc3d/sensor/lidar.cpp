@@ -1,11 +1,10 @@
 #include "bvc3d/sensor/lidar.hpp"
 
-#include "bvc3d/core/format.hpp"
-
 #include <cmath>
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/world/ray_caster.hpp"
 
