@@ -7,6 +7,7 @@
 #include "bvc3d/bvc/bvc_kernels.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 
@@ -57,6 +58,11 @@ const params::Table<BvcParams>& BvcParams::table() {
 
 void BvcParams::validate() const {
     table().check(*this);
+    const double cells = static_cast<double>(n_layers()) * n_dir * n_per_axis;
+    if (cells > max_cells)
+        table().fail("n_per_axis", "makes " + std::to_string(n_layers()) + " layers × " + std::to_string(n_dir) +
+                                       " directions × " + std::to_string(n_per_axis) + " distances = " +
+                                       format_number(cells) + " cells; the limit is " + format_number(max_cells));
     if (reading == BvcReading::nearest_beam && !elevations.empty())
         table().fail("reading", "cannot be nearest_beam with elevation layers (the nearest_beam reading is a 2-D model)");
 }

@@ -35,6 +35,10 @@ struct BvcParams {
     double norm_constant = 1.0;  // `fixed`: rate = raw / norm_constant
     BvcReading reading = BvcReading::gaussian;
 
+    // At most this many cells (layers × n_dir × n_per_axis): beyond it a layer is a mistake, and its
+    // weights and rates would not fit in memory.
+    static constexpr double max_cells = 1e6;
+
     int n_layers() const { return elevations.empty() ? 1 : static_cast<int>(elevations.size()); }
     int n_cells() const { return n_layers() * n_dir * n_per_axis; }
     double spacing() const { return n_per_axis > 1 ? max_dist / (n_per_axis - 1) : 0.0; }

@@ -4,6 +4,7 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/world/ray_caster.hpp"
 
@@ -47,7 +48,14 @@ const params::Table<LidarSpec>& LidarSpec::table() {
     return t;
 }
 
-void LidarSpec::validate() const { table().check(*this); }
+void LidarSpec::validate() const {
+    table().check(*this);
+    const double beams = static_cast<double>(elevations.size()) * azimuth_count;
+    if (beams > max_beams)
+        table().fail("azimuth_count", "makes " + std::to_string(elevations.size()) + " rows × " +
+                                          std::to_string(azimuth_count) + " columns = " + format_number(beams) +
+                                          " beams; the limit is " + format_number(max_beams));
+}
 
 Lidar::Lidar(LidarSpec spec) : spec_(std::move(spec)) {
     spec_.validate();
