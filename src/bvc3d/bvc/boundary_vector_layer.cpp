@@ -75,9 +75,6 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     const int padded = (p_.n_per_axis + 7) / 8 * 8;
     dist_decay_.assign(padded, 0.0);
     for (int n = 0; n < p_.n_per_axis; ++n) dist_decay_[n] = std::exp(-0.5 * (n * d) * (n * d) / (p_.sigma_r * p_.sigma_r));
-    profile_.assign(padded, 0.0);
-    row_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
-    rows_.assign(row_weight_.size(), nullptr);
     elev_.assign(p_.n_layers(), 0.0);
     dropped_e_.assign(p_.n_layers(), 0.0);
     kept_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
@@ -122,23 +119,30 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     // keeps the power recurrence below far from overflow.
     const bool recurrence = dd > 0 && dd <= p_.sigma_r;
     // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_).
-    std::vector<double>& elev = elev_;
-    std::vector<double>& dropped_e = dropped_e_;
+    double* elev = elev_.data();
+    double* dropped_e = dropped_e_.data();
     // For the truncation bound: per (layer, direction) the kept weights Σ E·A and the dropped ones,
     // per layer Σ E over returns that reach it and Σ E over those whose distance window is empty.
     std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
     std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
     std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
     std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    double* kept_weight = kept_weight_.data();
+    double* layer_weight = layer_weight_.data();
+    // The recurrence path first lists every return's profile and rows (jobs_, job_offset_,
+    // job_weight_), then adds them all in one kernel call, in return order.
+    jobs_.clear();
+    job_offset_.clear();
+    job_weight_.clear();
     std::size_t valid = 0, lookups = 0, misses = 0;
-    const bool use_memo = memo_useful_ || ++memo_probe_ % 16 == 0;
+    const bool use_memo = memo_bad_steps_ < memo_patience || ++memo_probe_ % 16 == 0;
     double last_phi = NAN;
     bool any_kept = true, any_dropped = false, skipped_row = false;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
         const LidarReturn& ret = returns[j];
         if (is_no_return(ret)) continue;
-        check_return(ret, j);
+        if (!(ret.range >= 0) || !std::isfinite(ret.azimuth) || !std::isfinite(ret.elevation)) check_return(ret, j);
         // Elevation factors, cached across the returns of one scanner row.
         if (!(ret.elevation == last_phi)) {
             last_phi = ret.elevation;
@@ -178,12 +182,12 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         } else {
             n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
         }
-        for (int l = 0; l < L; ++l) {
-            layer_weight_[l] += elev[l] + dropped_e[l];
-            if (dropped_e[l] > 0.0)
-                for (int d = 0; d < n_dirs; ++d)
-                    dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
-        }
+        for (int l = 0; l < L; ++l) layer_weight[l] += elev[l] + dropped_e[l];
+        if (any_dropped)
+            for (int l = 0; l < L; ++l)
+                if (dropped_e[l] > 0.0)
+                    for (int d = 0; d < n_dirs; ++d)
+                        dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
         if (!any_kept) continue;
 
         // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
@@ -204,33 +208,37 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         const int W = m_hi - m_lo + 1;
 
         // The (layer, direction) rows this return feeds, with their elevation × angular weights.
-        int count = 0;
+        const std::size_t first = job_weight_.size();
         for (int d = 0; d < n_dirs; ++d)
             for (int l = 0; l < L; ++l) {
                 if (elev[l] == 0.0) continue;
-                row_weight_[count] = elev[l] * ang[d];
-                kept_weight_[static_cast<std::size_t>(l) * K + dir[d]] += row_weight_[count];
-                rows_[count] = out_data + (static_cast<std::size_t>(l) * K + dir[d]) * stride + m_lo;
-                ++count;
+                const double w = elev[l] * ang[d];
+                const std::size_t lk = static_cast<std::size_t>(l) * K + dir[d];
+                kept_weight[lk] += w;
+                job_weight_.push_back(w);
+                job_offset_.push_back(static_cast<std::uint32_t>(lk * stride + m_lo));
             }
+        const int count = static_cast<int>(job_weight_.size() - first);
         if (count == 0) continue;
 
         // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
         if (recurrence) {
             // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return.
             const double x0 = r - m_lo * dd;
-            kernels::add_distance_profile(c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd),
-                                          dist_decay_.data(), W, row_weight_.data(), rows_.data(), count,
-                                          profile_.data());
+            jobs_.push_back({c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd), W, count});
         } else {
             for (int n = 0; n < W; ++n) {
                 const double x = r - (m_lo + n) * dd;
                 const double u = c_r_ * std::exp(-h_r * x * x);
-                for (int i = 0; i < count; ++i) rows_[i][n] += row_weight_[i] * u;
+                for (int i = 0; i < count; ++i) out_data[job_offset_[first + i] + n] += job_weight_[first + i] * u;
             }
         }
     }
-    if (use_memo && lookups > 0) memo_useful_ = misses * 4 < lookups * 3;
+    if (!jobs_.empty())
+        kernels::add_distance_profiles(jobs_.data(), jobs_.size(), job_offset_.data(), job_weight_.data(),
+                                       dist_decay_.data(), out_data);
+    if (use_memo && lookups > 0)
+        memo_bad_steps_ = misses * 4 < lookups * 3 ? 0 : std::min(memo_bad_steps_ + 1, memo_patience);
     for (int axis = 0; axis < L * K; ++axis)
         std::copy(out_data + static_cast<std::size_t>(axis) * stride, out_data + static_cast<std::size_t>(axis) * stride + M,
                   result.begin() + static_cast<std::ptrdiff_t>(axis) * M);
@@ -260,13 +268,22 @@ int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weigh
     const int K = p_.n_dir;
     const double dtheta = two_pi / K, h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta);
     const bool all_dirs = 2.0 * cut_theta_ >= two_pi;
-    const int k_first = all_dirs ? 0 : static_cast<int>(std::ceil((azimuth - cut_theta_) / dtheta));
-    const int k_last = all_dirs ? K - 1 : static_cast<int>(std::floor((azimuth + cut_theta_) / dtheta));
+    // ceil and floor of quotients within a few turns, from truncation (no libm call on baseline x86-64).
+    auto ceil_int = [](double t) {
+        const int i = static_cast<int>(t);
+        return i + (static_cast<double>(i) < t);
+    };
+    auto floor_int = [](double t) {
+        const int i = static_cast<int>(t);
+        return i - (static_cast<double>(i) > t);
+    };
+    const int k_first = all_dirs ? 0 : ceil_int((azimuth - cut_theta_) / dtheta);
+    const int k_last = all_dirs ? K - 1 : floor_int((azimuth + cut_theta_) / dtheta);
     int count = 0;
     for (int ki = k_first; ki <= k_last; ++ki) {
         const double x = all_dirs ? wrap_pi(azimuth - ki * dtheta) : azimuth - ki * dtheta;
         if (std::abs(x) > cut_theta_) continue;
-        dir[count] = ((ki % K) + K) % K;
+        dir[count] = ki < 0 ? ki + K : ki >= K ? ki - K : ki;  // |ki| < K: the window is under a turn
         weight[count] = c_theta_ * std::exp(-x * x * h_t);
         ++count;
     }
@@ -283,7 +300,7 @@ void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::s
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     std::fill(out.begin(), out.end(), 0.0);
     if (p_.reading == BvcReading::nearest_beam) {
-        raw_nearest_beam(returns, out);
+        raw_nearest_beam(returns, out, false);
         return;
     }
     const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis;
@@ -310,7 +327,8 @@ void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::s
     }
 }
 
-void BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out) const {
+bool BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out,
+                                           bool prune) const {
     // For each direction, the first return with the smallest |wrap(azimuth - θ_k)|.
     const int K = p_.n_dir, M = p_.n_per_axis;
     best_return_.assign(K, returns.size());
@@ -329,20 +347,37 @@ void BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns,
             }
         }
     }
+    // Pruned, a direction's profile is evaluated over its distance window only (as raw_pruned does):
+    // a cell outside it would get less than tiny_r·c_r. Those Gaussian tails (down to 1e-56 of the
+    // peak) were the subnormal float rates, and the weights Oja's rule grew from them, that made
+    // the place cells take a microcode assist per product on many CPUs.
+    const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
+    prune = prune && dd > 0;
+    double max_raw = 0;
     for (int k = 0; k < K; ++k) {
         if (best_return_[k] == returns.size()) continue;
-        for (int m = 0; m < M; ++m) {
-            const double x = returns[best_return_[k]].range - m * p_.spacing();
-            out[static_cast<std::size_t>(k) * M + m] = c_r_ * std::exp(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
+        const double r = returns[best_return_[k]].range;
+        int m_lo = 0, m_hi = M - 1;
+        if (prune) {  // a superset of |r - d_m| <= cut, as in raw_pruned
+            const double lo = (r - cut_r_) * inv_dd, hi = (r + cut_r_) * inv_dd;
+            m_lo = lo > 0 ? static_cast<int>(std::min(lo, 1e9)) : 0;
+            m_hi = std::min(static_cast<int>(std::min(hi, static_cast<double>(M - 2))) + 1, M - 1);
+        }
+        for (int m = m_lo; m <= m_hi; ++m) {
+            const double x = r - m * p_.spacing();
+            const double v = c_r_ * std::exp(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
+            out[static_cast<std::size_t>(k) * M + m] = v;
+            max_raw = std::max(max_raw, v);
         }
     }
+    return !prune || c_r_ * tiny_r <= pruned_tolerance * max_raw;
 }
 
 void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     if (p_.reading == BvcReading::nearest_beam) {
         std::fill(out.begin(), out.end(), 0.0);
-        raw_nearest_beam(returns, out);
+        if (!raw_nearest_beam(returns, out, true)) raw_nearest_beam(returns, out, false);
     } else if (!raw_pruned(returns, nullptr, out)) {
         raw_exact(returns, out);
     }
