@@ -77,6 +77,13 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     for (int n = 0; n < p_.n_per_axis; ++n) dist_decay_[n] = std::exp(-0.5 * (n * d) * (n * d) / (p_.sigma_r * p_.sigma_r));
     elev_.assign(p_.n_layers(), 0.0);
     dropped_e_.assign(p_.n_layers(), 0.0);
+    row_factor_.assign(p_.n_layers(), 0.0);
+    kept_layers_.assign(p_.n_layers(), 0);
+    any_layers_.assign(p_.n_layers(), 0);
+    // A batch: 256 returns, or as many rows as fill 1024 entries (plus one return's worth).
+    jobs_.resize(256);
+    job_offset_.resize(1024 + static_cast<std::size_t>(p_.n_layers()) * p_.n_dir);
+    job_weight_.resize(job_offset_.size());
     kept_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
     layer_weight_.assign(p_.n_layers(), 0.0);
     far_weight_.assign(p_.n_layers(), 0.0);
@@ -118,9 +125,13 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
     // keeps the power recurrence below far from overflow.
     const bool recurrence = dd > 0 && dd <= p_.sigma_r;
-    // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_).
+    // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_);
+    // the layers with a summed factor (kept_l, n_kept of them) and with any factor (any_l, n_any).
     double* elev = elev_.data();
     double* dropped_e = dropped_e_.data();
+    int* kept_l = kept_layers_.data();
+    int* any_l = any_layers_.data();
+    int n_kept = 0, n_any = 0;
     // For the truncation bound: per (layer, direction) the kept weights Σ E·A and the dropped ones,
     // per layer Σ E over returns that reach it and Σ E over those whose distance window is empty.
     std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
@@ -129,15 +140,21 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
     double* kept_weight = kept_weight_.data();
     double* layer_weight = layer_weight_.data();
-    // The recurrence path first lists every return's profile and rows (jobs_, job_offset_,
-    // job_weight_), then adds them all in one kernel call, in return order.
-    jobs_.clear();
-    job_offset_.clear();
-    job_weight_.clear();
+    // The recurrence path lists the returns' profiles (jobs) and the rows each feeds (offsets into
+    // the sums, weights), and adds a few hundred at a time in one kernel call, in return order.
+    kernels::ProfileJob* jobs = jobs_.data();
+    std::uint32_t* job_offset = job_offset_.data();
+    double* job_weight = job_weight_.data();
+    std::size_t n_jobs = 0, n_rows = 0;
+    const std::size_t rows_room = job_offset_.size() - static_cast<std::size_t>(K) * L;
+    auto flush = [&] {
+        kernels::add_distance_profiles(jobs, n_jobs, job_offset, job_weight, dist_decay_.data(), out_data);
+        n_jobs = n_rows = 0;
+    };
     std::size_t valid = 0, lookups = 0, misses = 0;
     const bool use_memo = memo_bad_steps_ < memo_patience || ++memo_probe_ % 16 == 0;
     double last_phi = NAN;
-    bool any_kept = true, any_dropped = false, skipped_row = false;
+    bool skipped_row = false;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
         const LidarReturn& ret = returns[j];
@@ -148,7 +165,7 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             last_phi = ret.elevation;
             skipped_row = plan && std::find(plan->skipped_rows.begin(), plan->skipped_rows.end(), ret.elevation) !=
                                       plan->skipped_rows.end();
-            any_kept = any_dropped = false;
+            n_kept = n_any = 0;
             for (int l = 0; l < L; ++l) {
                 elev[l] = dropped_e[l] = 0.0;
                 if (planar) {
@@ -158,13 +175,14 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
                     if (std::abs(x) <= cut_row_) elev[l] = c_phi_ * std::exp(-x * x * h_p);
                     else if (std::abs(x) <= cut_phi_) dropped_e[l] = c_phi_ * std::exp(-x * x * h_p);
                 }
-                any_kept = any_kept || elev[l] > 0.0;
-                any_dropped = any_dropped || dropped_e[l] > 0.0;
+                row_factor_[l] = elev[l] + dropped_e[l];
+                if (elev[l] > 0.0) kept_l[n_kept++] = l;
+                if (row_factor_[l] > 0.0) any_l[n_any++] = l;  // adding 0 to layer_weight changes nothing
             }
         }
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
         ++valid;
-        if (!any_kept && !any_dropped) continue;
+        if (n_any == 0) continue;
         const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
         const int* dir = direct_dir_.data();
         const double* ang = direct_weight_.data();
@@ -182,13 +200,13 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         } else {
             n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
         }
-        for (int l = 0; l < L; ++l) layer_weight[l] += elev[l] + dropped_e[l];
-        if (any_dropped)
+        for (int i = 0; i < n_any; ++i) layer_weight[any_l[i]] += row_factor_[any_l[i]];
+        if (n_any > n_kept)
             for (int l = 0; l < L; ++l)
                 if (dropped_e[l] > 0.0)
                     for (int d = 0; d < n_dirs; ++d)
                         dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
-        if (!any_kept) continue;
+        if (n_kept == 0) continue;
 
         // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
         // truncation toward zero serves for floor and ceil (r >= 0; no libm call on baseline x86-64).
@@ -202,41 +220,42 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             m_lo = 1;  // no cell in reach
         }
         if (m_lo > m_hi) {
-            for (int l = 0; l < L; ++l) far_weight_[l] += elev[l];
+            for (int i = 0; i < n_kept; ++i) far_weight_[kept_l[i]] += elev[kept_l[i]];
             continue;
         }
         const int W = m_hi - m_lo + 1;
 
         // The (layer, direction) rows this return feeds, with their elevation × angular weights.
-        const std::size_t first = job_weight_.size();
+        const std::size_t first = n_rows;
         for (int d = 0; d < n_dirs; ++d)
-            for (int l = 0; l < L; ++l) {
-                if (elev[l] == 0.0) continue;
+            for (int i = 0; i < n_kept; ++i) {
+                const int l = kept_l[i];
                 const double w = elev[l] * ang[d];
                 const std::size_t lk = static_cast<std::size_t>(l) * K + dir[d];
                 kept_weight[lk] += w;
-                job_weight_.push_back(w);
-                job_offset_.push_back(static_cast<std::uint32_t>(lk * stride + m_lo));
+                job_weight[n_rows] = w;
+                job_offset[n_rows] = static_cast<std::uint32_t>(lk * stride + m_lo);
+                ++n_rows;
             }
-        const int count = static_cast<int>(job_weight_.size() - first);
+        const int count = static_cast<int>(n_rows - first);
         if (count == 0) continue;
 
         // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
         if (recurrence) {
             // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return.
             const double x0 = r - m_lo * dd;
-            jobs_.push_back({c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd), W, count});
+            jobs[n_jobs++] = {c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd), W, count};
+            if (n_jobs == jobs_.size() || n_rows > rows_room) flush();
         } else {
             for (int n = 0; n < W; ++n) {
                 const double x = r - (m_lo + n) * dd;
                 const double u = c_r_ * std::exp(-h_r * x * x);
-                for (int i = 0; i < count; ++i) out_data[job_offset_[first + i] + n] += job_weight_[first + i] * u;
+                for (int i = 0; i < count; ++i) out_data[job_offset[first + i] + n] += job_weight[first + i] * u;
             }
+            n_rows = 0;
         }
     }
-    if (!jobs_.empty())
-        kernels::add_distance_profiles(jobs_.data(), jobs_.size(), job_offset_.data(), job_weight_.data(),
-                                       dist_decay_.data(), out_data);
+    if (n_jobs > 0) flush();
     if (use_memo && lookups > 0)
         memo_bad_steps_ = misses * 4 < lookups * 3 ? 0 : std::min(memo_bad_steps_ + 1, memo_patience);
     for (int axis = 0; axis < L * K; ++axis)

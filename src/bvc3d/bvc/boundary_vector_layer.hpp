@@ -118,9 +118,11 @@ private:
     mutable std::vector<double> direct_weight_;
 
     // Scratch for one step (a layer is not shared between threads): the elevation factors of the
-    // current row; every return's distance profile (jobs_) and the (layer, direction) rows it feeds,
-    // as offsets into padded_ and weights.
-    mutable std::vector<double> elev_, dropped_e_;
+    // current row (summed, dropped, their sum) and which layers have them; a batch of returns'
+    // distance profiles (jobs_) and the (layer, direction) rows each feeds, as offsets into padded_
+    // and weights.
+    mutable std::vector<double> elev_, dropped_e_, row_factor_;
+    mutable std::vector<int> kept_layers_, any_layers_;
     mutable std::vector<kernels::ProfileJob> jobs_;
     mutable std::vector<std::uint32_t> job_offset_;
     mutable std::vector<double> job_weight_;
