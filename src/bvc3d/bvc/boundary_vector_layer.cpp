@@ -90,10 +90,9 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     dropped_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
     axis_stride_ = padded + 8;
     padded_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir * axis_stride_, 0.0);
-    cache_key_.assign(cache_slots, NAN);
-    cache_count_.assign(cache_slots, 0);
-    cache_dir_.assign(cache_slots * p_.n_dir, 0);
-    cache_weight_.assign(cache_slots * p_.n_dir, 0.0);
+    memo_weight_.assign(cache_slots * (p_.n_dir + 1), 0.0);
+    memo_dir_.assign(cache_slots * (p_.n_dir + 1), 0);
+    for (std::size_t slot = 0; slot < cache_slots; ++slot) memo_weight_[slot * (p_.n_dir + 1)] = NAN;  // the keys
     direct_dir_.assign(p_.n_dir, 0);
     direct_weight_.assign(p_.n_dir, 0.0);
 }
@@ -189,14 +188,17 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         int n_dirs;
         if (use_memo) {
             ++lookups;
-            const std::size_t slot = slot_of(azimuth);
-            if (!(cache_key_[slot] == azimuth)) {
+            const std::size_t at = slot_of(azimuth) * (K + 1);
+            double* const key = memo_weight_.data() + at;
+            int* const count = memo_dir_.data() + at;
+            if (!(*key == azimuth)) {
                 ++misses;
-                fill_angular(slot, azimuth);
+                *count = angular_weights(azimuth, count + 1, key + 1);
+                *key = azimuth;
             }
-            dir = cache_dir_.data() + slot * K;
-            ang = cache_weight_.data() + slot * K;
-            n_dirs = cache_count_[slot];
+            dir = count + 1;
+            ang = key + 1;
+            n_dirs = *count;
         } else {
             n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
         }
@@ -307,12 +309,6 @@ int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weigh
         ++count;
     }
     return count;
-}
-
-void BoundaryVectorLayer::fill_angular(std::size_t slot, double azimuth) const {
-    const int K = p_.n_dir;
-    cache_count_[slot] = angular_weights(azimuth, cache_dir_.data() + slot * K, cache_weight_.data() + slot * K);
-    cache_key_[slot] = azimuth;
 }
 
 void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const {

@@ -93,7 +93,8 @@ private:
     // The directions an azimuth reaches and their angular factors c_θ·exp(-x²/2σ_θ²): a pure
     // function of the azimuth, memoised in a direct-mapped table keyed by the azimuth's bits
     // (scanners repeat the same azimuths row after row, and step after step while the agent does not
-    // turn). Slot s holds count_[s] directions at dir_/weight_[s·n_dir ...]; a NaN key never matches.
+    // turn). Slot s is memo_weight_[s·(n_dir + 1) ...] = key, factors and memo_dir_[same] = count,
+    // directions: two cache lines a lookup. A NaN key never matches.
     static constexpr std::size_t cache_slots = 1024;
     // The slot for `azimuth` in (-π, π]: its position on the circle, so a beam table's evenly spaced
     // columns (up to cache_slots of them) never share a slot. A hit is an add, a multiply and a
@@ -102,11 +103,10 @@ private:
         const auto s = static_cast<std::size_t>((azimuth + 3.14159265358979323846) * (cache_slots / 6.283185307179586477));
         return s < cache_slots ? s : cache_slots - 1;
     }
-    void fill_angular(std::size_t slot, double azimuth) const;
     // The directions `azimuth` reaches and their angular factors; returns how many.
     int angular_weights(double azimuth, int* dir, double* weight) const;
-    mutable std::vector<double> cache_key_, cache_weight_;
-    mutable std::vector<int> cache_count_, cache_dir_;
+    mutable std::vector<double> memo_weight_;
+    mutable std::vector<int> memo_dir_;
     // Irregular point sets (real LiDAR) repeat no azimuth: the memo then only evicts useful cache
     // lines, so after memo_patience steps in a row whose memo mostly missed, the next steps compute
     // the factors directly (into direct_*), checking again every 16th step. (A beam table misses

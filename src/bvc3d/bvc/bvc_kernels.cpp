@@ -1,10 +1,22 @@
 #include "bvc3d/bvc/bvc_kernels.hpp"
 
+#include <array>
+
 #include "bvc3d/core/simd.hpp"
 
 namespace bvc3d::kernels {
 
 namespace {
+
+// The first eight powers b^0..b^7 from a product tree, built in registers (a vector loaded from eight
+// scalar stores would wait for them to reach the cache: store forwarding cannot merge them).
+template <int N, class V>
+[[gnu::always_inline]] inline std::array<V, 8 / N> powers(double b, double b2, double b4) {
+    const double b3 = b2 * b, b5 = b4 * b, b6 = b4 * b2, b7 = b4 * b3;
+    if constexpr (N == 8) return {V{1.0, b, b2, b3, b4, b5, b6, b7}};
+    else if constexpr (N == 4) return {V{1.0, b, b2, b3}, V{b4, b5, b6, b7}};
+    else return {V{1.0, b}, V{b2, b3}, V{b4, b5}, V{b6, b7}};
+}
 
 // The kernel for vectors of N doubles (8 on AVX-512, 4 on AVX2, 2 on the baseline): each block of 8
 // cells is 8/N vectors. Every lane does the same operations whatever N, so the results are the same
@@ -24,9 +36,7 @@ template <int N>
         // Eight independent power chains b^(n+t), t = 0..7, stepped by b^8; the first powers come
         // from a product tree (three multiplications deep rather than eight).
         const double b2 = b * b, b4 = b2 * b2, b8 = b4 * b4;
-        const double first[8] = {1.0, b, b2, b2 * b, b4, b4 * b, b4 * b2, b4 * (b2 * b)};
-        V pw[P];
-        for (int p = 0; p < P; ++p) simd::load(pw[p], first + p * N);
+        std::array<V, P> pw = powers<N, V>(b, b2, b4);
         const int W = job.width, count = job.rows;
         for (int n = 0; n < W; n += 8) {
             V u[P];
