@@ -84,6 +84,7 @@ private:
     mutable std::vector<Vec3> dirs_;
     mutable std::vector<Vec2> horizontal_;
     mutable std::vector<double> ranges_, azimuths_;
+    mutable std::vector<std::size_t> cast_rows_;
 };
 
 }  // namespace bvc3d
