@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "bvc3d/bvc/bvc_kernels.hpp"
+#include "bvc3d/bvc/profile_job.hpp"
 #include "bvc3d/core/params.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 

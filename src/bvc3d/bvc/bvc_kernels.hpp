@@ -3,16 +3,9 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace bvc3d::kernels {
+#include "bvc3d/bvc/profile_job.hpp"
 
-// One return's distance profile c_r·exp(-(r - (m_lo + n)·Δ)²/2σ²), n < W, evaluated as a·b^n·decay[n]
-// (a = c_r·exp(-h x0²), b = exp(2h x0 Δ), decay[n] = exp(-h n²Δ²)), to be added with a weight to each of
-// `rows` rows; the rows' offsets (into the sums, at m_lo) and weights follow one another in the
-// arrays passed to add_distance_profiles.
-struct ProfileJob {
-    double a, b;
-    std::int32_t width, rows;
-};
+namespace bvc3d::kernels {
 
 // For each job in turn, in order: sums[offset_i + n] += weight_i·a·b^n·decay[n] for n < width and each
 // of its rows i. decay holds the widest width rounded up to a multiple of 8 entries; each row has

@@ -91,7 +91,12 @@ std::vector<Facet> facets(const std::vector<TrialSummaryRow>& trials) {
 }  // namespace
 
 std::string mixing_problem(const std::vector<TrialSummaryRow>& trials, const std::vector<std::filesystem::path>& files) {
-    const auto file = [&](std::size_t i) { return i < files.size() ? "'" + files[i].string() + "'" : "trial " + trials[i].name; };
+    // Appended, not "'" + ...: g++ 12 warns falsely on that (-Wrestrict, GCC bug 105329).
+    const auto file = [&](std::size_t i) {
+        std::string text = i < files.size() ? std::string("'") : std::string("trial ");
+        text += i < files.size() ? files[i].string() + "'" : trials[i].name;
+        return text;
+    };
     for (const auto& f : facets(trials)) {
         const auto swept = [&](const TrialSummaryRow& t) {
             for (const auto& [k, v] : t.swept)
