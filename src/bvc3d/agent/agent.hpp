@@ -2,8 +2,8 @@
 // Agent stage: where the agent goes.
 // Takes: a World (for collision) and a seed, or a given path. Gives: the model steps — when and at
 // which pose the model is updated — one at a time, and its state as text for checkpoints.
-// Kinds of agent: the ground robot's random walk (random_walk.hpp) and a given trajectory
-// (trajectory.hpp). The trial runner, checkpoints and walk sharing see only this interface.
+// Kinds of agent: the ground robot's random walk (random_walk.hpp), a given trajectory
+// (trajectory.hpp) and the flying agent (flying_walk.hpp). The trial runner, checkpoints and walk sharing see only this interface.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -41,7 +41,7 @@ public:
 class AgentSpec {
 public:
     virtual ~AgentSpec() = default;
-    virtual std::string kind() const = 0;  // "random_walk", "trajectory"
+    virtual std::string kind() const = 0;  // "random_walk", "trajectory", "flight"
     virtual void validate() const = 0;     // InputError naming the bad parameter
     virtual std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const = 0;
     // Configuration text that fixes the steps: the YAML a trial file records.
@@ -51,6 +51,12 @@ public:
     // The trial YAML keys that give this agent back (`robot:` and its keys, `trajectory: FILE`), with
     // their descriptions (`bvc3d config`); InputError if there are none (a path given as arrays).
     virtual void write_yaml(params::CommentedYaml& out) const = 0;
+    // Coordinates of the positions the analysis bins: 2 (x, y) for agents on the floor, 3 (x, y, z)
+    // for flying ones.
+    virtual int dims() const { return 2; }
+    // InputError if the agent cannot move in this world (a flying agent without a flight volume, a
+    // ground robot in a flight-only world), so that experiments fail before anything runs.
+    virtual void check_world(const WorldDescription&) const {}
 };
 
 }  // namespace bvc3d

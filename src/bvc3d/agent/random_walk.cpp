@@ -162,8 +162,15 @@ void RandomWalk::restore_state(const std::string& text) {
     restore(w);
 }
 
+void RandomWalkSpec::check_world(const WorldDescription& world) const {
+    if (world.walkable.points.empty() && world.flight)
+        throw InputError("world '" + world.name + "' is a flight-only world (no walkable region): the random walk's "
+                         "robot cannot use it; use the flying agent (trial key flight:, --agent flight)");
+}
+
 std::unique_ptr<Agent> RandomWalkSpec::make(const World& world, std::uint64_t seed) const {
     validate();
+    check_world(world.description());
     auto body = std::make_shared<const BodyCollider>(world.description(), robot_.radius, robot_.height);
     Rng rng(seed, Stream::walk);
     const Pose start = RandomWalk::draw_start(world.description(), *body, rng);

@@ -84,6 +84,7 @@ public:
     std::string key() const override;
     double steps_per_second() const override { return 1.0 / robot_.model_dt; }
     void write_yaml(params::CommentedYaml& out) const override;
+    void check_world(const WorldDescription& world) const override;
 
 private:
     RobotParams robot_;
