@@ -13,7 +13,7 @@ namespace {
 
 void write_identity(hid_t f, const TrialIdentity& id) {
     h5::write_attr(f, "format", std::string("bvc3d-trial"));
-    h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_format_version));
+    h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_version_for(id.dims)));
     h5::write_attr(f, "name", id.name);
     h5::write_attr(f, "condition", id.condition);
     std::string swept;
@@ -58,7 +58,8 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         h5::write(s, "t", group.t, {n});
         h5::write(s, "x", group.x, {n});
         h5::write(s, "y", group.y, {n});
-        if (std::any_of(group.z.begin(), group.z.end(), [](double z) { return z != 0.0; })) h5::write(s, "z", group.z, {n});
+        if (id.dims == 3 || std::any_of(group.z.begin(), group.z.end(), [](double z) { return z != 0.0; }))
+            h5::write(s, "z", group.z, {n});
         h5::write(s, "heading", group.heading, {n});
         h5::write(s, "rates", rec.rates, {n, static_cast<std::size_t>(rec.n_place)});
         if (!rec.bvc.empty()) h5::write(s, "bvc_rates", rec.bvc, {n, static_cast<std::size_t>(rec.n_bvc)});
@@ -75,18 +76,44 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
     out.commit();
 }
 
+namespace {
+
+// Files without the attribute predate it: version 1.
+int format_version(hid_t f) {
+    return h5::exists_attr(f, "format_version") ? static_cast<int>(h5::read_attr_int(f, "format_version")) : 1;
+}
+
+std::string version_error(const std::filesystem::path& path, int v) {
+    return "trial file '" + path.string() + "' has format_version " + std::to_string(v) +
+           "; this bvc3d reads versions 1 to " + std::to_string(trial_file_format_version) +
+           " (written by a newer bvc3d? docs/trial-files.md)";
+}
+
+void check_version(hid_t f, const std::filesystem::path& path) {
+    const int v = format_version(f);
+    if (v < 1 || v > trial_file_format_version) throw InputError(version_error(path, v));
+}
+
+}  // namespace
+
 std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+    int version = 1;
+    std::optional<TrialStamp> stamp;
     try {
         auto lock = h5::hdf5_lock();
         const auto f = h5::open_file(path.string());
         if (h5::read_attr_string(f, "format") != "bvc3d-trial") return std::nullopt;
-        if (!h5::exists(f, "metrics")) return std::nullopt;
-        return TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
+        version = format_version(f);
+        if (h5::exists(f, "metrics"))
+            stamp = TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
     } catch (const InputError&) {
         return std::nullopt;
     }
+    // A newer bvc3d's file is not broken: say so rather than overwrite it.
+    if (version < 1 || version > trial_file_format_version) throw InputError(version_error(path, version));
+    return stamp;
 }
 
 namespace {
@@ -102,6 +129,7 @@ h5::Handle open_trial(const std::filesystem::path& path) {
     } catch (const InputError&) {
     }
     if (format != "bvc3d-trial") throw InputError("'" + path.string() + "' is not a bvc3d trial file");
+    check_version(f, path);
     return f;
 }
 
@@ -141,10 +169,13 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     const auto g = h5::open_group(f, "metrics");
     for (const auto& name : h5::attribute_names(g)) d.metric_attributes.emplace_back(name, h5::read_attr(g, name));
     if (h5::exists(g, "extent")) d.extent = h5::read_doubles(g, "extent");
+    if (h5::exists(g, "volume")) d.volume = h5::read_doubles(g, "volume");
     const auto s = h5::open_group(f, "samples");
     d.x = h5::read_doubles(s, "x");
     d.y = h5::read_doubles(s, "y");
     if (h5::exists(s, "z")) d.z = h5::read_doubles(s, "z");
+    d.dims = format_version(f) >= 2 ? 3 : 2;
+    if (d.dims == 3 && d.z.empty()) throw InputError("'" + path.string() + "': a 3-D trial file without samples/z");
     const auto dims = h5::dims(s, "rates");
     if (dims.size() != 2 || dims[0] != d.x.size() || d.y.size() != d.x.size() || (!d.z.empty() && d.z.size() != d.x.size()))
         throw InputError("'" + path.string() + "': samples/rates has the wrong shape");
