@@ -55,5 +55,6 @@ void add_simulator_commands(CLI::App& app);
 void add_model_commands(CLI::App& app);
 void add_experiment_commands(CLI::App& app);
 void add_sweep_command(CLI::App& app);
+void add_flight_command(CLI::App& app);
 
 }  // namespace bvc3d::cli
