@@ -280,3 +280,47 @@ def test_flying_trial_reports_3d_metrics_and_errors_for_mismatches():
         bvc3d.run_trial(model="3d-0.2", world="flight-room", agent="flight", explore_hours=0.01, sample_hours=0.01)
     with pytest.raises(bvc3d.InputError, match="flight-only world"):
         bvc3d.run_trial(model="2d", world="flight-room", explore_hours=0.01, sample_hours=0.01)
+
+
+# ---------------------------------------------------------------------------------------------
+# bvc3d flight: trial files with z and a format version, summary, figures
+
+
+def test_flight_command_writes_3d_trials_summary_and_figures(tmp_path):
+    import h5py
+
+    from conftest import run_cli
+    out = tmp_path / "flight"
+    run_cli("flight", "--out", out, "--models", "fly-up,fly-5l", "--worlds", "flight-room", "--seeds", "1",
+            "--hours", "0.03", "--jobs", "1", check=True)
+    with h5py.File(out / "flight-room_fly-5l_seed0.h5", "r") as f:
+        assert f.attrs["format_version"] == 2
+        z, centers = f["samples/z"][:], f["metrics/bin_centers"][:]
+        assert centers.shape[1] == 3 and np.ptp(z) > 0.5
+        np.testing.assert_allclose(f["metrics/volume"][:], VOLUME)
+        iso = f["metrics/isotropy"][:]
+        assert np.array_equal(np.isnan(iso), f["metrics/modality"][:] != 1)
+    summary = (out / "summary.md").read_text()
+    assert "isotropy (median)" in summary and "decoding vertical (m)" in summary
+    figures = {p.name for p in (out / "figures").iterdir()}
+    assert {"worlds.png", "trajectory3d.png", "isotropy.png", "decoding_vertical.png", "frac_unimodal.png"} <= figures
+    assert "decoding_vertical.png" in (out / "report.md").read_text()
+    # A file of a format version this bvc3d does not know is refused by name, not misread.
+    newer = out / "flight-room_fly-up_seed0.h5"
+    with h5py.File(newer, "r+") as f:
+        f.attrs["format_version"] = 3
+    r = run_cli("analyze", newer)
+    assert r.returncode == 2 and "format_version 3" in r.stderr and str(newer) in r.stderr
+    r = run_cli("flight", "--out", out, "--models", "fly-up", "--worlds", "flight-room", "--seeds", "1",
+                "--hours", "0.03", "--jobs", "1")
+    assert r.returncode == 2 and "format_version 3" in r.stderr
+
+
+def test_flight_command_refuses_ground_models_and_worlds(tmp_path):
+    from conftest import run_cli
+    r = run_cli("flight", "--out", tmp_path / "a", "--models", "3d-0.2", "--worlds", "flight-room", "--hours", "0.01")
+    assert r.returncode == 2 and "preset for the ground robot" in r.stderr
+    world = SOURCE_DIR / "configs" / "worlds" / "two-rooms.yaml"
+    r = run_cli("flight", "--out", tmp_path / "b", "--models", "fly-up", "--worlds", world, "--hours", "0.01")
+    assert r.returncode == 2 and "no flight volume" in r.stderr
+    assert not (tmp_path / "a").exists() or not any((tmp_path / "a").glob("*.h5"))
