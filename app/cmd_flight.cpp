@@ -85,7 +85,7 @@ void add_flight_command(CLI::App& app) {
         "and report.md. Completed trials are skipped on a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
         const auto trials = flight_trials(*o);
-        const ExperimentOutcome outcome = run_local_experiment(trials, o->out, o->jobs, o->checkpoint_minutes);
+        const ExperimentOutcome outcome = run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, false, {}});
         print_outcome(trials.size(), o->out, outcome);
         summarize(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(),
