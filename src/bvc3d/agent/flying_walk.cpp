@@ -164,9 +164,20 @@ void FlyingWalk::restore_state(const std::string& text) {
 }
 
 void FlightSpec::check_world(const WorldDescription& world) const {
-    if (!world.flight)
-        throw InputError("world '" + world.name + "' has no flight volume, so a flying agent cannot use it (a ground "
-                         "world: use the random walk's robot, or declare flight_volume in the world's YAML)");
+    if (!world.flight) {
+        const std::string reason = "the world has no flight volume, so a flying agent cannot use it (a ground world: "
+                                   "use the random walk's robot, or declare flight_volume in the world's YAML)";
+        if (world.file.empty()) throw InputError("world '" + world.name + "': " + reason);
+        throw ConfigError(world.file, "flight_volume", reason);
+    }
+    validate();
+    try {
+        const SphereCollider fits(world, flight_.radius);  // throws for a volume that cannot hold the body
+        (void)fits;
+    } catch (const InputError& e) {
+        if (world.file.empty() || dynamic_cast<const ConfigError*>(&e)) throw;
+        throw ConfigError(world.file, "flight_volume", e.what());
+    }
 }
 
 std::unique_ptr<Agent> FlightSpec::make(const World& world, std::uint64_t seed) const {

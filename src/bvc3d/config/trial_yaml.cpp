@@ -122,6 +122,9 @@ TrialConfig trial_from_yaml(const YamlView& v) {
         for (const char* section : {"protocol", "robot", "analysis"})
             if (v.has(section) && v[section].is_map() && v[section].has(e.key())) v[section][e.key()].fail(e.reason());
         v.fail(e.what());
+    } catch (const InputError& e) {  // a model and an agent that do not go together: name the file
+        if (dynamic_cast<const ConfigError*>(&e)) throw;
+        v.fail(e.what());
     }
     return t;
 }
