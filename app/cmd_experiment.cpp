@@ -14,6 +14,7 @@
 #include <memory>
 #include <sstream>
 
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
@@ -262,7 +263,7 @@ void summarize(const std::filesystem::path& out, const std::vector<std::filesyst
 namespace {
 
 struct RunOptions {
-    std::string config, world, lean, model, protocol, extent, out, trajectory;
+    std::string config, world, lean, model, protocol, extent, out, trajectory, agent;
     std::optional<double> tilt, explore_hours, sample_hours, hours;
     std::optional<std::uint64_t> seed;
     bool record_bvc = false, no_memory_check = false;
@@ -276,7 +277,13 @@ TrialConfig run_config(const RunOptions& o) {
     if (o.tilt) t.world.tilt_deg = o.tilt;
     if (!o.lean.empty()) t.world.lean = o.lean;
     if (!o.model.empty()) t.model = config::resolve_model(o.model);
-    if (!o.trajectory.empty()) t.agent = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory));
+    if (!o.agent.empty()) {
+        if (o.agent == "flight") t.set_agent(std::make_shared<FlightSpec>());
+        else if (o.agent == "random_walk") t.set_agent(std::make_shared<RandomWalkSpec>());
+        else throw InputError("--agent must be 'random_walk' or 'flight', got '" + o.agent + "'");
+        if (!o.trajectory.empty()) throw InputError("give --agent or --trajectory, not both");
+    }
+    if (!o.trajectory.empty()) t.set_agent(std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory)));
     if (o.seed) t.seed = *o.seed;
     if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
     const auto hours = [](const char* flag, double h) {
@@ -339,6 +346,8 @@ void add_run(CLI::App& app) {
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
     cmd->add_option("--trajectory", o->trajectory,
                     "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
+    cmd->add_option("--agent", o->agent,
+                    "random_walk (the ground robot, default) or flight (the flying agent; docs/flying.md)");
     cmd->add_option("--seed", o->seed, "Random seed, 0 .. 2^64 - 1 (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
@@ -462,8 +471,8 @@ void add_analyze(CLI::App& app) {
                     "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
     cmd->footer("Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
-                "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2,\n"
-                "decoding templates rate_maps; docs/analysis.md).");
+                "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20 (10 for flying agents'\n"
+                "3-D files), d-th 2, decoding templates rate_maps; docs/analysis.md, docs/flying.md).");
     cmd->callback([o] {
         const bool new_extent = !o->extent.empty();
         const ExtentOption extent = parse_extent(new_extent ? o->extent : "data");
@@ -495,24 +504,43 @@ void add_analyze(CLI::App& app) {
             p.validate();
             params.push_back(p);
         }
+        int dims = 2;  // columns for the metrics of the files' largest dimension
+        for (const auto& d : trials) dims = std::max(dims, d.dims);
+        const auto columns = analysis::metric_names(dims);
         std::printf("%-40s", "trial");
-        for (const auto& n : analysis::metric_names()) std::printf(" %15s", n.c_str());
+        for (const auto& n : columns) std::printf(" %15s", n.c_str());
         std::printf("\n");
         for (std::size_t i = 0; i < trials.size(); ++i) {
             const auto& d = trials[i];
             const Eigen::Map<const analysis::RowMatrixXf> rates(d.rates.data(), static_cast<Eigen::Index>(d.x.size()),
                                                                 static_cast<Eigen::Index>(d.n_place));
-            const auto m = analysis::analyze_trial<float>(d.x, d.y, rates, params[i]);
+            analysis::Points positions(static_cast<Eigen::Index>(d.x.size()), d.dims);
+            for (std::size_t k = 0; k < d.x.size(); ++k) {
+                positions(static_cast<Eigen::Index>(k), 0) = d.x[k];
+                positions(static_cast<Eigen::Index>(k), 1) = d.y[k];
+                if (d.dims == 3) positions(static_cast<Eigen::Index>(k), 2) = d.z[k];
+            }
+            const auto m = analysis::analyze_trial<float>(positions, rates, params[i]);
             std::printf("%-40s", d.name.c_str());
-            for (const auto& [name, v] : analysis::scalar_metrics(m)) std::printf(" %15.6g", v);
+            const auto values = analysis::scalar_metrics(m);
+            for (const auto& c : columns) {
+                const auto it = std::find_if(values.begin(), values.end(), [&](const auto& v) { return v.first == c; });
+                if (it == values.end()) std::printf(" %15s", "-");
+                else std::printf(" %15.6g", it->second);
+            }
             std::printf("\n");
             if (i == 0 && !o->cells.empty()) {
                 AtomicFile f(o->cells);
-                f.stream() << "cell,modality,peak_rate,mean_rate,field_area,spatial_info\n";
-                for (std::size_t c = 0; c < m.modality.size(); ++c)
+                // field_area is m² of hexagons in 2-D, m³ of voxels in 3-D; isotropy only for 3-D files.
+                const bool three = m.dims == 3;
+                f.stream() << "cell,modality,peak_rate,mean_rate,field_area,spatial_info" << (three ? ",isotropy\n" : "\n");
+                for (std::size_t c = 0; c < m.modality.size(); ++c) {
                     f.stream() << c << ',' << m.modality[c] << ',' << num(m.cells.peak_rate[c]) << ','
                                << num(m.cells.mean_rate[c]) << ',' << num(m.cells.field_area[c]) << ','
-                               << num(m.cells.spatial_info[c]) << '\n';
+                               << num(m.cells.spatial_info[c]);
+                    if (three) f.stream() << ',' << num(m.isotropy[c]);
+                    f.stream() << '\n';
+                }
                 f.commit();
             }
         }

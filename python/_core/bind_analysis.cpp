@@ -6,6 +6,7 @@
 #include <string>
 
 #include "bindings.hpp"
+#include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
 #include "bvc3d/core/error.hpp"
 
@@ -51,6 +52,27 @@ pyb::dict decoding_dict(const an::DecodingResult& d) {
     r["n_decoded"] = d.n_decoded;
     r["n_undecoded"] = d.n_undecoded;
     return r;
+}
+
+pyb::dict decoding_dict_3d(const an::DecodingResult& d) {
+    pyb::dict r = decoding_dict(d);
+    r["median_horizontal_m"] = d.median_horizontal_m;
+    r["mean_horizontal_m"] = d.mean_horizontal_m;
+    r["median_vertical_m"] = d.median_vertical_m;
+    r["mean_vertical_m"] = d.mean_vertical_m;
+    r["median_vertical_chance_m"] = d.median_vertical_chance_m;
+    return r;
+}
+
+using MaybeBox = std::optional<std::array<double, 6>>;
+std::optional<an::Box3> box_of(const MaybeBox& b) {
+    if (!b) return std::nullopt;
+    return an::Box3{(*b)[0], (*b)[1], (*b)[2], (*b)[3], (*b)[4], (*b)[5]};
+}
+
+Eigen::Map<const an::Points> positions3(const ArrayD& a) {
+    if (a.ndim() != 2 || a.shape(1) != 3) throw InputError("positions must be an (N, 3) array");
+    return {a.data(), a.shape(0), 3};
 }
 
 pyb::dict summary_dict(const an::ModalitySummary& s) {
@@ -142,8 +164,13 @@ void bind_sample_functions(pyb::module_& a) {
            int min_samples, double d_th, const MaybeExtent& extent, const std::string& decoding_templates) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
-            const an::AnalysisParams params{gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent),
-                                            an::parse_decoding_templates(decoding_templates)};
+            an::AnalysisParams params;
+            params.gridsize = gridsize;
+            params.quantile = quantile;
+            params.dbscan = {eps, min_samples};
+            params.d_th = d_th;
+            params.extent = extent_of(extent);
+            params.decoding_templates = an::parse_decoding_templates(decoding_templates);
             an::TrialMetrics m;
             interruptible([&](const std::atomic<bool>&) {
                 m = an::analyze_trial<T>(xs, ys, r, params);
@@ -167,12 +194,102 @@ void bind_sample_functions(pyb::module_& a) {
         pyb::arg("decoding_templates"));
 }
 
+// 3-D (flying agents): voxel rate maps and the whole analysis of N × 3 positions.
+template <class T>
+void bind_voxel_functions(pyb::module_& a) {
+    auto values_arg = [](const char* name) {
+        auto arg = pyb::arg(name);
+        if constexpr (std::is_same_v<T, float>) arg.noconvert();
+        return arg;
+    };
+    a.def(
+        "voxel_rate_maps",
+        [](const ArrayD& positions, const Array<T>& rates, double voxel, const MaybeBox& volume, double quantile) {
+            const auto p = positions3(positions);
+            const auto r = matrix<T>(rates, "rates");
+            an::RateMaps m;
+            {
+                pyb::gil_scoped_release release;
+                auto grid = std::make_shared<an::VoxelGrid>(an::VoxelGrid::fit(p, voxel, box_of(volume)));
+                m = an::rate_maps<T>(grid, p, r, quantile);
+            }
+            return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean), numpy_of(m.bins.counts));
+        },
+        pyb::arg("positions"), values_arg("rates"), pyb::arg("voxel"), pyb::arg("volume"), pyb::arg("quantile"));
+    a.def(
+        "analyze3d",
+        [](const ArrayD& positions, const Array<T>& rates, double voxel, const MaybeBox& volume, double quantile,
+           double eps, int min_samples, double d_th, const std::string& decoding_templates) {
+            const auto p = positions3(positions);
+            const auto r = matrix<T>(rates, "rates");
+            an::AnalysisParams params = an::AnalysisParams::defaults(3);
+            params.voxel = voxel;
+            params.volume = box_of(volume);
+            params.quantile = quantile;
+            params.dbscan = {eps, min_samples};
+            params.d_th = d_th;
+            params.decoding_templates = an::parse_decoding_templates(decoding_templates);
+            an::TrialMetrics m;
+            {
+                pyb::gil_scoped_release release;
+                m = an::analyze_trial<T>(p, r, params);
+            }
+            pyb::dict d;
+            d["centers"] = numpy_of(m.maps.bins.centers);
+            d["counts"] = numpy_of(m.maps.bins.counts);
+            d["mean_maps"] = numpy_of(m.maps.mean);
+            d["maps"] = numpy_of(m.maps.map);
+            d["voxel_volume_m3"] = m.maps.grid->bin_measure();
+            d["modality"] = numpy_of(m.modality);
+            d["modality_summary"] = summary_dict(m.modality_summary);
+            d["sai"] = to_numpy(m.aliasing.sai.data(), {m.aliasing.sai.size()});
+            d["msai"] = m.aliasing.msai;
+            d["decoding"] = decoding_dict_3d(m.decoding);
+            d["cells"] = stats_dict(m.cells);
+            d["isotropy"] = numpy_of(m.isotropy);
+            pyb::dict scalars;
+            for (const auto& [name, v] : an::scalar_metrics(m)) scalars[name.c_str()] = v;
+            d["metrics"] = scalars;
+            return d;
+        },
+        pyb::arg("positions"), values_arg("rates"), pyb::arg("voxel"), pyb::arg("volume"), pyb::arg("quantile"),
+        pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("decoding_templates"));
+}
+
 }  // namespace
 
 void bind_analysis(pyb::module_& m) {
     auto a = m.def_submodule("analysis", "Analysis stage (use bvc3d.analysis)");
     bind_sample_functions<float>(a);  // first: taken only for float32 input, without conversion
     bind_sample_functions<double>(a);
+    bind_voxel_functions<float>(a);
+    bind_voxel_functions<double>(a);
+
+    a.def(
+        "dbscan_labels",
+        [](const ArrayD& points, double eps, int min_samples) {
+            const auto p = centers_of(points);
+            std::vector<int> labels;
+            {
+                pyb::gil_scoped_release release;
+                labels = an::dbscan_labels(p, {eps, min_samples});
+            }
+            return numpy_of(labels);
+        },
+        pyb::arg("points"), pyb::arg("eps"), pyb::arg("min_samples"));
+    a.def(
+        "isotropy",
+        [](const ArrayD& centers, const ArrayD& maps, const std::vector<int>& modality, double eps, int min_samples) {
+            const auto c = centers_of(centers);
+            const auto mp = matrix<double>(maps, "maps");
+            std::vector<double> iso;
+            {
+                pyb::gil_scoped_release release;
+                iso = an::field_isotropy(c, mp, modality, {eps, min_samples});
+            }
+            return numpy_of(iso);
+        },
+        pyb::arg("centers"), pyb::arg("maps"), pyb::arg("modality"), pyb::arg("eps"), pyb::arg("min_samples"));
 
     a.def(
         "dbscan_cluster_count",

@@ -1,6 +1,7 @@
 // Whole trials: run_trial, through the same pipeline as `bvc3d run`.
 #include "bindings.hpp"
 
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
@@ -36,10 +37,29 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     t.model = config::resolve_model(model);
     t.world = WorldSpec{world, tilt_deg, t.world.lean};
     t.seed = seed_of(seed, "seed");
-    if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) t.agent = trajectory_of(kwargs["trajectory"]);
-    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol"});
+    const bool flying = kwargs.contains("agent") && pyb::str(kwargs["agent"]).cast<std::string>() == "flight";
+    if (kwargs.contains("agent")) {
+        const std::string agent = pyb::str(kwargs["agent"]);
+        if (agent != "flight" && agent != "random_walk")
+            throw InputError("agent must be 'random_walk' or 'flight', got '" + agent + "'");
+    }
+    if (kwargs.contains("flight") && !flying) throw InputError("flight= (the flying agent's parameters) needs agent='flight'");
+    if (flying) {
+        FlightParams flight;
+        if (kwargs.contains("flight") && !kwargs["flight"].is_none())
+            apply_kwargs(flight, FlightParams::table(), kwargs["flight"].cast<pyb::kwargs>());
+        t.set_agent(std::make_shared<FlightSpec>(flight));
+        // The flying agents' protocol (docs/flying.md): 8 h + 8 h unless the keywords say otherwise.
+        t.protocol.explore_hours = t.protocol.sample_hours = 8.0;
+    }
+    if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) {
+        if (flying) throw InputError("give agent='flight' or trajectory=, not both");
+        t.set_agent(trajectory_of(kwargs["trajectory"]));
+    }
+    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol", "agent", "flight"});
     if (kwargs.contains("protocol")) t.protocol.kind = parse_protocol(pyb::str(kwargs["protocol"]));  // = kind
     t.validate();
+    t.agent->check_world(t.world.resolve());
     return t;
 }
 
@@ -84,7 +104,9 @@ void bind_experiment(pyb::module_& m) {
 (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded, and
 metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset or world YAML;
 tilt_deg: for world="cross"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
-follow instead of the random walk. Protocol keywords and their defaults:
+follow instead of the random walk; agent="flight" for the flying agent (docs/flying.md: a fly-*
+model, a world with a flight volume, 8 h + 8 h unless given, 3-D metrics), with flight=dict(...)
+for its parameters (see flying_walk). Protocol keywords and their defaults:
 )doc" + describe(Protocol::table(), Protocol{}))
             .c_str());
     pyb::list metrics;
@@ -95,6 +117,7 @@ follow instead of the random walk. Protocol keywords and their defaults:
         d["label"] = mt.label;
         d["title"] = mt.title;
         d["digits"] = mt.digits;
+        d["dims"] = mt.dims;  // 0: every trial; 3: flying agents' (3-D) trials only
         metrics.append(d);
     }
     m.attr("metric_table") = metrics;

@@ -1,6 +1,7 @@
 // World, Sensor, agents (random walk, trajectories).
 #include "bindings.hpp"
 
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
@@ -83,7 +84,7 @@ void bind_world(pyb::module_& m) {
             pyb::arg("path"))
         .def_static(
             "preset", [](const std::string& name) { return World(config::resolve_world(name)); },
-            pyb::arg("name"), "A preset name (cross, cross-30, ...) or a world YAML file")
+            pyb::arg("name"), "A preset name (cross, cross-30, ..., flight-room, atrium) or a world YAML file")
         .def_property_readonly("name", &World::name)
         .def_property_readonly("triangles",
                                [](const World& w) {
@@ -106,7 +107,21 @@ void bind_world(pyb::module_& m) {
                                    for (const auto& q : p) flat.insert(flat.end(), {q.x(), q.y()});
                                    return to_numpy(flat.data(), {static_cast<pyb::ssize_t>(p.size()), 2});
                                },
-                               "(K, 2) polygon the robot's body stays inside")
+                               "(K, 2) polygon the robot's body stays inside (empty in a flight-only world)")
+        .def_property_readonly(
+            "flight_volume",
+            [](const World& w) -> pyb::object {
+                const auto& f = w.description().flight;
+                if (!f) return pyb::none();
+                std::vector<double> flat;
+                for (const auto& q : f->region.points) flat.insert(flat.end(), {q.x(), q.y()});
+                pyb::dict d;
+                d["region"] = to_numpy(flat.data(), {static_cast<pyb::ssize_t>(f->region.points.size()), 2});
+                d["z_min"] = f->z_min;
+                d["z_max"] = f->z_max;
+                return d;
+            },
+            "The flight volume as a dict (region (K, 2) polygon, z_min, z_max), or None for a ground-only world")
         .def(
             "scan",
             [](const World& w, const pyb::object& sensor, double x, double y, double heading, const pyb::object& noise_seed,
@@ -142,6 +157,25 @@ void bind_simulator(pyb::module_& m) {
         },
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
         "The paper's random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step");
+    m.def(
+        "flying_walk",
+        [](const World& w, double hours, std::uint64_t seed, const pyb::kwargs& kwargs) {
+            FlightParams params;
+            apply_kwargs(params, FlightParams::table(), kwargs);
+            std::vector<ModelStep> steps;
+            {
+                pyb::gil_scoped_release release;
+                steps = flying_walk(w, hours, seed, params);
+            }
+            return steps_to_dict(steps);
+        },
+        pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
+        (R"doc(The flying agent's 3-D random walk (docs/flying.md): dict of arrays t, x, y, z (the body's center),
+heading (the yaw of flight), bumped, one entry per model step. The world needs a flight volume
+(flight-room, atrium, the cross arenas, or flight_volume in a world YAML). Flight keywords and
+their defaults:
+)doc" + describe(FlightParams::table(), FlightParams{}))
+            .c_str());
     m.def(
         "read_trajectory", [](const std::filesystem::path& path) { return steps_to_dict(read_trajectory_file(path)); },
         pyb::arg("path"),

@@ -1,5 +1,7 @@
 """Analysis of recorded samples (docs/analysis.md): rate maps, modality index, spatial aliasing,
 localization error and per-cell statistics. numpy in, numpy out; the work is done in C++.
+3-D positions (flying agents, docs/flying.md#analysis): ``voxel_rate_maps``, ``dbscan_labels``,
+``isotropy`` and ``analyze3d``, on the same code paths.
 
 Conventions (docs/analysis.md has the details):
 
@@ -30,6 +32,10 @@ __all__ = [
     "decoding_error",
     "cell_stats",
     "analyze",
+    "voxel_rate_maps",
+    "dbscan_labels",
+    "isotropy",
+    "analyze3d",
 ]
 
 
@@ -277,4 +283,94 @@ def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_t
     out["decoding"] = dict(out["decoding"])
     out["modality_summary"] = dict(out["modality_summary"])
     out["cells"] = dict(out["cells"])
+    return out
+
+
+def _positions3(positions):
+    p = np.ascontiguousarray(positions, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"positions must be an (n, 3) array of x, y, z, got shape {p.shape}")
+    return p
+
+
+def _voxel(voxel):
+    voxel = float(voxel)
+    if not voxel > 0 or not np.isfinite(voxel):
+        raise ValueError(f"voxel must be a positive length, got {voxel}")
+    return voxel
+
+
+def _volume(volume):
+    if volume is None:
+        return None
+    v = np.asarray(volume, dtype=np.float64).ravel()
+    if v.shape != (6,):
+        raise ValueError(f"volume must be (xmin, xmax, ymin, ymax, zmin, zmax), got {volume!r}")
+    return tuple(float(x) for x in v)
+
+
+def voxel_rate_maps(positions, rates, voxel=0.5, volume=None, quantile=0.1):
+    """3-D rate maps on cubic voxels (docs/flying.md#analysis), as ``rate_maps`` on hexagons.
+
+    Voxels of side ``voxel`` from the lower corner of ``volume`` (xmin, xmax, ymin, ymax, zmin, zmax;
+    positions outside it fall in no voxel), or without a volume from the positions' own minimum.
+    Voxel (i, j, k) spans [x0 + i*voxel, x0 + (i+1)*voxel) (and likewise in y, z); only visited voxels
+    exist, in the order of their flat index (i*ny + j)*nz + k. Per cell: the mean rate per voxel,
+    values below the cell's ``quantile`` set to 0, divided by its maximum.
+
+    Returns ``(centers (B, 3), maps (B, n_cells), counts (B,))`` (``maps`` is (B,) for 1-D rates).
+    """
+    p = _positions3(positions)
+    r, was_1d = _samples(rates, len(p), "rates")
+    centers, maps, _, counts = _an.voxel_rate_maps(p, r, _voxel(voxel), _volume(volume), _quantile(quantile))
+    return centers, (maps[:, 0] if was_1d else maps), counts
+
+
+def dbscan_labels(points, eps=1.0, min_samples=10):
+    """``sklearn.cluster.DBSCAN(eps, min_samples).fit(points).labels_``, identical for (N, 2) or (N, 3)
+    points: per point its cluster (numbered as scikit-learn numbers them) or -1 for noise."""
+    p = np.ascontiguousarray(points, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise ValueError(f"points must be an (N, 2) or (N, 3) array, got shape {p.shape}")
+    eps, min_samples = _dbscan_params(eps, min_samples)
+    return np.asarray(_an.dbscan_labels(p, eps, min_samples), dtype=np.int64)
+
+
+def isotropy(centers, maps, modality, eps=1.0, min_samples=10):
+    """Field isotropy per cell (docs/flying.md#analysis): for a cell with ``modality`` 1, its field is
+    the one DBSCAN cluster among the voxels where its map is > 0 (noise left out), each voxel weighted
+    by its map value; isotropy = the weighted sd of the field's z over the mean of its weighted sds
+    of x and y (population sds). 1 is round, > 1 a vertical column, < 1 a flat disc. NaN for cells
+    with another modality; +inf for a field with vertical spread only. Returns (n_cells,) floats."""
+    c = np.ascontiguousarray(centers, dtype=np.float64)
+    if c.ndim != 2 or c.shape[1] != 3:
+        raise ValueError(f"centers must be an (N, 3) array, got shape {c.shape}")
+    c, m, _ = _centers_maps(c, maps)
+    mi = np.asarray(modality).ravel()
+    if mi.shape != (m.shape[1],):
+        raise ValueError(f"modality must have one entry per cell ({m.shape[1]}), got shape {np.shape(modality)}")
+    eps, min_samples = _dbscan_params(eps, min_samples)
+    return np.asarray(_an.isotropy(c, m, [int(v) for v in mi], eps, min_samples))
+
+
+def analyze3d(positions, rates, voxel=0.5, volume=None, quantile=0.1, eps=1.0, min_samples=10, d_th=2.0,
+              decoding_templates="rate_maps"):
+    """Every metric of one trial of 3-D positions (a flying agent), on the code paths of ``analyze``:
+    voxel rate maps, modality (DBSCAN in 3-D, default min_samples 10), SAI/MSAI over voxel centers,
+    decoding with its horizontal and vertical parts, cell statistics, isotropy.
+
+    Returns a dict: ``centers``, ``counts``, ``mean_maps``, ``maps``, ``voxel_volume_m3``,
+    ``modality``, ``modality_summary``, ``sai``, ``msai``, ``decoding`` (as ``analyze``'s, plus
+    ``median_horizontal_m``, ``mean_horizontal_m``, ``median_vertical_m``, ``mean_vertical_m`` and
+    ``median_vertical_chance_m``, the vertical error of a decoder that guesses a first-half voxel at
+    random weighted by its samples), ``cells``, ``isotropy`` (n_cells,) and ``metrics`` (the scalar
+    metrics as trial files record them).
+    """
+    p = _positions3(positions)
+    r, _ = _samples(rates, len(p), "rates")
+    eps, min_samples = _dbscan_params(eps, min_samples)
+    out = dict(_an.analyze3d(p, r, _voxel(voxel), _volume(volume), _quantile(quantile), eps, min_samples, _d_th(d_th),
+                             _templates(decoding_templates, "decoding_templates")))
+    for key in ("decoding", "modality_summary", "cells", "metrics"):
+        out[key] = dict(out[key])
     return out

@@ -550,6 +550,15 @@ def make_report(path):
         figures = make_sweep_report(folder, figdir)
         write_report(folder, figures)
         return figures
+    from . import flight_report
+    try:
+        flying = flight_report.is_flight_folder(folder)
+    except ValueError as e:
+        raise SystemExit(f"bvc3d.report: {e}")
+    if flying:  # flying agents' trials (`bvc3d flight`): 3-D figures
+        figures = flight_report.make_flight_report(folder, figdir)
+        write_report(folder, figures)
+        return figures
     figures = []
 
     def add(name, sentence, draw):

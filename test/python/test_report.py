@@ -17,7 +17,8 @@ from matplotlib.text import Annotation
 import bvc3d
 from bvc3d import report
 
-METRICS = [m for m in bvc3d.metric_table if m["title"]]  # the metrics with figures
+# The metrics with figures in a ground experiment's report (the 3-D ones: test_flying.py).
+METRICS = [m for m in bvc3d.metric_table if m["title"] and m["dims"] == 0]
 
 
 def make_folder(path, modality_by_model):
@@ -132,7 +133,7 @@ def metric_values(model, tilt, seed, n_seeds):
 def make_experiment(path, models=("A", "B", "C"), tilts=(0, 30, 45, 60), seeds=(0, 1, 2), sample_hours=lambda t, s: 4.0):
     """An experiment folder as `bvc3d paper` writes it: trial files with the attributes and /metrics the
     report reads, trials.csv, summary.csv (mean and sd with numpy) and summary.md."""
-    names = [m["name"] for m in bvc3d.metric_table]
+    names = [m["name"] for m in bvc3d.metric_table if m["dims"] == 0]
     trials, rng = [], np.random.default_rng(0)
     centers = np.column_stack([np.linspace(-4, 4, 30), np.linspace(-3, 3, 30)])
     for seed in seeds:

@@ -85,7 +85,10 @@ def test_one_metric_table_names_what_files_summaries_and_figures_show(tmp_path):
     names = [m["name"] for m in bvc3d.metric_table]
     assert names[:4] == ["frac_active", "mean_mi_active", "frac_multimodal", "msai"]
     r = bvc3d.run_trial(model="2d", explore_hours=0.02, sample_hours=0.02)
-    assert list(r["metrics"]) == names
+    assert list(r["metrics"]) == [m["name"] for m in bvc3d.metric_table if m["dims"] in (0, 2)]
+    # A flying agent's trial reports every metric, the 3-D ones (dims 3) too.
+    r = bvc3d.run_trial(model="fly-up", world="flight-room", agent="flight", explore_hours=0.02, sample_hours=0.02)
+    assert list(r["metrics"]) == [m["name"] for m in bvc3d.metric_table if m["dims"] in (0, 3)]
     from bvc3d import report
     assert set(report.METRICS) == {m["name"] for m in bvc3d.metric_table if m["title"]}
 

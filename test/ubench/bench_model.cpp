@@ -4,6 +4,7 @@
 
 #include "../support/bvc_reference.hpp"
 #include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 
 using namespace bvc3d;
@@ -107,8 +108,28 @@ void BM_DenseReferenceStep(benchmark::State& state, std::string preset) {
     }
 }
 
+// A flying agent's model step in the flight room: the full spherical scan (all 8 100 rays, every row
+// cast whatever the model needs), the BVC layer and 250 place cells learning (docs/flying.md#speed).
+void BM_FlyingFullScanStep(benchmark::State& state, std::string preset) {
+    const ModelSpec model = model_preset(preset);
+    const World world(flight_room());
+    const Lidar lidar(model.sensor);
+    const BoundaryVectorLayer layer(model.bvc);
+    PlaceCellNetwork net(model.bvc.n_cells(), model.place, 1);
+    const auto walk = flying_walk(world, 0.1, 1);
+    std::vector<double> rates(layer.n_cells());
+    Scan scan;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        lidar.scan(world, walk[i++ % walk.size()].pose, scan);
+        layer.rates(scan, rates);
+        benchmark::DoNotOptimize(net.step(rates, true).data());
+    }
+}
+
 }  // namespace
 
+BENCHMARK_CAPTURE(BM_FlyingFullScanStep, fly_5l, std::string("fly-5l"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 2d, std::string("2d"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_1, std::string("3d-0.1"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_2, std::string("3d-0.2"))->Unit(benchmark::kMicrosecond);

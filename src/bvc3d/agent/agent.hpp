@@ -2,8 +2,8 @@
 // Agent stage: where the agent goes.
 // Takes: a World (for collision) and a seed, or a given path. Gives: the model steps — when and at
 // which pose the model is updated — one at a time, and its state as text for checkpoints.
-// Kinds of agent: the ground robot's random walk (random_walk.hpp) and a given trajectory
-// (trajectory.hpp). The trial runner, checkpoints and walk sharing see only this interface.
+// Kinds of agent: the ground robot's random walk (random_walk.hpp), a given trajectory
+// (trajectory.hpp) and the flying agent (flying_walk.hpp). The trial runner, checkpoints and walk sharing see only this interface.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -45,10 +45,11 @@ public:
 class AgentSpec {
 public:
     virtual ~AgentSpec() = default;
-    virtual std::string kind() const = 0;  // "random_walk", "trajectory"
+    virtual std::string kind() const = 0;  // "random_walk", "trajectory", "flight"
     virtual void validate() const = 0;     // InputError naming the bad parameter
     // Whether the agent can run in this world (a random walk: every start point has room for the
-    // robot; a trajectory: every row lies inside the world): InputError naming the world's key
+    // robot, and the world has a floor to walk on; a trajectory: every row lies inside the world; a
+    // flying agent: the world has a flight volume that holds its body): InputError naming the world's key
     // (`start.points[1]`) or the agent's (`robot.radius`), whichever is at fault. make() checks it too.
     virtual void check_world(const WorldDescription& world) const = 0;
     virtual std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const = 0;
@@ -59,6 +60,9 @@ public:
     // The trial YAML keys that give this agent back (`robot:` and its keys, `trajectory: FILE`), with
     // their descriptions (`bvc3d config`); InputError if there are none (a path given as arrays).
     virtual void write_yaml(params::CommentedYaml& out) const = 0;
+    // Coordinates of the positions the analysis bins: 2 (x, y) for agents on the floor, 3 (x, y, z)
+    // for flying ones.
+    virtual int dims() const { return 2; }
 };
 
 }  // namespace bvc3d

@@ -228,12 +228,16 @@ void RandomWalk::restore_state(const std::string& text) {
 }
 
 void RandomWalkSpec::check_world(const WorldDescription& world) const {
+    if (world.walkable.points.empty() && world.flight)
+        throw InputError("world '" + world.name + "' is a flight-only world (no walkable region): the random walk's "
+                         "robot cannot use it; use the flying agent (trial key flight:, --agent flight)");
     validate();
     RandomWalk::check_start(world, BodyCollider(world, robot_.radius, robot_.height));
 }
 
 std::unique_ptr<Agent> RandomWalkSpec::make(const World& world, std::uint64_t seed) const {
     validate();
+    if (world.description().walkable.points.empty() && world.description().flight) check_world(world.description());
     auto body = std::make_shared<const BodyCollider>(world.description(), robot_.radius, robot_.height);
     RandomWalk::check_start(world.description(), *body);
     Rng rng(seed, Stream::walk);

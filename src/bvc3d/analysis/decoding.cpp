@@ -93,6 +93,39 @@ double sparse_cost(const RowMatrixXd& unit, const Eigen::Ref<const RowMatrixX<T>
     return cost * 8;
 }
 
+// Smallest e with at least half the total weight at errors <= e.
+double weighted_median(std::vector<std::pair<double, double>> v) {
+    std::sort(v.begin(), v.end());
+    double total = 0;
+    for (const auto& [e, w] : v) total += w;
+    double sum = 0;
+    for (const auto& [e, w] : v)
+        if ((sum += w) >= 0.5 * total) return e;
+    return v.empty() ? NAN : v.back().first;
+}
+
+double mean_of(const std::vector<double>& v) {
+    double sum = 0;
+    for (const double e : v) sum += e;
+    return sum / static_cast<double>(v.size());
+}
+
+// The vertical error of chance (decoding.hpp): bins grouped by their height first.
+double vertical_chance(const Bins& first, const Eigen::Ref<const Points>& positions, std::size_t half) {
+    std::vector<std::pair<double, double>> layers;  // (z of bin centers, samples)
+    for (int b = 0; b < first.size(); ++b) {
+        const double z = first.centers(b, 2);
+        auto it = std::find_if(layers.begin(), layers.end(), [&](const auto& l) { return l.first == z; });
+        if (it == layers.end()) layers.emplace_back(z, 0.0), it = layers.end() - 1;
+        it->second += static_cast<double>(first.counts[static_cast<std::size_t>(b)]);
+    }
+    std::vector<std::pair<double, double>> pairs;
+    pairs.reserve((static_cast<std::size_t>(positions.rows()) - half) * layers.size());
+    for (Eigen::Index s = static_cast<Eigen::Index>(half); s < positions.rows(); ++s)
+        for (const auto& [z, w] : layers) pairs.emplace_back(std::abs(positions(s, 2) - z), w);
+    return weighted_median(std::move(pairs));
+}
+
 }  // namespace
 
 std::string decoding_templates_name(DecodingTemplates t) { return t == DecodingTemplates::means ? "means" : "rate_maps"; }
@@ -127,7 +160,8 @@ DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& 
         sparse_cost<T>(unit, second) <= dense_cost ? decode_sparse<T>(unit, second) : decode_dense<T>(unit, second);
 
     DecodingResult out;
-    std::vector<double> errors;
+    const bool split = positions.cols() == 3;  // horizontal and vertical parts of 3-D errors
+    std::vector<double> errors, horizontal, vertical;
     errors.reserve(best.size());
     for (std::size_t i = 0; i < best.size(); ++i) {
         if (best[i] < 0) {
@@ -141,6 +175,18 @@ DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& 
             d2 += diff * diff;
         }
         errors.push_back(std::sqrt(d2));
+        if (split) {
+            const double dx = positions(s, 0) - first.centers(best[i], 0), dy = positions(s, 1) - first.centers(best[i], 1);
+            horizontal.push_back(std::sqrt(dx * dx + dy * dy));
+            vertical.push_back(std::abs(positions(s, 2) - first.centers(best[i], 2)));
+        }
+    }
+    if (split && first.size() > 0) out.median_vertical_chance_m = vertical_chance(first, positions, half);
+    if (!horizontal.empty()) {
+        out.mean_horizontal_m = mean_of(horizontal);
+        out.median_horizontal_m = median(std::move(horizontal));
+        out.mean_vertical_m = mean_of(vertical);
+        out.median_vertical_m = median(std::move(vertical));
     }
     out.n_decoded = errors.size();
     if (!errors.empty()) {

@@ -36,6 +36,15 @@ struct DecodingResult {
     double mean_m = std::numeric_limits<double>::quiet_NaN();
     std::size_t n_decoded = 0;    // second-half samples that were decoded
     std::size_t n_undecoded = 0;  // second-half samples with no positive similarity to any template
+    // 3-D positions only (NaN otherwise): the error's horizontal (x, y) and vertical (z) parts, and
+    // the median vertical error of chance: a decoder that ignores the rates and picks a first-half
+    // bin at random, each with the weight of its first-half samples (the weighted median over every
+    // second-half sample and bin; docs/flying.md#analysis).
+    double median_horizontal_m = std::numeric_limits<double>::quiet_NaN();
+    double mean_horizontal_m = std::numeric_limits<double>::quiet_NaN();
+    double median_vertical_m = std::numeric_limits<double>::quiet_NaN();
+    double mean_vertical_m = std::numeric_limits<double>::quiet_NaN();
+    double median_vertical_chance_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Choices (docs/analysis.md):

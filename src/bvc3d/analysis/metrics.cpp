@@ -1,6 +1,29 @@
 #include "bvc3d/analysis/metrics.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace bvc3d::analysis {
+
+namespace {
+
+// Median of the values that are not NaN (numpy.median of them; +inf counts), NaN if none.
+double median_not_nan(const std::vector<double>& values) {
+    std::vector<double> v;
+    for (const double x : values)
+        if (!std::isnan(x)) v.push_back(x);
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    const std::size_t k = v.size() / 2;
+    return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
+}
+
+double fraction_unimodal(const TrialMetrics& m) {
+    if (m.modality.empty()) return NAN;
+    return static_cast<double>(std::count(m.modality.begin(), m.modality.end(), 1)) / static_cast<double>(m.modality.size());
+}
+
+}  // namespace
 
 const std::vector<Metric>& metric_table() {
     static const std::vector<Metric> table{
@@ -21,19 +44,34 @@ const std::vector<Metric>& metric_table() {
          [](const TrialMetrics& m) { return static_cast<double>(m.decoding.n_decoded); }},
         {"n_undecoded", "undecoded samples", "undecoded samples", "", -1,
          [](const TrialMetrics& m) { return static_cast<double>(m.decoding.n_undecoded); }},
+        // Flying agents (docs/flying.md#analysis).
+        {"frac_unimodal", "MI=1 fraction", "fraction of cells with one field (MI = 1)",
+         "Fraction of place cells with a single 3-D field (MI = 1)", 3, fraction_unimodal, 3},
+        {"isotropy_median", "isotropy (median)", "field isotropy: sd z / mean sd x, y",
+         "Isotropy of single 3-D fields (median over MI = 1 cells; bats: about 1)", 2,
+         [](const TrialMetrics& m) { return median_not_nan(m.isotropy); }, 3},
+        {"decode_horizontal_median_m", "decoding horizontal (m)", "median horizontal decoding error (m)",
+         "Horizontal localization error (median)", 2, [](const TrialMetrics& m) { return m.decoding.median_horizontal_m; },
+         3},
+        {"decode_vertical_median_m", "decoding vertical (m)", "median vertical decoding error (m)",
+         "Vertical localization error (median)", 2, [](const TrialMetrics& m) { return m.decoding.median_vertical_m; }, 3},
+        {"decode_vertical_chance_m", "vertical chance (m)", "median vertical error of a random guess (m)", "", 2,
+         [](const TrialMetrics& m) { return m.decoding.median_vertical_chance_m; }, 3},
     };
     return table;
 }
 
-std::vector<std::string> metric_names() {
+std::vector<std::string> metric_names(int dims) {
     std::vector<std::string> names;
-    for (const auto& m : metric_table()) names.emplace_back(m.name);
+    for (const auto& m : metric_table())
+        if (dims == 0 || m.applies(dims)) names.emplace_back(m.name);
     return names;
 }
 
 std::vector<std::pair<std::string, double>> scalar_metrics(const TrialMetrics& m) {
     std::vector<std::pair<std::string, double>> out;
-    for (const auto& metric : metric_table()) out.emplace_back(metric.name, metric.value(m));
+    for (const auto& metric : metric_table())
+        if (metric.applies(m.dims)) out.emplace_back(metric.name, metric.value(m));
     return out;
 }
 

@@ -17,10 +17,13 @@ struct Metric {
     const char* title;    // figure title; "" for metrics without a figure of their own
     int digits;           // decimals in summary.md; -1 for metrics summary.md leaves out
     double (*value)(const TrialMetrics&);
+    int dims = 0;         // 0: every trial; 3: trials of 3-D positions only (flying agents)
+    bool applies(int trial_dims) const { return dims == 0 || dims == trial_dims; }
 };
 
 const std::vector<Metric>& metric_table();
-std::vector<std::string> metric_names();
+// The metrics a trial of `dims`-coordinate positions reports (every metric: dims 0).
+std::vector<std::string> metric_names(int dims = 0);
 std::vector<std::pair<std::string, double>> scalar_metrics(const TrialMetrics& m);
 
 }  // namespace bvc3d::analysis

@@ -173,34 +173,41 @@ Neighborhoods neighbors(const PointSet& pts, double eps) {
     return nb;
 }
 
-int cluster_count(const PointSet& pts, const DbscanParams& params) {
-    // A core point needs min_samples neighbors (itself included): none with fewer points.
-    if (pts.size() < static_cast<std::size_t>(params.min_samples) || pts.size() == 0) return 0;
-    const Neighborhoods nb = neighbors(pts, params.eps);
+// DBSCAN labels as scikit-learn's labels_: -1 for noise, clusters numbered in order of discovery.
+std::vector<int> cluster_labels(const PointSet& pts, const DbscanParams& params) {
     const std::size_t n = pts.size();
+    std::vector<int> label(n, -1);
+    // A core point needs min_samples neighbors (itself included): none with fewer points.
+    if (n < static_cast<std::size_t>(params.min_samples) || n == 0) return label;
+    const Neighborhoods nb = neighbors(pts, params.eps);
     std::vector<char> core(n);
     for (std::size_t i = 0; i < n; ++i) core[i] = nb.offsets[i + 1] - nb.offsets[i] >= params.min_samples;
     // sklearn's dbscan_inner. Its neighborhoods need not be symmetric (see the KD-tree), so the
-    // count follows the same expansion: a new cluster at each unlabeled core point in index order,
+    // clusters follow the same expansion: a new cluster at each unlabeled core point in index order,
     // grown through the neighborhoods of core points only.
-    std::vector<char> labeled(n, 0);
     std::vector<int> stack;
     int clusters = 0;
     for (std::size_t start = 0; start < n; ++start) {
-        if (labeled[start] || !core[start]) continue;
+        if (label[start] != -1 || !core[start]) continue;
         stack.push_back(static_cast<int>(start));
         while (!stack.empty()) {
             const auto i = static_cast<std::size_t>(stack.back());
             stack.pop_back();
-            if (labeled[i]) continue;
-            labeled[i] = 1;
+            if (label[i] != -1) continue;
+            label[i] = clusters;
             if (!core[i]) continue;
             for (int k = nb.offsets[i]; k < nb.offsets[i + 1]; ++k)
-                if (!labeled[static_cast<std::size_t>(nb.indices[static_cast<std::size_t>(k)])])
+                if (label[static_cast<std::size_t>(nb.indices[static_cast<std::size_t>(k)])] == -1)
                     stack.push_back(nb.indices[static_cast<std::size_t>(k)]);
         }
         ++clusters;
     }
+    return label;
+}
+
+int cluster_count(const PointSet& pts, const DbscanParams& params) {
+    int clusters = 0;
+    for (const int l : cluster_labels(pts, params)) clusters = std::max(clusters, l + 1);
     return clusters;
 }
 
@@ -232,6 +239,12 @@ Neighborhoods sklearn_radius_neighbors(const Eigen::Ref<const Centers>& points, 
     DbscanParams{eps, 1}.validate();
     check_points(points);
     return neighbors(to_points(points), eps);
+}
+
+std::vector<int> dbscan_labels(const Eigen::Ref<const Centers>& points, const DbscanParams& params) {
+    params.validate();
+    check_points(points);
+    return cluster_labels(to_points(points), params);
 }
 
 int dbscan_cluster_count(const Eigen::Ref<const Centers>& points, const DbscanParams& params) {

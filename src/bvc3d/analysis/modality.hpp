@@ -37,6 +37,10 @@ Neighborhoods sklearn_radius_neighbors(const Eigen::Ref<const Centers>& points, 
 // expansion order over its neighborhoods. 0 for no points (where scikit-learn would refuse).
 int dbscan_cluster_count(const Eigen::Ref<const Centers>& points, const DbscanParams& params = {});
 
+// The labels of DBSCAN(eps, min_samples).fit(points).labels_: per point its cluster (0, 1, ... in
+// scikit-learn's numbering) or -1 for noise.
+std::vector<int> dbscan_labels(const Eigen::Ref<const Centers>& points, const DbscanParams& params = {});
+
 // Cluster count per cell (column of `maps`) over the centers of its bins with value > 0.
 std::vector<int> modality(const Eigen::Ref<const Centers>& centers, const Eigen::Ref<const RowMatrixXd>& maps,
                           const DbscanParams& params = {});

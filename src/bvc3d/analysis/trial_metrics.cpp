@@ -28,15 +28,24 @@ const params::Table<AnalysisParams>& AnalysisParams::table() {
     return t;
 }
 
+AnalysisParams AnalysisParams::defaults(int dims) {
+    AnalysisParams p;
+    if (dims == 3) p.dbscan.min_samples = 10;
+    return p;
+}
+
 void AnalysisParams::validate() const {
     table().check(*this);
     if (extent) extent->validate();
+    if (!(voxel > 0) || !std::isfinite(voxel)) throw InputError("analysis: voxel must be a positive length");
+    if (volume) volume->validate();
 }
 
 std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, const AnalysisParams& params) {
+    if (positions.cols() == 3) return std::make_shared<VoxelGrid>(VoxelGrid::fit(positions, params.voxel, params.volume));
     if (positions.cols() != 2)
         throw InputError("positions with " + std::to_string(positions.cols()) +
-                         " coordinates: only 2-D (hexagonal) binning is available");
+                         " coordinates: binning needs 2 (hexagons) or 3 (voxels)");
     const Eigen::VectorXd x = positions.col(0), y = positions.col(1);
     return std::make_shared<HexGrid>(HexGrid::fit({x.data(), static_cast<std::size_t>(x.size())},
                                                   {y.data(), static_cast<std::size_t>(y.size())}, params.gridsize,
@@ -48,6 +57,7 @@ TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eige
                            const AnalysisParams& params) {
     params.validate();
     TrialMetrics m;
+    m.dims = static_cast<int>(positions.cols());
     m.maps = rate_maps<T>(fit_grid(positions, params), positions, rates, params.quantile);
     m.modality = modality(m.maps.bins.centers, m.maps.map, params.dbscan);
     m.modality_summary = summarize_modality(m.modality);
@@ -60,6 +70,7 @@ TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eige
         m.decoding.n_undecoded = n - n / 2;
     }
     m.cells = cell_stats(m.maps);
+    if (m.dims == 3) m.isotropy = field_isotropy(m.maps.bins.centers, m.maps.map, m.modality, params.dbscan);
     return m;
 }
 

@@ -1,9 +1,10 @@
 #pragma once
 // Everything the analysis reports for one trial (docs/analysis.md), from its recorded arrays: the
 // entry point for the experiment stage and `bvc3d analyze`.
-// Takes: positions (N × D: x, y for ground agents) and place-cell rates (samples × cells, float32
-// as recorded). Gives: rate maps, modality per cell and its summary, SAI per bin and MSAI,
-// localization error, per-cell statistics; metrics.hpp names the scalar metrics.
+// Takes: positions (N × D: x, y for ground agents, x, y, z for flying ones) and place-cell rates
+// (samples × cells, float32 as recorded). Gives: rate maps, modality per cell and its summary, SAI per
+// bin and MSAI, localization error, per-cell statistics (and for 3-D, field isotropy);
+// metrics.hpp names the scalar metrics.
 #include <memory>
 #include <optional>
 #include <span>
@@ -12,8 +13,10 @@
 #include "bvc3d/analysis/aliasing.hpp"
 #include "bvc3d/analysis/cell_stats.hpp"
 #include "bvc3d/analysis/decoding.hpp"
+#include "bvc3d/analysis/isotropy.hpp"
 #include "bvc3d/analysis/modality.hpp"
 #include "bvc3d/analysis/rate_maps.hpp"
+#include "bvc3d/analysis/voxels.hpp"
 #include "bvc3d/core/params.hpp"
 
 namespace bvc3d::analysis {
@@ -25,24 +28,35 @@ struct AnalysisParams {
     double d_th = 2.0;             // m, SAI exclusion radius
     std::optional<Extent> extent;  // default: the trial's own trajectory; the arena's for a fixed grid
     DecodingTemplates decoding_templates = DecodingTemplates::rate_maps;  // the paper's: the rate maps
+    // 3-D positions (docs/flying.md#analysis): cubic voxels of this side, over `volume` (a trial's
+    // flight volume) or else over the positions' own bounds. Not keys of the table: 2-D trials'
+    // configurations stay as they were.
+    double voxel = 0.5;            // m
+    std::optional<Box3> volume;
 
     // The keys (extent aside, which is a rectangle): gridsize, quantile, eps, min_samples, d_th,
     // decoding_templates.
     static const params::Table<AnalysisParams>& table();
+    // The defaults for positions of `dims` coordinates: DBSCAN's min_samples is 20 in 2-D (the
+    // paper's) and 10 in 3-D (0.5 m voxels have 33 lattice neighbors within 1 m, the paper's
+    // hexagons about 90; docs/flying.md#analysis).
+    static AnalysisParams defaults(int dims);
     void validate() const;
 };
 
 struct TrialMetrics {
+    int dims = 2;  // coordinates of the positions
     RateMaps maps;
     std::vector<int> modality;  // per cell
     ModalitySummary modality_summary;
     AliasingResult aliasing;
     DecodingResult decoding;    // on the same grid as the maps, with the same quantile
     CellStats cells;
+    std::vector<double> isotropy;  // per cell, 3-D positions only (isotropy.hpp); empty in 2-D
 };
 
-// The grid a trial's positions are binned on: hexagons for 2-D positions (gridsize, extent).
-// 3-D positions need a voxel grid, which arrives with flying agents (InputError until then).
+// The grid a trial's positions are binned on: hexagons for 2-D positions (gridsize, extent), voxels
+// for 3-D ones (voxel, volume); InputError for other dimensions.
 std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, const AnalysisParams& params);
 
 // Any number of samples: with none the maps have no bins (MI 0 for every cell, MSAI NaN); with

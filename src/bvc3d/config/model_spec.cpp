@@ -34,6 +34,14 @@ ModelSpec layered(const std::string& name, std::vector<double> elevations, int n
     return m;
 }
 
+// A flying agent's model: the full spherical scanner (both halves) at the body's center.
+ModelSpec flying(const std::string& name, std::vector<double> elevations, int n_per_axis) {
+    ModelSpec m{name, LidarSpec::spherical_full(), {}, {}};
+    m.bvc.elevations = std::move(elevations);
+    m.bvc.n_per_axis = n_per_axis;
+    return m;
+}
+
 }  // namespace
 
 const std::vector<ModelPreset>& model_presets() {
@@ -52,6 +60,12 @@ const std::vector<ModelPreset>& model_presets() {
              m.bvc.max_dist = 11.9;
              return m;
          }},
+        {"fly-up", "flying: full spherical scanner at the body's center, layers 0, 0.1, 0.2 rad (upward only) × 8 × 40",
+         [] { return flying("fly-up", {0.0, 0.1, 0.2}, 40); }, true},
+        {"fly-5l", "flying: full spherical scanner, layers -0.4, -0.2, 0, 0.2, 0.4 rad × 8 directions × 24 distances",
+         [] { return flying("fly-5l", {-0.4, -0.2, 0.0, 0.2, 0.4}, 24); }, true},
+        {"fly-9l", "flying: full spherical scanner, layers -0.8 to 0.8 rad in steps of 0.2 × 8 × 13 (936 cells)",
+         [] { return flying("fly-9l", {-0.8, -0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8}, 13); }, true},
     };
     return presets;
 }
@@ -62,9 +76,14 @@ std::vector<std::string> model_preset_names() {
     return names;
 }
 
-ModelSpec model_preset(const std::string& name) {
+const ModelPreset* find_model_preset(const std::string& name) {
     for (const auto& p : model_presets())
-        if (p.name == name) return p.make();
+        if (p.name == name) return &p;
+    return nullptr;
+}
+
+ModelSpec model_preset(const std::string& name) {
+    if (const auto* p = find_model_preset(name)) return p->make();
     std::string list;
     for (const auto& n : model_preset_names()) list += (list.empty() ? "" : ", ") + n;
     throw InputError("unknown model '" + name + "' (presets: " + list + "; or a model YAML file)");

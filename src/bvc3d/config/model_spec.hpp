@@ -1,7 +1,7 @@
 #pragma once
 // Config stage: a whole model — which scanner it reads, its BVC layer and its place-cell network —
-// and the named presets: the paper's four (Table I) and the authors'-code 2-D baseline
-// (docs/model-reference.md#presets).
+// and the named presets: the paper's four (Table I), the authors'-code 2-D baseline
+// (docs/model-reference.md#presets) and the flying agents' three (docs/flying.md#models).
 #include <functional>
 #include <string>
 #include <vector>
@@ -25,11 +25,13 @@ struct ModelPreset {
     std::string name;
     std::string description;
     std::function<ModelSpec()> make;
+    bool flying = false;  // made for flying agents (fly-*): the ground robot refuses it, and they refuse the others
 };
 
 // The one list of model presets, in the order help texts show them.
 const std::vector<ModelPreset>& model_presets();
 std::vector<std::string> model_preset_names();
 ModelSpec model_preset(const std::string& name);  // throws InputError for unknown names
+const ModelPreset* find_model_preset(const std::string& name);  // nullptr for unknown names
 
 }  // namespace bvc3d

@@ -80,11 +80,31 @@ Protocol::Kind parse_protocol(const std::string& name) {
     throw InputError("protocol '" + name + "' is not one of explore_then_sample, online");
 }
 
+void TrialConfig::set_agent(std::shared_ptr<const AgentSpec> a) {
+    if (a->dims() != agent->dims()) {  // the analysis defaults follow the positions' dimension
+        const auto defaults = analysis::AnalysisParams::defaults(a->dims());
+        if (analysis.dbscan.min_samples == analysis::AnalysisParams::defaults(agent->dims()).dbscan.min_samples)
+            analysis.dbscan.min_samples = defaults.dbscan.min_samples;
+    }
+    agent = std::move(a);
+}
+
 void TrialConfig::validate() const {
     model.validate();
     protocol.validate();
     agent->validate();
     analysis.validate();
+    // A preset made for one kind of agent on the other (custom models are the user's call).
+    if (const std::string preset = config::preset_name_of(model); !preset.empty()) {
+        const bool flying_model = find_model_preset(preset)->flying;
+        if (flying_model && agent->kind() == "random_walk")
+            throw InputError("model '" + preset + "' is a preset for flying agents (its scanner sits at the body's "
+                             "center and looks down too): the ground robot uses 2d, 3d-0.1, 3d-0.2, 3d-3l or 2d-8beam; "
+                             "or fly with it (trial key flight:, --agent flight)");
+        if (!flying_model && agent->kind() == "flight")
+            throw InputError("model '" + preset + "' is a preset for the ground robot (its scanner sits on the robot, "
+                             "above the floor): flying agents use fly-up, fly-5l or fly-9l (docs/flying.md#models)");
+    }
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
     if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
         Protocol::table().fail("sample_hours", "= " + format_number(protocol.sample_hours) +
@@ -135,7 +155,11 @@ std::string TrialConfig::canonical() const {
 
 analysis::AnalysisParams TrialConfig::analysis_params(const WorldDescription& w) const {
     analysis::AnalysisParams params = analysis;
-    if (arena_extent) {
+    if (agent->dims() == 3 && w.flight) {  // voxels over the flight volume (docs/flying.md#analysis)
+        const auto box = w.flight->bounds();
+        params.volume = analysis::Box3{box.min().x(), box.max().x(), box.min().y(), box.max().y(), box.min().z(), box.max().z()};
+    }
+    if (arena_extent && !w.walkable.points.empty()) {
         const auto box = w.walkable.bounds();
         params.extent = analysis::Extent{box.min().x(), box.max().x(), box.min().y(), box.max().y()};
     }

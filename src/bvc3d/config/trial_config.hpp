@@ -55,6 +55,9 @@ struct TrialConfig {
     // Where the trial was described ("trial.yaml", "sweep.yaml, condition 3"), for messages; a label.
     std::string origin;
 
+    // Sets the agent; when that changes the positions' dimension, a min_samples left at the old
+    // dimension's default takes the new one's (20 in 2-D, 10 in 3-D).
+    void set_agent(std::shared_ptr<const AgentSpec> a);
     std::string condition_label() const;
     // Throws InputError for impossible values (model, protocol, agent, analysis, durations).
     void validate() const;
@@ -69,7 +72,7 @@ struct TrialConfig {
     std::string canonical() const;
     std::string fingerprint() const;  // a short hash of canonical()
     // The trial's analysis parameters, with the walkable region's bounds as the extent when
-    // arena_extent asks for them.
+    // arena_extent asks for them, and for a 3-D agent the flight volume as the voxels' box.
     analysis::AnalysisParams analysis_params(const WorldDescription& world) const;
 };
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/format.hpp"
@@ -74,8 +75,14 @@ void analysis_from(const YamlView& v, TrialConfig& t) {
 }
 
 std::shared_ptr<const AgentSpec> agent_from(const YamlView& v) {
-    if (v.has("robot") && v.has("trajectory"))
-        v.fail("give 'robot' (the random walk's robot) or 'trajectory' (a given path), not both");
+    if (v.has("robot") + v.has("trajectory") + v.has("flight") > 1)
+        v.fail("give one of 'robot' (the random walk's robot), 'trajectory' (a given path) or 'flight' (the flying "
+               "agent), not several");
+    if (v.has("flight")) {
+        FlightParams flight;
+        read_table(v["flight"], flight, FlightParams::table());
+        return std::make_shared<FlightSpec>(flight);
+    }
     if (v.has("trajectory")) {
         const YamlView file = v["trajectory"];
         try {
@@ -94,7 +101,7 @@ std::shared_ptr<const AgentSpec> agent_from(const YamlView& v) {
 }  // namespace
 
 std::vector<std::string> trial_keys() {
-    return {"world", "model", "seed", "protocol", "robot", "trajectory", "analysis"};
+    return {"world", "model", "seed", "protocol", "robot", "trajectory", "analysis", "flight"};
 }
 
 TrialConfig trial_from_yaml(const YamlView& v) {
@@ -104,7 +111,7 @@ TrialConfig trial_from_yaml(const YamlView& v) {
     if (v.has("model")) t.model = model_from(v["model"]);
     if (v.has("seed")) t.seed = v["seed"].as_uint64();
     if (v.has("protocol")) read_table(v["protocol"], t.protocol, Protocol::table());
-    t.agent = agent_from(v);
+    t.set_agent(agent_from(v));
     if (v.has("analysis")) analysis_from(v["analysis"], t);
     t.origin = v.file();
     // What the sections allow one by one may still not fit together (too short a protocol for
@@ -114,6 +121,9 @@ TrialConfig trial_from_yaml(const YamlView& v) {
     } catch (const params::ParamError& e) {
         for (const char* section : {"protocol", "robot", "analysis"})
             if (v.has(section) && v[section].is_map() && v[section].has(e.key())) v[section][e.key()].fail(e.reason());
+        v.fail(e.what());
+    } catch (const InputError& e) {  // a model and an agent that do not go together: name the file
+        if (dynamic_cast<const ConfigError*>(&e)) throw;
         v.fail(e.what());
     }
     return t;
@@ -147,7 +157,8 @@ std::string trial_to_commented_yaml(const TrialConfig& t) {
     if (t.world.source == "cross" || t.world.tilt_deg)
         out.line("  ", "tilt_deg", format_number(t.world.tilt_deg.value_or(0.0)),
                  "cross only: degrees the central walls lean");
-    if (preset_world) out.line("  ", "lean", params::CommentedYaml::scalar(t.world.lean), "the corner they lean toward");
+    if (preset_world && t.world.source.rfind("cross", 0) == 0)
+        out.line("  ", "lean", params::CommentedYaml::scalar(t.world.lean), "the corner they lean toward");
     if (const std::string preset = preset_name_of(t.model); !preset.empty()) {
         out.line("", "model", preset,
                  "a preset (" + list(model_preset_names()) + "), a model YAML file or a mapping (bvc3d config --model NAME)");

@@ -58,8 +58,10 @@ void check_simple(const YamlView& v, const Polygon2& poly) {
 }
 
 // rect: [xmin, ymin, xmax, ymax] or polygon: [[x, y], ...]
-Polygon2 region_from_yaml(const YamlView& v) {
-    v.expect_map({"rect", "polygon"});
+Polygon2 region_from_yaml(const YamlView& v, std::initializer_list<const char*> other_keys = {}) {
+    std::vector<std::string> keys{"rect", "polygon"};
+    keys.insert(keys.end(), other_keys.begin(), other_keys.end());
+    v.expect_map(keys);
     if (v.has("rect") == v.has("polygon")) v.fail("give exactly one of 'rect' or 'polygon'");
     if (v.has("rect")) {
         const auto r = meters(v["rect"], 4);
@@ -99,7 +101,8 @@ CrossArenaParams cross_from_yaml(const YamlView& v) {
                     {"height", &p.height},
                     {"wall_length", &p.wall_length},
                     {"wall_thickness", &p.wall_thickness},
-                    {"start_offset", &p.start_offset}});
+                    {"start_offset", &p.start_offset},
+                    {"flight_clearance", &p.flight_clearance}});
     return p;
 }
 
@@ -191,10 +194,48 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
 
 }  // namespace
 
-std::vector<std::string> world_preset_names() { return {"cross", "cross-0", "cross-30", "cross-45", "cross-60"}; }
+namespace {
+
+// flight_volume: {rect: [...] or polygon: [...] (default: the walkable region), z_min: Z, z_max: Z}.
+// The volume must lie within the geometry's bounds: a flying body outside every wall is a mistake.
+FlightVolume flight_from_yaml(const YamlView& v, const WorldDescription& w) {
+    if (!v.is_map()) v.fail("must be a mapping: {rect: [xmin, ymin, xmax, ymax], z_min: Z, z_max: Z}");
+    FlightVolume f;
+    if (v.has("rect") || v.has("polygon")) {
+        f.region = region_from_yaml(v, {"z_min", "z_max"});
+    } else {
+        v.expect_map({"rect", "polygon", "z_min", "z_max"});
+        if (w.walkable.points.size() < 3) v.fail("needs a 'rect' or 'polygon' (the world has no walkable region to default to)");
+        f.region = w.walkable;
+    }
+    if (!v.has("z_min")) v.fail_key("z_min", "is required (m, the volume's floor)");
+    if (!v.has("z_max")) v.fail_key("z_max", "is required (m, the volume's ceiling)");
+    f.z_min = v["z_min"].as_double();
+    f.z_max = v["z_max"].as_double();
+    if (!std::isfinite(f.z_min) || !std::isfinite(f.z_max)) v.fail("z_min and z_max must be finite");
+    if (!(f.z_max > f.z_min))
+        v.fail("is empty: z_max (" + format_number(f.z_max) + ") must be above z_min (" + format_number(f.z_min) + ")");
+    Eigen::AlignedBox3d world_box;
+    for (const auto& p : w.mesh.vertices) world_box.extend(p);
+    const auto box = f.bounds();
+    const double slack = 1e-9 * std::max(1.0, world_box.sizes().maxCoeff());
+    if (!(box.min().array() >= world_box.min().array() - slack).all() ||
+        !(box.max().array() <= world_box.max().array() + slack).all())
+        v.fail("reaches outside the world's geometry (x " + format_number(world_box.min().x()) + " to " +
+               format_number(world_box.max().x()) + ", y " + format_number(world_box.min().y()) + " to " +
+               format_number(world_box.max().y()) + ", z " + format_number(world_box.min().z()) + " to " +
+               format_number(world_box.max().z()) + " m)");
+    return f;
+}
+
+}  // namespace
+
+std::vector<std::string> world_preset_names() {
+    return {"cross", "cross-0", "cross-30", "cross-45", "cross-60", "flight-room", "atrium"};
+}
 
 WorldDescription world_from_yaml(const YamlView& v) {
-    v.expect_map({"name", "objects", "walkable", "start"});
+    v.expect_map({"name", "objects", "walkable", "start", "flight_volume"});
     WorldDescription w;
     w.name = v.get("name", std::filesystem::path(v.file()).stem().string());
     w.file = v.file();
@@ -210,8 +251,18 @@ WorldDescription world_from_yaml(const YamlView& v) {
         w.walkable = region_from_yaml(v["walkable"]);
     } else if (arena) {
         w.walkable = arena->walkable;
-    } else {
-        v.fail_key("walkable", "is required (the floor region the robot may use) unless the world has a cross_arena");
+    } else if (!v.has("flight_volume")) {
+        v.fail_key("walkable", "is required (the floor region the robot may use) unless the world has a cross_arena "
+                               "or a flight_volume");
+    }
+    if (v.has("flight_volume")) {
+        w.flight = flight_from_yaml(v["flight_volume"], w);
+    } else if (arena && !v.has("walkable")) {
+        w.flight = arena->flight;
+    }
+    if (w.walkable.points.empty()) {  // a flight-only world: no ground robot, no start region
+        if (v.has("start")) v.fail_key("start", "needs a walkable region (flying agents start anywhere in the flight volume)");
+        return w;
     }
     // A floor with no geometry over it is a world the sensors cannot see.
     Eigen::AlignedBox2d geometry;
@@ -256,6 +307,10 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
 WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
     const auto presets = world_preset_names();
     if (std::find(presets.begin(), presets.end(), name) != presets.end()) {
+        if (name == "flight-room" || name == "atrium") {
+            if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world, not to '" + name + "'");
+            return name == "atrium" ? atrium() : flight_room();
+        }
         CrossArenaParams p;
         p.lean = lean;
         if (name != "cross") {
@@ -281,7 +336,8 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
         const std::string name = v.as_string();
         if (name == "horizontal") return LidarSpec::horizontal();
         if (name == "spherical") return LidarSpec::spherical();
-        v.fail("expected horizontal, spherical, or a sensor mapping");
+        if (name == "spherical-full") return LidarSpec::spherical_full();
+        v.fail("expected horizontal, spherical, spherical-full, or a sensor mapping");
     }
     if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping");
     const std::string preset = v.get("preset", "");
@@ -309,7 +365,8 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
 std::string builtin_sensor_name(const LidarSpec& s) {
     const auto& table = LidarSpec::table();
     const std::string text = params::yaml_lines(table, s, "");
-    for (const auto& [name, spec] : {std::pair{"horizontal", LidarSpec::horizontal()}, {"spherical", LidarSpec::spherical()}})
+    for (const auto& [name, spec] : {std::pair{"horizontal", LidarSpec::horizontal()}, {"spherical", LidarSpec::spherical()},
+                                     {"spherical-full", LidarSpec::spherical_full()}})
         if (text == params::yaml_lines(table, spec, "")) return name;
     return "";
 }
@@ -328,9 +385,10 @@ std::string sensor_to_commented_yaml(const LidarSpec& s) {
 LidarSpec resolve_sensor(const std::string& name) {
     if (name == "horizontal") return LidarSpec::horizontal();
     if (name == "spherical") return LidarSpec::spherical();
+    if (name == "spherical-full") return LidarSpec::spherical_full();
     std::error_code ec;
     if (!std::filesystem::exists(name, ec))
-        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical' nor an existing YAML file");
+        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical', 'spherical-full' nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }

@@ -18,12 +18,23 @@ NamedArray array(const char* name, std::vector<std::size_t> shape, std::vector<T
 
 }  // namespace
 
+analysis::Points sample_positions(const GroupResult& r, int dims) {
+    const auto n = static_cast<Eigen::Index>(r.x.size());
+    analysis::Points p(n, dims);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        p(i, 0) = r.x[static_cast<std::size_t>(i)];
+        p(i, 1) = r.y[static_cast<std::size_t>(i)];
+        if (dims == 3) p(i, 2) = r.z[static_cast<std::size_t>(i)];
+    }
+    return p;
+}
+
 AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const GroupResult& r, std::size_t model) {
     AnalyzedTrial a;
     a.params = t.analysis_params(world);
     const auto& rec = r.models.at(model);
     const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()), rec.n_place);
-    a.metrics = analysis::analyze_trial<float>(r.x, r.y, rates, a.params);
+    a.metrics = analysis::analyze_trial<float>(sample_positions(r, t.agent->dims()), rates, a.params);
     return a;
 }
 
@@ -64,6 +75,7 @@ TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world
     id.sample_hours = t.protocol.sample_hours;
     id.config = t.canonical();
     id.fingerprint = t.fingerprint();
+    id.dims = t.agent->dims();
     return id;
 }
 
@@ -73,6 +85,10 @@ MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::An
     // How they were computed, so that `bvc3d analyze` starts from the same parameters.
     for (const auto& f : analysis::AnalysisParams::table().fields()) r.parameters.emplace_back(f.key, f.get(p));
     if (p.extent) r.arrays.push_back(array("extent", {4}, std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, false));
+    if (m.dims == 3 && p.volume) {
+        const auto& v = *p.volume;
+        r.arrays.push_back(array("volume", {6}, std::vector<double>{v.xmin, v.xmax, v.ymin, v.ymax, v.zmin, v.zmax}, false));
+    }
     const auto& bins = m.maps.bins;
     const std::size_t nb = static_cast<std::size_t>(bins.size()), nc = static_cast<std::size_t>(m.maps.map.cols());
     const std::size_t dims = static_cast<std::size_t>(bins.centers.cols());
@@ -86,11 +102,12 @@ MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::An
     r.arrays.push_back(array("peak_rate", {nc}, m.cells.peak_rate));
     r.arrays.push_back(array("field_area", {nc}, m.cells.field_area));
     r.arrays.push_back(array("spatial_info", {nc}, m.cells.spatial_info));
+    if (m.dims == 3) r.arrays.push_back(array("isotropy", {nc}, m.isotropy));
     return r;
 }
 
 analysis::AnalysisParams stored_analysis_params(const TrialFileData& file, const std::filesystem::path& path) {
-    analysis::AnalysisParams p;
+    analysis::AnalysisParams p = analysis::AnalysisParams::defaults(file.dims);
     const auto& table = analysis::AnalysisParams::table();
     const auto where = [&](const std::string& name) { return "trial file '" + path.string() + "': attribute '/metrics/" + name + "'"; };
     bool any = false;
@@ -124,6 +141,10 @@ analysis::AnalysisParams stored_analysis_params(const TrialFileData& file, const
     if (!has_templates && !any) p.decoding_templates = analysis::DecodingTemplates::means;
     if (file.extent && file.extent->size() == 4)
         p.extent = analysis::Extent{(*file.extent)[0], (*file.extent)[1], (*file.extent)[2], (*file.extent)[3]};
+    if (file.volume && file.volume->size() == 6) {
+        const auto& v = *file.volume;
+        p.volume = analysis::Box3{v[0], v[1], v[2], v[3], v[4], v[5]};
+    }
     return p;
 }
 
@@ -145,7 +166,7 @@ analysis::Extent arena_extent(const TrialFileData& file, const std::filesystem::
 bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t) {
     const auto stamp = read_trial_stamp(path);
     if (!stamp || stamp->fingerprint != t.fingerprint()) return false;
-    for (const auto& name : analysis::metric_names())
+    for (const auto& name : analysis::metric_names(t.agent->dims()))
         if (std::find(stamp->metric_attributes.begin(), stamp->metric_attributes.end(), name) == stamp->metric_attributes.end())
             return false;
     return true;

@@ -28,6 +28,8 @@ GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunCo
 GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std::vector<std::filesystem::path>& paths,
                                const RunControl& control = {});
 
+// The recorded positions as N × dims: x, y (and z for 3-D agents).
+analysis::Points sample_positions(const GroupResult& r, int dims);
 // Analyzes one model of a group's result with the trial's parameters.
 AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const GroupResult& result, std::size_t model);
 

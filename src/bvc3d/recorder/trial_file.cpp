@@ -15,7 +15,7 @@ namespace {
 
 void write_identity(hid_t f, const TrialIdentity& id) {
     h5::write_attr(f, "format", std::string("bvc3d-trial"));
-    h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_format_version));
+    h5::write_attr(f, "format_version", static_cast<std::int64_t>(trial_file_version_for(id.dims)));
     h5::write_attr(f, "name", id.name);
     h5::write_attr(f, "condition", id.condition);
     std::string swept;
@@ -61,7 +61,8 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         h5::write(s, "t", group.t, {n});
         h5::write(s, "x", group.x, {n});
         h5::write(s, "y", group.y, {n});
-        if (std::any_of(group.z.begin(), group.z.end(), [](double z) { return z != 0.0; })) h5::write(s, "z", group.z, {n});
+        if (id.dims == 3 || std::any_of(group.z.begin(), group.z.end(), [](double z) { return z != 0.0; }))
+            h5::write(s, "z", group.z, {n});
         h5::write(s, "heading", group.heading, {n});
         h5::write(s, "rates", rec.rates, {n, static_cast<std::size_t>(rec.n_place)});
         if (!rec.bvc.empty()) h5::write(s, "bvc_rates", rec.bvc, {n, static_cast<std::size_t>(rec.n_bvc)});
@@ -80,18 +81,39 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
     out.commit();
 }
 
+namespace {
+
+// Files without the attribute predate it: version 1.
+int format_version(hid_t f) {
+    return h5::exists_attr(f, "format_version") ? static_cast<int>(h5::read_attr_int(f, "format_version")) : 1;
+}
+
+std::string version_error(const std::filesystem::path& path, int v) {
+    return "trial file '" + path.string() + "' has format_version " + std::to_string(v) +
+           "; this bvc3d reads versions 1 to " + std::to_string(trial_file_format_version) +
+           " (written by a newer bvc3d? docs/trial-files.md)";
+}
+
+}  // namespace
+
 std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+    int version = 1;
+    std::optional<TrialStamp> stamp;
     try {
         auto lock = h5::hdf5_lock();
         const auto f = h5::open_file(path.string());
         if (h5::read_attr_string(f, "format") != "bvc3d-trial") return std::nullopt;
-        if (!h5::exists(f, "metrics")) return std::nullopt;
-        return TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
+        version = format_version(f);
+        if (h5::exists(f, "metrics"))
+            stamp = TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
     } catch (const InputError&) {
         return std::nullopt;
     }
+    // A newer bvc3d's file is not broken: say so rather than overwrite it.
+    if (version < 1 || version > trial_file_format_version) throw InputError(version_error(path, version));
+    return stamp;
 }
 
 namespace {
@@ -116,7 +138,7 @@ public:
             if (h5::attr_class(file_, "format_version") != H5T_INTEGER) fail("attribute 'format_version' is not an integer");
             const auto version = h5::read_attr_int(file_, "format_version");
             if (version < 1 || version > trial_file_format_version)
-                fail("format_version " + std::to_string(version) + " is not supported (this bvc3d reads version " +
+                fail("format_version " + std::to_string(version) + " is not supported (this bvc3d reads versions 1 to " +
                      std::to_string(trial_file_format_version) + (version > trial_file_format_version ? "; a newer bvc3d wrote it)" : ")"));
         }
     }
@@ -233,6 +255,7 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     for (const auto& name : r.guarded("group '/metrics'", [&] { return h5::attribute_names(g); }))
         d.metric_attributes.emplace_back(name, r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
     d.extent = read_extent(r, g);
+    if (h5::exists(g, "volume")) d.volume = r.finite<double>(g, "/metrics/", "volume");
     const auto s = r.group("samples");
     const auto nx = r.shape(s, "/samples/", "x", 1)[0];
     if (r.shape(s, "/samples/", "y", 1)[0] != nx)
@@ -246,6 +269,8 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     d.x = r.finite<double>(s, "/samples/", "x");
     d.y = r.finite<double>(s, "/samples/", "y");
     if (has_z) d.z = r.finite<double>(s, "/samples/", "z");
+    d.dims = format_version(r.file()) >= 2 ? 3 : 2;
+    if (d.dims == 3 && !has_z) r.fail(": a 3-D trial (format version 2) without dataset '/samples/z'");
     d.rates = r.finite<float>(s, "/samples/", "rates", rates[1]);
     d.n_place = rates[1];
     return d;

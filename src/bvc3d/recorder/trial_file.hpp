@@ -16,7 +16,13 @@
 
 namespace bvc3d {
 
-inline constexpr int trial_file_format_version = 1;
+// Version 1: ground trials (x, y; z only when some sample has z != 0). Version 2: trials of flying
+// agents (3-D positions: samples/z always, /metrics/volume). A file keeps the lowest version that
+// holds its trial, so ground trials' files are as they always were. Readers refuse other versions.
+inline constexpr int trial_file_format_version = 2;
+inline constexpr int trial_file_format_version_2d = 1;
+// The version a trial of positions with `dims` coordinates is written with.
+inline int trial_file_version_for(int dims) { return dims == 3 ? trial_file_format_version : trial_file_format_version_2d; }
 
 // Which trial a file holds and how it was configured (the root attributes).
 struct TrialIdentity {
@@ -25,6 +31,7 @@ struct TrialIdentity {
     std::uint64_t seed = 0;
     double tilt_deg = NAN;  // cross arenas only
     double explore_hours = NAN, sample_hours = NAN;
+    int dims = 2;  // coordinates of the analyzed positions: 2, or 3 for flying agents
 };
 
 // A named array of a trial file, row-major with the given shape.
@@ -43,12 +50,14 @@ struct MetricsRecord {
     std::vector<NamedArray> arrays;
 };
 
-// Writes the file atomically: it appears only when complete. z is written when any sample has z != 0.
+// Writes the file atomically: it appears only when complete. z is written for 3-D trials (id.dims 3)
+// and when any sample has z != 0.
 void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id, const GroupResult& group,
                       std::size_t model_index, const MetricsRecord& metrics);
 
 // A complete trial file's fingerprint and the names of the attributes under /metrics (the metrics
 // it holds, with their parameters); nullopt if the file is missing, broken or not a trial file.
+// InputError for a trial file of a format version this build does not know (a newer bvc3d's).
 struct TrialStamp {
     std::string fingerprint;
     std::vector<std::string> metric_attributes;
@@ -61,6 +70,7 @@ std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path);
 struct TrialFileData : TrialIdentity {
     std::vector<std::pair<std::string, params::Value>> metric_attributes;  // everything under /metrics
     std::optional<std::vector<double>> extent;                          // /metrics/extent, if fixed
+    std::optional<std::vector<double>> volume;                          // /metrics/volume (3-D trials)
     std::vector<double> x, y, z;                                        // z empty for ground trials
     std::vector<float> rates;                                           // samples × n_place
     std::size_t n_place = 0;

@@ -61,6 +61,19 @@ TrialSummaryRow read_summary(const std::filesystem::path& file) {
 std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files) {
     std::vector<TrialSummaryRow> rows;
     for (const auto& f : files) rows.push_back(read_summary(f));
+    // Metrics of one kind of trial only (3-D: flying agents) that no trial has are left out, so a
+    // ground experiment's tables are what they always were.
+    for (const auto& m : analysis::metric_table()) {
+        if (m.dims == 0) continue;
+        const bool any = std::any_of(rows.begin(), rows.end(), [&](const TrialSummaryRow& r) {
+            return std::any_of(r.metrics.begin(), r.metrics.end(),
+                               [&](const auto& v) { return v.first == m.name && !std::isnan(v.second); });
+        });
+        if (any) continue;
+        for (auto& r : rows)
+            r.metrics.erase(std::remove_if(r.metrics.begin(), r.metrics.end(), [&](const auto& v) { return v.first == m.name; }),
+                            r.metrics.end());
+    }
     return rows;
 }
 
@@ -177,8 +190,12 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
     os << '|';
     for (const auto& k : keys) os << ' ' << k << " |";
     std::vector<const analysis::Metric*> columns;
-    for (const auto& m : analysis::metric_table())
-        if (m.digits >= 0) columns.push_back(&m);
+    for (const auto& m : analysis::metric_table()) {
+        const bool reported = m.dims == 0 || std::any_of(rows.begin(), rows.end(), [&](const SummaryRow& r) {
+            return std::find(r.metric_names.begin(), r.metric_names.end(), m.name) != r.metric_names.end();
+        });
+        if (m.digits >= 0 && reported) columns.push_back(&m);
+    }
     os << " seeds |";
     for (const auto* c : columns) os << ' ' << c->heading << " |";
     os << "\n|";
@@ -204,6 +221,9 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
                       : "\nOne trial (seed) per condition: each value is that trial's.")
        << " MI: modality index (DBSCAN clusters per place cell);\n"
           "MSAI: mean spatial aliasing index; decoding: position error of the cosine-nearest rate-map bin.\n";
+    if (std::any_of(columns.begin(), columns.end(), [](const analysis::Metric* c) { return c->dims == 3; }))
+        os << "3-D (flying agents, 0.5 m voxels): isotropy = a single field's rate-weighted sd along z over the mean of\n"
+              "its sds along x and y (1: round); vertical chance = the median vertical error of a random guess.\n";
     f.commit();
 }
 

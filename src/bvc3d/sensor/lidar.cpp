@@ -30,6 +30,13 @@ LidarSpec LidarSpec::spherical(bool upper_only) {
     return s;
 }
 
+LidarSpec LidarSpec::spherical_full() {
+    LidarSpec s = spherical(false);
+    s.name = "spherical-full";
+    s.height = 0.0;
+    return s;
+}
+
 const params::Table<LidarSpec>& LidarSpec::table() {
     using namespace params;
     static const Table<LidarSpec> t(

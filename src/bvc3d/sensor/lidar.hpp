@@ -37,6 +37,9 @@ struct LidarSpec {
     static LidarSpec horizontal();
     // The paper's 3-D scanner: the 90 × 180 range image at 0.18 m; `upper_only` keeps rows 0-44.
     static LidarSpec spherical(bool upper_only = true);
+    // The flying agents' scanner: all 90 rows of the spherical one, both halves, at the body's
+    // center (height 0; docs/flying.md#models).
+    static LidarSpec spherical_full();
 
     std::size_t beam_count() const { return elevations.size() * static_cast<std::size_t>(azimuth_count); }
     // Same beams, same noise: scans are identical whatever the names.

@@ -40,6 +40,8 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
     require(reach < p.half_width, "tilt_deg " + format_number(p.tilt_deg) +
                                       " makes the central walls' tops pass through the outer walls");
     require(std::abs(p.start_offset) < p.half_width, "start_offset must lie inside the arena");
+    require(std::isfinite(p.flight_clearance) && p.flight_clearance >= 0 && 2 * p.flight_clearance < p.height,
+            "flight_clearance must be >= 0 and leave room between floor and ceiling");
 
     WorldDescription w;
     w.name = "cross-" + format_number(p.tilt_deg);
@@ -65,6 +67,61 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
     w.walkable = Polygon2::rectangle(-a, -a, a, a);
     const double o = p.start_offset;
     w.start.points = {Vec2(o, o), Vec2(-o, o), Vec2(-o, -o), Vec2(o, -o)};
+    w.flight = FlightVolume{w.walkable, p.flight_clearance, p.height - p.flight_clearance};
+    return w;
+}
+
+Eigen::AlignedBox3d FlightVolume::bounds() const {
+    const auto box = region.bounds();
+    return Eigen::AlignedBox3d(Vec3(box.min().x(), box.min().y(), z_min), Vec3(box.max().x(), box.max().y(), z_max));
+}
+
+namespace {
+
+// A closed room: floor, ceiling and four walls, the same quads (in the same order) as the room's
+// YAML file in configs/worlds lists.
+void add_room(TriangleMesh& m, double hx, double hy, double h) {
+    m.add_quad(Vec3(-hx, -hy, 0), Vec3(hx, -hy, 0), Vec3(hx, hy, 0), Vec3(-hx, hy, 0));      // floor
+    m.add_quad(Vec3(-hx, -hy, h), Vec3(-hx, hy, h), Vec3(hx, hy, h), Vec3(hx, -hy, h));      // ceiling
+    m.add_quad(Vec3(-hx, -hy, 0), Vec3(-hx, hy, 0), Vec3(-hx, hy, h), Vec3(-hx, -hy, h));    // x = -hx
+    m.add_quad(Vec3(hx, -hy, 0), Vec3(hx, -hy, h), Vec3(hx, hy, h), Vec3(hx, hy, 0));        // x = +hx
+    m.add_quad(Vec3(-hx, -hy, 0), Vec3(-hx, -hy, h), Vec3(hx, -hy, h), Vec3(hx, -hy, 0));    // y = -hy
+    m.add_quad(Vec3(-hx, hy, 0), Vec3(hx, hy, 0), Vec3(hx, hy, h), Vec3(-hx, hy, h));        // y = +hy
+}
+
+void add_box(TriangleMesh& m, const Vec3& center, const Vec3& size) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = center;
+    m.append(box_mesh(size), pose);
+}
+
+constexpr double flight_clearance = 0.2;  // m between the flight volume and floor or ceiling
+
+}  // namespace
+
+WorldDescription flight_room() {
+    WorldDescription w;
+    w.name = "flight-room";
+    const double hx = 2.9, hy = 2.3, h = 2.7;
+    add_room(w.mesh, hx, hy, h);
+    w.flight = FlightVolume{Polygon2::rectangle(-hx, -hy, hx, hy), flight_clearance, h - flight_clearance};
+    return w;
+}
+
+WorldDescription atrium() {
+    WorldDescription w;
+    w.name = "atrium";
+    const double a = 5.0, h = 6.0;
+    add_room(w.mesh, a, a, h);
+    // The mezzanine ring: a 0.2 m slab at 2.8-3.0 m over the 1.5 m band along the walls.
+    add_box(w.mesh, Vec3(0, 4.25, 2.9), Vec3(10, 1.5, 0.2));
+    add_box(w.mesh, Vec3(0, -4.25, 2.9), Vec3(10, 1.5, 0.2));
+    add_box(w.mesh, Vec3(4.25, 0, 2.9), Vec3(1.5, 7, 0.2));
+    add_box(w.mesh, Vec3(-4.25, 0, 2.9), Vec3(1.5, 7, 0.2));
+    // Two pillars, placed off the diagonals so that no symmetry maps the hall onto itself.
+    add_box(w.mesh, Vec3(-1.5, 1.0, 3.0), Vec3(0.6, 0.6, 6.0));
+    add_box(w.mesh, Vec3(2.0, -1.5, 3.0), Vec3(0.6, 0.6, 6.0));
+    w.flight = FlightVolume{Polygon2::rectangle(-a, -a, a, a), flight_clearance, h - flight_clearance};
     return w;
 }
 

@@ -18,13 +18,22 @@ struct StartRegion {
     Polygon2 region;
 };
 
+// Where a flying agent's body may be (docs/flying.md): a floor region × [z_min, z_max]. The whole
+// body stays inside it.
+struct FlightVolume {
+    Polygon2 region;
+    double z_min = 0.0, z_max = 0.0;  // m
+    Eigen::AlignedBox3d bounds() const;
+};
+
 struct WorldDescription {
     std::string name;
     std::string file;  // the YAML file it came from (errors about its keys name it); empty for presets
     std::optional<double> tilt_deg;  // the tilt of the cross arena, when the world is (or holds) one
     TriangleMesh mesh;
-    Polygon2 walkable;  // the robot's body stays inside this floor polygon
+    Polygon2 walkable;  // the robot's body stays inside this floor polygon (none in a flight-only world)
     StartRegion start;
+    std::optional<FlightVolume> flight;  // where a flying agent may fly; none in a ground-only world
 };
 
 // The paper's arena (docs/model-reference.md#the-cross-arena).
@@ -36,10 +45,18 @@ struct CrossArenaParams {
     double wall_length = 7.0;
     double wall_thickness = 0.3;
     double start_offset = 4.0;  // start corners at (±offset, ±offset)
+    double flight_clearance = 0.2;  // the flight volume: the floor × [clearance, height - clearance]
 };
 
 // Checks the parameters (throws InputError naming the parameter) and builds the arena.
 WorldDescription cross_arena(const CrossArenaParams& p);
+
+// Flight-only worlds (docs/flying.md#worlds): no walkable region, a flight volume with 0.2 m
+// clearance from floor and ceiling. `flight-room`: an empty 5.8 × 4.6 × 2.7 m room (the size of the
+// bats' room of Yartsev & Ulanovsky 2013). `atrium`: 10 × 10 × 6 m with a 1.5 m wide mezzanine ring
+// (z 2.8-3.0 m) along the walls and two 0.6 m square pillars from floor to ceiling.
+WorldDescription flight_room();
+WorldDescription atrium();
 
 class World {
 public:
