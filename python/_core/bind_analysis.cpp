@@ -50,6 +50,9 @@ pyb::dict decoding_dict(const an::DecodingResult& d) {
     r["mean_m"] = d.mean_m;
     r["n_decoded"] = d.n_decoded;
     r["n_undecoded"] = d.n_undecoded;
+    r["frac_undecoded"] = d.frac_undecoded();
+    r["median_all_m"] = d.median_all_m;
+    r["mean_all_m"] = d.mean_all_m;
     return r;
 }
 
@@ -143,11 +146,15 @@ void bind_sample_functions(pyb::module_& a) {
     a.def(
         "analyze",
         [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile, double eps,
-           int min_samples, double d_th, const MaybeExtent& extent, const std::string& decoding_templates) {
+           int min_samples, double d_th, const MaybeExtent& extent, const std::string& decoding_templates,
+           double mi_quantile, int skip_samples, int msai_bins) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
-            const an::AnalysisParams params{gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent),
-                                            an::parse_decoding_templates(decoding_templates)};
+            an::AnalysisParams params{gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent),
+                                      an::parse_decoding_templates(decoding_templates)};
+            params.mi_quantile = mi_quantile;
+            params.skip_samples = skip_samples;
+            params.msai_bins = msai_bins;
             an::TrialMetrics m;
             {
                 pyb::gil_scoped_release release;
@@ -169,7 +176,7 @@ void bind_sample_functions(pyb::module_& a) {
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
         pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"),
-        pyb::arg("decoding_templates"));
+        pyb::arg("decoding_templates"), pyb::arg("mi_quantile"), pyb::arg("skip_samples"), pyb::arg("msai_bins"));
 }
 
 }  // namespace
