@@ -28,6 +28,12 @@ ModelSpec layered(const std::string& name, std::vector<double> elevations, int n
     return m;
 }
 
+// The same model reading the spherical image with the authors' angle labels.
+ModelSpec as_authors(ModelSpec m) {
+    m.sensor = LidarSpec::spherical_as_authors();
+    return m;
+}
+
 }  // namespace
 
 const std::vector<ModelPreset>& model_presets() {
@@ -46,6 +52,13 @@ const std::vector<ModelPreset>& model_presets() {
              m.bvc.max_dist = 11.9;
              return m;
          }},
+        // The 3-D models reading the spherical image as the authors' code labels it.
+        {"3d-0.1-authors", "3d-0.1 with the authors' image labels and whole-column heading roll",
+         [] { return as_authors(layered("3d-0.1-authors", {0.0, 0.1}, 60)); }},
+        {"3d-0.2-authors", "3d-0.2 with the authors' image labels and whole-column heading roll",
+         [] { return as_authors(layered("3d-0.2-authors", {0.0, 0.2}, 60)); }},
+        {"3d-3l-authors", "3d-3l with the authors' image labels and whole-column heading roll",
+         [] { return as_authors(layered("3d-3l-authors", {0.0, 0.1, 0.2}, 40)); }},
     };
     return presets;
 }

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 
 namespace bvc3d::config {
@@ -142,7 +143,44 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
 
 }  // namespace
 
-std::vector<std::string> world_preset_names() { return {"cross", "cross-0", "cross-30", "cross-45", "cross-60"}; }
+namespace {
+
+// The one list of world presets: cross arenas, some with their tilt fixed by the name.
+struct WorldPreset {
+    std::string name;
+    std::optional<double> fixed_tilt;  // none: the preset takes a tilt (default 0)
+    CrossArenaParams (*params)(double tilt_deg);
+};
+
+CrossArenaParams paper_cross(double tilt_deg) { return CrossArenaParams{.tilt_deg = tilt_deg}; }
+
+const std::vector<WorldPreset>& world_presets() {
+    static const std::vector<WorldPreset> presets{
+        {"cross", std::nullopt, paper_cross},   {"cross-0", 0.0, paper_cross},  {"cross-30", 30.0, paper_cross},
+        {"cross-45", 45.0, paper_cross},        {"cross-60", 60.0, paper_cross},
+        {"cross-webots", std::nullopt, CrossArenaParams::webots},
+    };
+    return presets;
+}
+
+const WorldPreset* find_world_preset(const std::string& name) {
+    for (const auto& p : world_presets())
+        if (p.name == name) return &p;
+    return nullptr;
+}
+
+}  // namespace
+
+std::vector<std::string> world_preset_names() {
+    std::vector<std::string> names;
+    for (const auto& p : world_presets()) names.push_back(p.name);
+    return names;
+}
+
+bool world_preset_takes_tilt(const std::string& name) {
+    const WorldPreset* p = find_world_preset(name);
+    return p && !p->fixed_tilt;
+}
 
 WorldDescription world_from_yaml(const YamlView& v) {
     v.expect_map({"name", "objects", "walkable", "start"});
@@ -197,19 +235,17 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
 }
 
 WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
-    const auto presets = world_preset_names();
-    if (std::find(presets.begin(), presets.end(), name) != presets.end()) {
-        CrossArenaParams p;
+    if (const WorldPreset* preset = find_world_preset(name)) {
+        if (preset->fixed_tilt && tilt_deg)
+            throw InputError("a tilt only applies to the cross and cross-webots worlds; '" + name + "' fixes its own");
+        CrossArenaParams p = preset->params(preset->fixed_tilt ? *preset->fixed_tilt : tilt_deg.value_or(0.0));
         p.lean = lean;
-        if (name != "cross") {
-            if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world; '" + name + "' fixes its own");
-            p.tilt_deg = std::stod(name.substr(6));
-        } else if (tilt_deg) {
-            p.tilt_deg = *tilt_deg;
-        }
-        return cross_arena(p);
+        WorldDescription w = cross_arena(p);
+        if (!preset->fixed_tilt && name != "cross") w.name = name + "-" + format_number(p.tilt_deg);
+        return w;
     }
-    if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world, not to '" + name + "'");
+    const auto presets = world_preset_names();
+    if (tilt_deg) throw InputError("a tilt only applies to the cross and cross-webots worlds, not to '" + name + "'");
     std::error_code ec;
     if (!std::filesystem::exists(name, ec)) {
         std::string list;
@@ -219,12 +255,31 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
     return load_world_file(name);
 }
 
+namespace {
+
+// The built-in sensors, by name.
+const std::vector<std::pair<std::string, LidarSpec>>& builtin_sensors() {
+    static const std::vector<std::pair<std::string, LidarSpec>> sensors{
+        {"horizontal", LidarSpec::horizontal()},
+        {"spherical", LidarSpec::spherical()},
+        {"spherical-authors", LidarSpec::spherical_as_authors()},
+    };
+    return sensors;
+}
+
+const LidarSpec* find_builtin_sensor(const std::string& name) {
+    for (const auto& [n, spec] : builtin_sensors())
+        if (n == name) return &spec;
+    return nullptr;
+}
+
+}  // namespace
+
 LidarSpec sensor_from_yaml(const YamlView& v) {
     if (v.is_scalar()) {
         const std::string name = v.as_string();
-        if (name == "horizontal") return LidarSpec::horizontal();
-        if (name == "spherical") return LidarSpec::spherical();
-        v.fail("expected horizontal, spherical, or a sensor mapping");
+        if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
+        v.fail("expected horizontal, spherical, spherical-authors, or a sensor mapping");
     }
     const std::string preset = v.get("preset", "");
     const bool own_rows = v.has("elevations") || v.has("elevations_deg");
@@ -251,7 +306,7 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
 std::string builtin_sensor_name(const LidarSpec& s) {
     const auto& table = LidarSpec::table();
     const std::string text = params::yaml_lines(table, s, "");
-    for (const auto& [name, spec] : {std::pair{"horizontal", LidarSpec::horizontal()}, {"spherical", LidarSpec::spherical()}})
+    for (const auto& [name, spec] : builtin_sensors())
         if (text == params::yaml_lines(table, spec, "")) return name;
     return "";
 }
@@ -268,11 +323,10 @@ std::string sensor_to_commented_yaml(const LidarSpec& s) {
 }
 
 LidarSpec resolve_sensor(const std::string& name) {
-    if (name == "horizontal") return LidarSpec::horizontal();
-    if (name == "spherical") return LidarSpec::spherical();
+    if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
     std::error_code ec;
     if (!std::filesystem::exists(name, ec))
-        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical' nor an existing YAML file");
+        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical', 'spherical-authors' nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }
