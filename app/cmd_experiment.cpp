@@ -11,6 +11,7 @@
 
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
@@ -251,6 +252,7 @@ void add_run(CLI::App& app) {
 
 struct PaperOptions {
     std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol;
+    std::string preset = "spec", choices;
     int seeds = 1, jobs = 0;
     std::optional<double> hours;
     double checkpoint_minutes = 0;
@@ -267,6 +269,8 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
     std::vector<double> tilts;
     for (const auto& t : split(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
+    std::vector<std::string> choices = paper_preset(o.preset).choices;
+    for (const auto& c : split(o.choices)) choices.push_back(c);
     std::vector<TrialConfig> trials;
     for (int seed = 0; seed < o.seeds; ++seed)
         for (double tilt : tilts)
@@ -275,6 +279,7 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
                 t.world = WorldSpec{"cross", tilt, "+x+y"};
                 t.model = m;
                 t.seed = static_cast<std::uint64_t>(seed);
+                apply_authors_choices(t, choices);
                 if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
                 if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
                 t.arena_extent = o.arena_extent;
@@ -293,6 +298,13 @@ void add_paper(CLI::App& app) {
     cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
     cmd->add_option("--tilts", o->tilts, "Comma-separated tilts of the cross arena, degrees")->capture_default_str();
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
+    std::string presets, choice_names;
+    for (const auto& p : paper_presets()) presets += "\n  " + p.name + ": " + p.description;
+    for (const auto& c : authors_choices()) choice_names += "\n  " + c.name + ": " + c.description;
+    cmd->add_option("--preset", o->preset, "The experiment's configuration:" + presets)->capture_default_str();
+    cmd->add_option("--authors-choices", o->choices,
+                    "Comma-separated authors' choices to switch on besides the preset's (docs/reproduction.md):" +
+                        choice_names);
     cmd->add_flag("--arena-extent", o->arena_extent, "Bin rate maps over the arena instead of each trajectory");
     cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
                     "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
@@ -314,8 +326,8 @@ void add_analyze(CLI::App& app) {
     auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files, optionally with other parameters");
     struct Options {
         std::vector<std::string> files;
-        std::optional<int> gridsize, min_samples;
-        std::optional<double> quantile, eps, d_th;
+        std::optional<int> gridsize, min_samples, skip_samples, msai_bins;
+        std::optional<double> quantile, eps, d_th, mi_quantile;
         std::string extent, cells, templates;
     };
     auto o = std::make_shared<Options>();
@@ -325,13 +337,16 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
     cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
     cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
+    cmd->add_option("--mi-quantile", o->mi_quantile, "Rate-map threshold quantile of the modality index (-1: --quantile's)");
+    cmd->add_option("--skip-samples", o->skip_samples, "Recorded samples to leave out at the start");
+    cmd->add_option("--msai-bins", o->msai_bins, "Divide SAI and MSAI by this fixed number of bins (0: each trial's own)");
     cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX, or 'data' for the trajectory's own");
     cmd->add_option("--decoding-templates", o->templates,
                     "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
     cmd->footer("Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
                 "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2,\n"
-                "decoding templates rate_maps; docs/analysis.md).");
+                "decoding templates rate_maps, mi-quantile -1, skip-samples 0, msai-bins 0; docs/analysis.md).");
     cmd->callback([o] {
         std::optional<analysis::Extent> extent;
         if (!o->extent.empty() && o->extent != "data") {
@@ -353,6 +368,9 @@ void add_analyze(CLI::App& app) {
             if (o->eps) params.dbscan.eps = *o->eps;
             if (o->min_samples) params.dbscan.min_samples = *o->min_samples;
             if (o->d_th) params.d_th = *o->d_th;
+            if (o->mi_quantile) params.mi_quantile = *o->mi_quantile;
+            if (o->skip_samples) params.skip_samples = *o->skip_samples;
+            if (o->msai_bins) params.msai_bins = *o->msai_bins;
             if (!o->templates.empty()) params.decoding_templates = analysis::parse_decoding_templates(o->templates);
             if (o->extent == "data") params.extent.reset();
             if (extent) params.extent = extent;
