@@ -3,6 +3,7 @@
 
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 
@@ -35,7 +36,9 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     t.world = WorldSpec{world, tilt_deg, t.world.lean};
     t.seed = seed;
     if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) t.agent = trajectory_of(kwargs["trajectory"]);
-    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol"});
+    if (kwargs.contains("authors_choices"))
+        apply_authors_choices(t, kwargs["authors_choices"].cast<std::vector<std::string>>());
+    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol", "authors_choices"});
     if (kwargs.contains("protocol")) t.protocol.kind = parse_protocol(pyb::str(kwargs["protocol"]));  // = kind
     t.validate();
     return t;
@@ -81,8 +84,10 @@ void bind_experiment(pyb::module_& m) {
         (R"doc(One trial at full speed, as `bvc3d run` does it, returned as numpy arrays: t, x, y, z, heading
 (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded, and
 metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset or world YAML;
-tilt_deg: for world="cross"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
-follow instead of the random walk. Protocol keywords and their defaults:
+tilt_deg: for world="cross" or "cross-webots"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
+follow instead of the random walk; authors_choices: a list of the authors' choices to switch on (as
+`bvc3d paper --authors-choices`; ["all"] for all of them; protocol keywords still apply after them).
+Protocol keywords and their defaults:
 )doc" + describe(Protocol::table(), Protocol{}))
             .c_str());
     pyb::list metrics;

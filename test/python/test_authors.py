@@ -223,3 +223,14 @@ def test_authors_robot_gives_fewer_samples_than_the_papers():
                                 bump_gaussian_turn=True, fixed_start_heading=True)
     assert authors["heading"][0] == 0.0 or authors["bumped"][0]
     assert len(authors["t"]) < 0.97 * len(paper["t"])
+
+
+def test_run_trial_with_authors_choices_equals_the_cli(tmp_path):
+    out = tmp_path / "cli"
+    run_cli("paper", "--preset", "authors", "--hours", 0.03, "--tilts", "30", "--models", "3d-0.2", "--no-report",
+            "--out", out, check=True)
+    r = bvc3d.run_trial(model="3d-0.2", world="cross", tilt_deg=30, seed=0, authors_choices=["all"], sample_hours=0.03)
+    assert r["name"] == "cross-webots-30_3d-0.2-authors_seed0"
+    with h5py.File(out / (r["name"] + ".h5")) as f:
+        assert np.array_equal(f["samples/rates"][:], r["rates"]) and np.array_equal(f["samples/x"][:], r["x"])
+        assert f["metrics"].attrs["msai"] == r["metrics"]["msai"]
