@@ -17,6 +17,7 @@
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/config/sweep_yaml.hpp"
@@ -379,6 +380,7 @@ void add_run(CLI::App& app) {
 
 struct PaperOptions {
     std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol, extent;
+    std::string preset = "spec", choices;
     int seeds = 1, jobs = 0;
     std::optional<double> hours;
     double checkpoint_minutes = 0;
@@ -393,6 +395,8 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
     std::vector<double> tilts;
     for (const auto& t : split(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
+    std::vector<std::string> choices = paper_preset(o.preset).choices;
+    for (const auto& c : split(o.choices)) choices.push_back(c);
     const double n_trials = static_cast<double>(o.seeds) * static_cast<double>(models.size()) * static_cast<double>(tilts.size());
     if (o.seeds < 1) throw InputError("--seeds must be >= 1, got " + std::to_string(o.seeds));
     if (n_trials > config::max_trials)
@@ -409,6 +413,7 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
                 t.world = WorldSpec{"cross", tilt, "+x+y"};
                 t.model = m;
                 t.seed = static_cast<std::uint64_t>(seed);
+                apply_authors_choices(t, choices);
                 if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
                 if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
                 apply_extent(extent, t);
@@ -427,6 +432,13 @@ void add_paper(CLI::App& app) {
     cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
     cmd->add_option("--tilts", o->tilts, "Comma-separated tilts of the cross arena, degrees")->capture_default_str();
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
+    std::string presets, choice_names;
+    for (const auto& p : paper_presets()) presets += "\n  " + p.name + ": " + p.description;
+    for (const auto& c : authors_choices()) choice_names += "\n  " + c.name + ": " + c.description;
+    cmd->add_option("--preset", o->preset, "The experiment's configuration:" + presets)->capture_default_str();
+    cmd->add_option("--authors-choices", o->choices,
+                    "Comma-separated authors' choices to switch on besides the preset's (docs/reproduction.md):" +
+                        choice_names);
     cmd->add_option("--extent", o->extent, extent_help);
     cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
                     "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
@@ -455,8 +467,8 @@ void add_analyze(CLI::App& app) {
     auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files, optionally with other parameters");
     struct Options {
         std::vector<std::string> files;
-        std::optional<int> gridsize, min_samples;
-        std::optional<double> quantile, eps, d_th;
+        std::optional<int> gridsize, min_samples, skip_samples, msai_bins;
+        std::optional<double> quantile, eps, d_th, mi_quantile;
         std::string extent, cells, templates;
     };
     auto o = std::make_shared<Options>();
@@ -466,13 +478,17 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
     cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
     cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
+    cmd->add_option("--mi-quantile", o->mi_quantile, "Rate-map threshold quantile of the modality index (-1: --quantile's)");
+    cmd->add_option("--skip-samples", o->skip_samples, "Recorded samples to leave out at the start");
+    cmd->add_option("--msai-bins", o->msai_bins, "Divide SAI and MSAI by this fixed number of bins (0: each trial's own)");
     cmd->add_option("--extent", o->extent, extent_help);
     cmd->add_option("--decoding-templates", o->templates,
                     "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
     cmd->footer("Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
                 "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20 (10 for flying agents'\n"
-                "3-D files), d-th 2, decoding templates rate_maps; docs/analysis.md, docs/flying.md).");
+                "3-D files), d-th 2, decoding templates rate_maps, mi-quantile -1, skip-samples 0, msai-bins 0;\n"
+                "docs/analysis.md, docs/flying.md).");
     cmd->callback([o] {
         const bool new_extent = !o->extent.empty();
         const ExtentOption extent = parse_extent(new_extent ? o->extent : "data");
@@ -495,6 +511,9 @@ void add_analyze(CLI::App& app) {
             if (o->eps) set("eps", *o->eps);
             if (o->min_samples) set("min_samples", static_cast<long long>(*o->min_samples));
             if (o->d_th) set("d_th", *o->d_th);
+            if (o->mi_quantile) set("mi_quantile", *o->mi_quantile);
+            if (o->skip_samples) set("skip_samples", static_cast<long long>(*o->skip_samples));
+            if (o->msai_bins) set("msai_bins", static_cast<long long>(*o->msai_bins));
             if (!o->templates.empty()) p.decoding_templates = analysis::parse_decoding_templates(o->templates);
             if (new_extent) {
                 p.extent.reset();

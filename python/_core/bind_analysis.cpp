@@ -51,6 +51,9 @@ pyb::dict decoding_dict(const an::DecodingResult& d) {
     r["mean_m"] = d.mean_m;
     r["n_decoded"] = d.n_decoded;
     r["n_undecoded"] = d.n_undecoded;
+    r["frac_undecoded"] = d.frac_undecoded();
+    r["median_all_m"] = d.median_all_m;
+    r["mean_all_m"] = d.mean_all_m;
     return r;
 }
 
@@ -161,7 +164,8 @@ void bind_sample_functions(pyb::module_& a) {
     a.def(
         "analyze",
         [](const ArrayD& x, const ArrayD& y, const Array<T>& rates, int gridsize, double quantile, double eps,
-           int min_samples, double d_th, const MaybeExtent& extent, const std::string& decoding_templates) {
+           int min_samples, double d_th, const MaybeExtent& extent, const std::string& decoding_templates,
+           double mi_quantile, int skip_samples, int msai_bins) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
             an::AnalysisParams params;
@@ -171,6 +175,9 @@ void bind_sample_functions(pyb::module_& a) {
             params.d_th = d_th;
             params.extent = extent_of(extent);
             params.decoding_templates = an::parse_decoding_templates(decoding_templates);
+            params.mi_quantile = mi_quantile;
+            params.skip_samples = skip_samples;
+            params.msai_bins = msai_bins;
             an::TrialMetrics m;
             interruptible([&](const std::atomic<bool>&) {
                 m = an::analyze_trial<T>(xs, ys, r, params);
@@ -191,7 +198,7 @@ void bind_sample_functions(pyb::module_& a) {
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
         pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"),
-        pyb::arg("decoding_templates"));
+        pyb::arg("decoding_templates"), pyb::arg("mi_quantile"), pyb::arg("skip_samples"), pyb::arg("msai_bins"));
 }
 
 // 3-D (flying agents): voxel rate maps and the whole analysis of N × 3 positions.

@@ -4,6 +4,7 @@
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 
@@ -56,7 +57,9 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
         if (flying) throw InputError("give agent='flight' or trajectory=, not both");
         t.set_agent(trajectory_of(kwargs["trajectory"]));
     }
-    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol", "agent", "flight"});
+    if (kwargs.contains("authors_choices"))
+        apply_authors_choices(t, kwargs["authors_choices"].cast<std::vector<std::string>>());
+    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol", "agent", "flight", "authors_choices"});
     if (kwargs.contains("protocol")) t.protocol.kind = parse_protocol(pyb::str(kwargs["protocol"]));  // = kind
     t.validate();
     t.agent->check_world(t.world.resolve());
@@ -103,10 +106,12 @@ void bind_experiment(pyb::module_& m) {
         (R"doc(One trial at full speed, as `bvc3d run` does it, returned as numpy arrays: t, x, y, z, heading
 (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded, and
 metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset or world YAML;
-tilt_deg: for world="cross"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
+tilt_deg: for world="cross" or "cross-webots"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
 follow instead of the random walk; agent="flight" for the flying agent (docs/flying.md: a fly-*
 model, a world with a flight volume, 8 h + 8 h unless given, 3-D metrics), with flight=dict(...)
-for its parameters (see flying_walk). Protocol keywords and their defaults:
+for its parameters (see flying_walk); authors_choices: a list of the authors' choices to switch on (as
+`bvc3d paper --authors-choices`; ["all"] for all of them; protocol keywords still apply after them).
+Protocol keywords and their defaults:
 )doc" + describe(Protocol::table(), Protocol{}))
             .c_str());
     pyb::list metrics;

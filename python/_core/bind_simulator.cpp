@@ -58,6 +58,8 @@ Sensor.horizontal() and Sensor.spherical() are the paper's two scanners; Sensor(
         .def_static("horizontal", &LidarSpec::horizontal, "The paper's 2-D scanner: 720 beams at 0.08 m")
         .def_static("spherical", &LidarSpec::spherical, pyb::arg("upper_only") = true,
                     "The paper's 90×180 range image at 0.18 m; upper_only keeps rows 0-44 (elevation > 0)")
+        .def_static("spherical_as_authors", &LidarSpec::spherical_as_authors, pyb::arg("upper_only") = true,
+                    "The spherical image labeled as the authors' code labels it (angle labels, whole-column heading roll)")
         .def_static("from_yaml", &config::resolve_sensor, pyb::arg("path"))
         .def_property_readonly("beam_count", &LidarSpec::beam_count)
         .def("__repr__", [](const LidarSpec& s) {
@@ -83,8 +85,10 @@ void bind_world(pyb::module_& m) {
             "from_yaml", [](const std::filesystem::path& path) { return World(config::load_world_file(path.string())); },
             pyb::arg("path"))
         .def_static(
-            "preset", [](const std::string& name) { return World(config::resolve_world(name)); },
-            pyb::arg("name"), "A preset name (cross, cross-30, ..., flight-room, atrium) or a world YAML file")
+            "preset",
+            [](const std::string& name, std::optional<double> tilt_deg) { return World(config::resolve_world(name, tilt_deg)); },
+            pyb::arg("name"), pyb::arg("tilt_deg") = pyb::none(),
+            "A preset name (cross, cross-30, ..., cross-webots, flight-room, atrium) or a world YAML file; tilt_deg for cross and cross-webots")
         .def_property_readonly("name", &World::name)
         .def_property_readonly("triangles",
                                [](const World& w) {
@@ -150,13 +154,18 @@ void bind_simulator(pyb::module_& m) {
     bind_world(m);
     m.def(
         "random_walk",
-        [](const World& w, double hours, const pyb::object& seed) {
+        [](const World& w, double hours, const pyb::object& seed, const pyb::kwargs& robot) {
             const std::uint64_t s = seed_of(seed, "seed");
-            const auto steps = interruptible([&](const std::atomic<bool>&) { return random_walk(w, hours, s); });
+            RobotParams p;
+            apply_kwargs(p, RobotParams::table(), robot);
+            const auto steps = interruptible([&](const std::atomic<bool>&) { return random_walk(w, hours, s, p); });
             return steps_to_dict(steps);
         },
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
-        "The paper's random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step");
+        ("The random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step (x, y, heading\n"
+         "where the model sees the world from). Robot keywords and their defaults (the paper's robot):\n" +
+         describe(RobotParams::table(), RobotParams{}))
+            .c_str());
     m.def(
         "flying_walk",
         [](const World& w, double hours, std::uint64_t seed, const pyb::kwargs& kwargs) {

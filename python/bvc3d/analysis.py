@@ -120,6 +120,12 @@ def _d_th(d_th):
 _TEMPLATES = ("rate_maps", "means")
 
 
+def _count(n, name):
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+        raise ValueError(f"{name} must be an integer >= 0, got {n!r}")
+    return int(n)
+
+
 def _templates(templates, name="templates"):
     if templates not in _TEMPLATES:
         raise ValueError(f"{name} must be 'rate_maps' or 'means', got {templates!r}")
@@ -232,11 +238,14 @@ def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, template
     Each sample of the second half is decoded to the bin whose template is most cosine-similar to
     the sample's rates (ties: first bin in matplotlib's order); its error is the distance from its
     true position to that bin's center. Samples with no positive similarity to any template (e.g.
-    all cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of the
-    statistics. Needs at least 2 samples (ValueError otherwise; ``analyze`` copes with fewer).
+    all cells silent) are not decoded: they are counted in ``n_undecoded`` and left out of
+    ``median_m`` and ``mean_m``. ``median_all_m`` and ``mean_all_m`` count them at chance: the mean
+    distance from the sample's true position to the first half's template bins, each weighted by the
+    number of first-half samples in it. Needs at least 2 samples (ValueError otherwise; ``analyze``
+    copes with fewer).
 
     Returns a dict: ``median_m``, ``mean_m`` (NaN if nothing was decoded), ``n_decoded``,
-    ``n_undecoded``.
+    ``n_undecoded``, ``frac_undecoded``, ``median_all_m``, ``mean_all_m``.
     """
     x, y = _positions(x, y)
     r, _ = _samples(rates, len(x), "rates")
@@ -263,13 +272,18 @@ def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
 
 
 def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_th=2.0, extent=None,
-            decoding_templates="rate_maps"):
+            decoding_templates="rate_maps", mi_quantile=None, skip_samples=0, msai_bins=0):
     """Every metric of one trial in one call (the C++ entry point the experiment uses).
 
     Returns a dict: ``centers``, ``counts``, ``mean_maps``, ``maps``, ``bin_area_m2``,
     ``modality``, ``modality_summary`` (dict), ``sai``, ``msai``, ``decoding`` (dict as
     ``decoding_error(..., quantile=quantile, templates=decoding_templates)``; same grid as the
     maps), ``cells`` (dict as ``cell_stats``).
+
+    The authors' conventions (docs/reproduction.md), off by default: ``mi_quantile`` thresholds the
+    maps the modality index is counted on at its own quantile (None: ``quantile``);
+    ``skip_samples`` drops that many samples at the start before anything else; ``msai_bins`` > 0
+    divides SAI and MSAI by that fixed number of bins instead of the number of bins (their 2662).
 
     Any number of samples is accepted: with none there are no bins (every MI 0, MSAI NaN, cell
     statistics NaN); with fewer than 2 nothing is decoded (NaN errors, ``n_decoded`` 0,
@@ -279,7 +293,9 @@ def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_t
     r, _ = _samples(rates, len(x), "rates")
     eps, min_samples = _dbscan_params(eps, min_samples)
     out = dict(_an.analyze(x, y, r, _gridsize(gridsize), _quantile(quantile), eps, min_samples, _d_th(d_th),
-                           _extent(extent), _templates(decoding_templates, "decoding_templates")))
+                           _extent(extent), _templates(decoding_templates, "decoding_templates"),
+                           -1.0 if mi_quantile is None else _quantile(mi_quantile), _count(skip_samples, "skip_samples"),
+                           _count(msai_bins, "msai_bins")))
     out["decoding"] = dict(out["decoding"])
     out["modality_summary"] = dict(out["modality_summary"])
     out["cells"] = dict(out["cells"])

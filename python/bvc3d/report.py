@@ -589,6 +589,9 @@ def make_report(path):
     add("decoding.png", "Median position error when each sample of the second half is decoded to the cosine-"
         f"nearest rate-map bin of the first half: the direct measure of localization. {bars}",
         lambda p: fig_bars(folder, "decode_median_m", p))
+    add("decoding_coverage.png", "Fraction of second-half samples the decoder could not place (no positive similarity "
+        f"to any template): the decoding errors above leave them out. {bars}",
+        lambda p: fig_bars(folder, "frac_undecoded", p))
     write_report(folder, figures)
     return figures
 

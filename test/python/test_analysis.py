@@ -417,7 +417,7 @@ def dense_decoder(x, y, rates, templates="rate_maps", quantile=0.1, gridsize=50)
     n = len(x)
     half = n // 2
     ext = (x.min(), x.max(), y.min(), y.max())
-    centers, means, _ = A.hexbin(x[:half], y[:half], rates[:half].astype(np.float64), gridsize, ext)
+    centers, means, counts = A.hexbin(x[:half], y[:half], rates[:half].astype(np.float64), gridsize, ext)
     tmpl = numpy_rate_maps(means, quantile) if templates == "rate_maps" else means
     norms = np.linalg.norm(tmpl, axis=1, keepdims=True)
     unit = np.divide(tmpl, norms, out=np.zeros_like(tmpl), where=norms > 0)
@@ -425,8 +425,12 @@ def dense_decoder(x, y, rates, templates="rate_maps", quantile=0.1, gridsize=50)
     best = scores.argmax(axis=1)
     ok = scores.max(axis=1) > 0
     dx, dy = x[half:] - centers[best, 0], y[half:] - centers[best, 1]
-    err = np.sqrt(dx * dx + dy * dy)[ok]
-    return np.median(err), err.mean(), ok.sum(), (~ok).sum()
+    err = np.sqrt(dx * dx + dy * dy)
+    # Chance for an undecoded sample: its mean distance to the template bins, weighted by occupancy.
+    dist = np.hypot(x[half:, None] - centers[None, :, 0], y[half:, None] - centers[None, :, 1])
+    chance = dist @ counts / counts.sum()
+    every = np.where(ok, err, chance)
+    return np.median(err[ok]), err[ok].mean(), ok.sum(), (~ok).sum(), np.median(every), every.mean()
 
 
 # sparse rates, and dense ones (the blocked-product path); a quantile that removes nothing (0.1,
@@ -440,10 +444,32 @@ def test_decoding_matches_a_dense_numpy_decoder(floor, quantile, templates):
         rates += np.float32(1e-3) * np.random.default_rng(7).random(rates.shape, dtype=np.float32)
     rates[len(x) // 2 + 5] = 0  # a silent sample is not decoded
     d = A.decoding_error(x, y, rates, quantile=quantile, templates=templates)
-    med, mean, n_ok, n_bad = dense_decoder(x, y, rates, templates, quantile)
+    med, mean, n_ok, n_bad, med_all, mean_all = dense_decoder(x, y, rates, templates, quantile)
     assert d["n_decoded"] == n_ok and d["n_undecoded"] == n_bad and n_bad >= 1
     assert d["median_m"] == pytest.approx(med, abs=1e-9)
     assert d["mean_m"] == pytest.approx(mean, abs=1e-9)
+    assert d["frac_undecoded"] == n_bad / (n_ok + n_bad)
+    assert d["median_all_m"] == pytest.approx(med_all, abs=1e-9)
+    assert d["mean_all_m"] == pytest.approx(mean_all, abs=1e-9)
+
+
+def test_undecoded_samples_count_at_chance():
+    """Silencing a third of the second half: those samples count at their occupancy-weighted chance
+    error, which is far worse than decoding, so the error over all samples rises."""
+    x, y = walk(0, 1.0, 12)
+    rates = place_population(x, y, 100, np.random.default_rng(12), sigma=0.6)
+    rates += np.float32(1e-3)  # every cell a little active: every sample decodes
+    half = len(x) // 2
+    full = A.decoding_error(x, y, rates)
+    assert full["n_undecoded"] == 0 and full["frac_undecoded"] == 0
+    assert full["median_all_m"] == full["median_m"] and full["mean_all_m"] == full["mean_m"]
+    rates[half::3] = 0
+    d = A.decoding_error(x, y, rates)
+    _, _, n_ok, n_bad, med_all, mean_all = dense_decoder(x, y, rates)
+    assert d["n_undecoded"] == n_bad == len(range(half, len(x), 3))
+    assert d["frac_undecoded"] == pytest.approx(1 / 3, abs=0.01)
+    assert d["mean_all_m"] == pytest.approx(mean_all, abs=1e-9) and d["median_all_m"] == pytest.approx(med_all, abs=1e-9)
+    assert d["mean_all_m"] > d["mean_m"] + 1.0  # chance in a 10 m arena is metres, decoding is decimetres
 
 
 def test_decoding_default_templates_are_the_spec_rate_maps():
@@ -451,18 +477,18 @@ def test_decoding_default_templates_are_the_spec_rate_maps():
     x, y = walk(45, 1.0, 8)
     rates = place_population(x, y, 120, np.random.default_rng(8), sigma=0.7)  # peak rates 0.3-1: scaling matters
     d = A.decoding_error(x, y, rates)
-    med, mean, n_ok, n_bad = dense_decoder(x, y, rates, "rate_maps", 0.1)
+    med, mean, n_ok, n_bad, _, _ = dense_decoder(x, y, rates, "rate_maps", 0.1)
     assert (d["n_decoded"], d["n_undecoded"]) == (n_ok, n_bad)
     assert abs(d["median_m"] - med) < 1e-9 and abs(d["mean_m"] - mean) < 1e-9
     assert d == A.decoding_error(x, y, rates, templates="rate_maps", quantile=0.1)
     # ... and not the raw means: the per-cell normalization changes which bins win.
-    med_m, mean_m, _, _ = dense_decoder(x, y, rates, "means")
+    med_m, mean_m, _, _, _, _ = dense_decoder(x, y, rates, "means")
     assert abs(mean - mean_m) > 1e-6
     means = A.decoding_error(x, y, rates, templates="means")
     assert abs(means["mean_m"] - mean_m) < 1e-9
     # The quantile is the rate maps' quantile.
     q = A.decoding_error(x, y, rates, quantile=0.97)
-    med_q, mean_q, _, _ = dense_decoder(x, y, rates, "rate_maps", 0.97)
+    med_q, mean_q, _, _, _, _ = dense_decoder(x, y, rates, "rate_maps", 0.97)
     assert abs(q["median_m"] - med_q) < 1e-9 and abs(q["mean_m"] - mean_q) < 1e-9 and abs(mean_q - mean) > 1e-6
 
 

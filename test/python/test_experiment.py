@@ -71,7 +71,8 @@ def test_summary_has_sixteen_rows(paper_dir):
 def test_figures_and_report(paper_dir):
     expected = {  # width, height in pixels (figure inches x 120 dpi)
         "mi_active.png": (840, 432), "mi_mean.png": (840, 432), "mi_multimodal.png": (840, 432),
-        "msai.png": (840, 432), "decoding.png": (840, 432), "trajectory.png": (552, 552),
+        "msai.png": (840, 432), "decoding.png": (840, 432), "decoding_coverage.png": (840, 432),
+        "trajectory.png": (552, 552),
         "place_fields.png": (1008, 480), "sai_grid.png": (1344, 1200), "environments.png": (1632, 432),
     }
     for name, size in expected.items():

@@ -1,12 +1,18 @@
 """Results do not move unless a change means them to: `bvc3d paper --hours 0.5` (all four models in
 all four arenas) must write trial files whose every dataset and attribute equals, bit for bit, those
-recorded in test/data/paper-0.5h-digests.json (only `format_version` may change).
+recorded in test/data/paper-0.5h-digests.json and its additions (only `format_version` may change).
 
-The digests were taken from the files of the code before the architecture refactor. A change that is
-meant to move results (and says so in docs/performance.md or the reproduction notes) regenerates
-them with
+The digests of test/data/paper-0.5h-digests.json were taken from the files of the code before the
+architecture refactor. A change that adds datasets or attributes without moving any (a new metric, a
+new analysis parameter recorded with the metrics) records the new ones in a file of their own,
+test/data/paper-0.5h-digests.<what>.json, so that the earlier digests stay as they were and still
+must match:
+    PYTHONPATH=build/python /usr/bin/python3 test/python/test_regression.py --add WHAT RESULTS_DIR
+A change that is meant to move results (and says so in docs/performance.md or the reproduction
+notes) regenerates every digest file with
     PYTHONPATH=build/python /usr/bin/python3 test/python/test_regression.py --write RESULTS_DIR
-where RESULTS_DIR holds the files of `build/bvc3d paper --hours 0.5 --no-report --out RESULTS_DIR`.
+RESULTS_DIR holds the files of `build/bvc3d paper --hours 0.5 --no-report --out RESULTS_DIR`. No key
+may be recorded in two files.
 """
 import hashlib
 import json
@@ -16,7 +22,8 @@ import sys
 import h5py
 import numpy as np
 
-DIGESTS = pathlib.Path(__file__).resolve().parents[1] / "data" / "paper-0.5h-digests.json"
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+DIGESTS = DATA / "paper-0.5h-digests.json"
 IGNORED = {"/@format_version"}
 
 
@@ -47,11 +54,28 @@ def folder_digests(folder):
     return {p.name: file_digests(p) for p in sorted(pathlib.Path(folder).glob("*.h5"))}
 
 
+def digest_files():
+    """The base file first, then the additions in name order."""
+    return [DIGESTS] + sorted(DATA.glob("paper-0.5h-digests.*.json"))
+
+
+def recorded_digests():
+    """{trial file: {key: digest}} over every digest file; a key recorded twice is an error."""
+    merged, origin = {}, {}
+    for path in digest_files():
+        for name, keys in json.loads(path.read_text()).items():
+            for key, digest in keys.items():
+                assert (name, key) not in origin, f"{name}: {key} is recorded in {origin[name, key]} and {path.name}"
+                origin[name, key] = path.name
+                merged.setdefault(name, {})[key] = digest
+    return merged
+
+
 def test_paper_half_hour_is_bit_identical(tmp_path):
     from conftest import run_cli
     out = tmp_path / "paper"
     run_cli("paper", "--hours", 0.5, "--no-report", "--jobs", 2, "--out", out, check=True)
-    expected = json.loads(DIGESTS.read_text())
+    expected = recorded_digests()
     got = folder_digests(out)
     assert sorted(got) == sorted(expected), "a different set of trial files"
     differences = [f"{name}: {key}" for name in expected for key in sorted(set(expected[name]) | set(got[name]))
@@ -59,8 +83,24 @@ def test_paper_half_hour_is_bit_identical(tmp_path):
     assert not differences, "results moved:\n" + "\n".join(differences[:40])
 
 
+def write(path, digests):
+    path.write_text(json.dumps(digests, indent=0, sort_keys=True) + "\n")
+    print(f"wrote {path}")
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 3 or sys.argv[1] != "--write":
+    if len(sys.argv) == 3 and sys.argv[1] == "--write":
+        got = folder_digests(sys.argv[2])
+        claimed = set()
+        for path in digest_files()[1:]:  # each addition keeps its keys; the base file takes the rest
+            keys = {(n, k) for n, ks in json.loads(path.read_text()).items() for k in ks}
+            claimed |= keys
+            write(path, {n: {k: d for k, d in ks.items() if (n, k) in keys} for n, ks in got.items()})
+        write(DIGESTS, {n: {k: d for k, d in ks.items() if (n, k) not in claimed} for n, ks in got.items()})
+    elif len(sys.argv) == 4 and sys.argv[1] == "--add":
+        recorded = recorded_digests()
+        new = {n: {k: d for k, d in ks.items() if k not in recorded.get(n, {})}
+               for n, ks in folder_digests(sys.argv[3]).items()}
+        write(DATA / f"paper-0.5h-digests.{sys.argv[2]}.json", {n: ks for n, ks in new.items() if ks})
+    else:
         raise SystemExit(__doc__)
-    DIGESTS.write_text(json.dumps(folder_digests(sys.argv[2]), indent=0, sort_keys=True) + "\n")
-    print(f"wrote {DIGESTS}")

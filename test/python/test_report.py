@@ -127,6 +127,7 @@ def metric_values(model, tilt, seed, n_seeds):
         "msai": 0.03 if last or n_seeds == 1 else 0.0,
         "decode_median_m": 0.0 if (model == 0 and tilt == 60) else (1e-4 if model == 2 else 0.3 + 0.01 * seed),
         "decode_mean_m": 1.0, "n_bins": 30.0, "n_decoded": 90.0, "n_undecoded": 10.0,
+        "frac_undecoded": 0.1 + 0.01 * seed, "decode_median_all_m": 0.4 + 0.01 * seed, "decode_mean_all_m": 1.5,
     }
 
 

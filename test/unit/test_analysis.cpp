@@ -200,6 +200,10 @@ TEST(AnalysisAliasing, MatchesDoubleLoop) {
     }
     EXPECT_NEAR(res.msai, total / n, 1e-12);
     EXPECT_EQ(res.sai(7), 0.0);
+    // A fixed number of bins (the authors' 2662): SAI_i = Σ cos / 2662, MSAI = Σ_i Σ_j cos / 2662².
+    const AliasingResult fixed = spatial_aliasing(c, m, 2.0, 2662);
+    for (int i = 0; i < n; ++i) EXPECT_NEAR(fixed.sai(i), res.sai(i) * n / 2662, 1e-12);
+    EXPECT_NEAR(fixed.msai, total * n / (2662.0 * 2662.0), 1e-12);
 }
 
 TEST(AnalysisDecoding, GaussianPlaceFieldsDecodeWell) {

@@ -99,7 +99,9 @@ TEST(BoundaryVectorLayer, MatchesTheEquationsOnRealScansOfEveryPaperWorld) {
 
 TEST(BoundaryVectorLayer, PrunedScanningGivesTheSameRates) {
     const World world = World::cross({.tilt_deg = 45});
-    for (const char* name : {"3d-0.1", "3d-0.2", "3d-3l"}) {
+    // The authors' image labels too: plans read the rows' labels, and the bound allows for linspace's
+    // repeated azimuth.
+    for (const char* name : {"3d-0.1", "3d-0.2", "3d-3l", "3d-0.1-authors", "3d-0.2-authors", "3d-3l-authors"}) {
         const ModelSpec m = model_preset(name);
         const BoundaryVectorLayer layer(m.bvc);
         const Lidar lidar(m.sensor);

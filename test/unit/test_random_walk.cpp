@@ -297,3 +297,116 @@ TEST(RandomWalk, AJammedRobotIsAnErrorNotAHang) {
     fast.turn_rate = 1e6;  // turns take no time: without the jam check this would never end
     EXPECT_THROW(random_walk(World(w), 1.0, 0, fast), InputError);
 }
+
+// The authors' robot (docs/reproduction.md#the-authors-configuration): turns last whole 96 ms
+// control steps at 1.83 rad/s and overshoot their target by less than one step; a bump draws a
+// uniform heading and then makes the Gaussian turn too; the start heading is fixed.
+TEST(RandomWalk, AuthorsRobotTurnsInWholeControlSteps) {
+    const World world = World::cross(CrossArenaParams::webots(30));
+    const RobotParams p = RobotParams::authors();
+    auto body = std::make_shared<const BodyCollider>(world.description(), p.radius, p.height);
+    Rng rng(5, Stream::walk);
+    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    RandomWalk walk(body, p, rng, start);
+    std::vector<TurnEvent> log;
+    walk.log_turns(&log);
+    std::vector<ModelStep> steps;
+    while (auto s = walk.next(3 * 3600.0)) steps.push_back(*s);
+
+    const double per_step = 1.83 * 0.096;
+    std::size_t turns = 0, overshoots = 0, mismatched = 0;
+    for (std::size_t i = 0; i + 1 < steps.size(); ++i) {
+        const auto &a = steps[i], &b = steps[i + 1];
+        if (a.bumped || b.bumped || a.pose.heading == b.pose.heading) continue;
+        // A Gaussian turn between two full steps: k whole control steps, k · 1.83 · 0.096 rad.
+        // (A turn that runs into a wall at once adds an unrecorded bump in between: rare.)
+        const double k = (b.t - a.t - p.model_dt) / 0.096;
+        if (std::abs(k - std::round(k)) > 1e-6 || std::round(k) < 1) {
+            ++mismatched;
+            continue;
+        }
+        const double turned = std::abs(wrap_pi(b.pose.heading - a.pose.heading));
+        if (std::round(k) * per_step < pi - per_step) {
+            EXPECT_NEAR(turned, std::round(k) * per_step, 1e-9) << i;
+            ++turns;
+        }
+    }
+    EXPECT_GT(turns, 500u);
+    EXPECT_LT(mismatched, steps.size() / 500);
+    // Each drawn Gaussian turn is overshot by [0, one step): the realized turns' overshoots, read off
+    // the log (a Gaussian turn d realizes ceil(|d| / step) steps), are spread over the step.
+    for (const auto& e : log)
+        if (e.kind == TurnEvent::Kind::gaussian && std::abs(e.drawn) < pi - per_step) {
+            const double over = std::ceil(std::abs(e.drawn) / per_step) * per_step - std::abs(e.drawn);
+            ASSERT_GE(over, 0.0);
+            ASSERT_LT(over, per_step);
+            overshoots += over > per_step / 2;
+        }
+    EXPECT_GT(overshoots, 300u);
+    // Every bump's uniform heading is followed by a Gaussian turn.
+    std::size_t bumps = 0;
+    for (std::size_t i = 0; i + 1 < log.size(); ++i)
+        if (log[i].kind == TurnEvent::Kind::bump) {
+            ++bumps;
+            EXPECT_EQ(log[i + 1].kind, TurnEvent::Kind::gaussian) << i;
+        }
+    EXPECT_GT(bumps, 200u);
+}
+
+TEST(RandomWalk, FixedStartHeadingKeepsTheDrawnStartPoint) {
+    const World world = World::cross();
+    RobotParams fixed;
+    fixed.fixed_start_heading = true;
+    fixed.start_heading = 1.25;
+    for (std::uint64_t seed = 0; seed < 8; ++seed) {
+        auto a = RandomWalkSpec().make(world, seed), b = RandomWalkSpec(fixed).make(world, seed);
+        const auto& wa = dynamic_cast<const RandomWalk&>(*a);
+        const auto& wb = dynamic_cast<const RandomWalk&>(*b);
+        EXPECT_EQ(wb.pose().heading, 1.25);
+        EXPECT_EQ(wa.pose().x, wb.pose().x);
+        EXPECT_EQ(wa.pose().y, wb.pose().y);
+    }
+}
+
+// With a logging lag the walk is the same and each step is logged where the robot is `lag` seconds
+// later. Oracle: the path rebuilt from the steps alone: between two steps the robot turns in place,
+// then drives straight to the next step at 0.5 m/s (bump moves of < 1 mm that update nothing are
+// the only thing it cannot see).
+TEST(RandomWalk, LogLagLogsWhereTheRobotIsLater) {
+    const World world = World::cross({.tilt_deg = 45});
+    RobotParams lagged;
+    lagged.log_lag = 0.192;
+    const auto plain = random_walk(world, 1.0, 8), steps = random_walk(world, 1.0, 8, lagged);
+    ASSERT_EQ(plain.size(), steps.size());
+    const auto position_at = [&](double t, std::size_t from) {
+        for (std::size_t j = from; j + 1 < steps.size(); ++j) {
+            const auto &a = steps[j], &b = steps[j + 1];
+            if (t > b.t) continue;
+            const double d = std::hypot(b.pose.x - a.pose.x, b.pose.y - a.pose.y), t_go = b.t - d / 0.5;
+            if (t <= t_go) return std::pair{a.pose.x, a.pose.y};
+            const double f = (t - t_go) / (b.t - t_go);
+            return std::pair{a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y)};
+        }
+        return std::pair{double(NAN), double(NAN)};
+    };
+    std::size_t exact = 0, checked = 0, moved = 0, still = 0;
+    for (std::size_t i = 0; i + 2 < steps.size(); ++i) {
+        ASSERT_EQ(steps[i].pose.x, plain[i].pose.x);
+        ASSERT_EQ(steps[i].t, plain[i].t);
+        ASSERT_TRUE(steps[i].logged_pose.has_value());
+        const auto& logged = *steps[i].logged_pose;
+        EXPECT_EQ(logged.heading, steps[i].pose.heading);  // only the position lags
+        const auto [x, y] = position_at(steps[i].t + 0.192, i);
+        const double err = std::hypot(logged.x - x, logged.y - y);
+        ASSERT_LT(err, 2e-3) << i;
+        exact += err < 1e-9;
+        ++checked;
+        const double shift = std::hypot(logged.x - steps[i].pose.x, logged.y - steps[i].pose.y);
+        moved += std::abs(shift - 0.096) < 1e-9;
+        still += shift == 0;
+    }
+    EXPECT_GT(exact, checked * 99 / 100);
+    EXPECT_GT(moved, checked / 2);  // most steps are followed by straight driving: 0.192 s × 0.5 m/s
+    EXPECT_GT(still, checked / 50);  // turns longer than the lag
+    EXPECT_FALSE(plain[0].logged_pose.has_value());
+}

@@ -1,6 +1,7 @@
 // Worlds from YAML and mesh files, and the errors bad ones give (file, key, reason).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -94,6 +95,28 @@ TEST(WorldYaml, PresetsAndShippedPaperWorldsAgree) {
     }
     EXPECT_THROW(config::resolve_world("cross-30", 45.0), InputError);
     EXPECT_THROW(config::resolve_world("atlantis"), InputError);
+}
+
+// The authors' Webots arena: inner faces of the 0.3 m outer walls (centered on ±5 m) at ±4.85 m, the
+// ceiling's underside at 2.25 m (a 0.3 m slab on 2.4 m walls), the central cross as the paper's.
+TEST(WorldYaml, WebotsCrossHasTheAuthorsGeometry) {
+    const World w(config::resolve_world("cross-webots", 45.0));
+    EXPECT_EQ(w.name(), "cross-webots-45");
+    EXPECT_EQ(w.description().tilt_deg, 45.0);
+    for (const Vec3& dir : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)})
+        EXPECT_NEAR(w.rays().cast(Vec3(4.2 * dir.x() + 0.1 * dir.y(), 4.2 * dir.y() + 0.1 * dir.x(), 1.0), dir, 20),
+                    0.65, 1e-9);
+    EXPECT_NEAR(w.rays().cast(Vec3(-4.5, 4.5, 0.2), Vec3::UnitZ(), 20), 2.05, 1e-9);
+    EXPECT_NEAR(w.description().walkable.area(), 9.7 * 9.7, 1e-9);
+    // The central walls as the paper's arena has them, tops displaced by 2.25·tan 45° toward +x,+y:
+    // wall A (along x) at height z spans |y - z| <= 0.15·√2, so a ray along +y at x = 2, z = 1 from
+    // y = -2 meets it at y = 1 - 0.15·√2, 7 m long (|x| <= 3.5) with 1.35 m gaps to the outer walls.
+    EXPECT_NEAR(w.rays().cast(Vec3(2, -2, 1), Vec3::UnitY(), 20), 3 - 0.15 * std::sqrt(2.0), 1e-9);
+    EXPECT_NEAR(w.rays().cast(Vec3(3.6, -2, 1), Vec3::UnitY(), 20), 6.85, 1e-9);
+    EXPECT_EQ(config::world_preset_takes_tilt("cross-webots"), true);
+    EXPECT_EQ(config::world_preset_takes_tilt("cross-30"), false);
+    // The paper's arena is unchanged.
+    EXPECT_NEAR(World(config::resolve_world("cross", 0.0)).rays().cast(Vec3(4, 1, 1), Vec3::UnitX(), 20), 1.0, 1e-9);
 }
 
 TEST(MeshImport, EveryFormatLoadsThePanel) {

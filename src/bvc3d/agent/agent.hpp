@@ -24,6 +24,10 @@ struct ModelStep {
     double t = 0.0;  // seconds since the agent started
     Pose pose;
     bool bumped = false;  // the step ended at a contact
+    // Where the sample is logged when that is not `pose` (a logging lag): the model still sees
+    // the world from `pose`.
+    std::optional<Pose> logged_pose;
+    const Pose& logged() const { return logged_pose ? *logged_pose : pose; }
 };
 
 class Agent {

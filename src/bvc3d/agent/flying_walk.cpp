@@ -109,14 +109,14 @@ std::optional<ModelStep> FlyingWalk::next(double t_end) {
             state_.position += step_len * u;
             state_.t += p_.model_dt;
             ++state_.steps_since_turn;
-            return ModelStep{state_.t, pose(), false};
+            return ModelStep{state_.t, pose(), false, std::nullopt};
         }
         // Contact: stop a nanometre short of it, then fly off in a new direction.
         const double moved = std::max(0.0, free - 1e-9);
         state_.position += moved * u;
         state_.t += moved / p_.speed;
         state_.bump_pending = true;
-        if (moved > p_.min_update_move) return ModelStep{state_.t, pose(), true};
+        if (moved > p_.min_update_move) return ModelStep{state_.t, pose(), true, std::nullopt};
     }
     return std::nullopt;
 }

@@ -20,8 +20,35 @@ const params::Table<RobotParams>& RobotParams::table() {
                   integer("n_walk", &RobotParams::n_walk, closed(1, 1e9), "model steps between Gaussian turns"),
                   real("turn_sd", &RobotParams::turn_sd, closed(0, 100), "rad, sd of the Gaussian turn").in_radians(),
                   real("min_update_move", &RobotParams::min_update_move, closed(0, 1),
-                       "m: a step cut short by a bump updates the model if it moved more")});
+                       "m: a step cut short by a bump updates the model if it moved more"),
+                  real("turn_control_step", &RobotParams::turn_control_step, closed(0, 10),
+                       "s: > 0 turns in whole steps of this length, overshooting by up to one (0: exact turns)")
+                      .quiet_at_default(),
+                  flag("bump_gaussian_turn", &RobotParams::bump_gaussian_turn,
+                       "after a bump's uniform heading, also make the Gaussian turn")
+                      .quiet_at_default(),
+                  flag("fixed_start_heading", &RobotParams::fixed_start_heading,
+                       "start at start_heading (false: a uniform random heading)")
+                      .quiet_at_default(),
+                  real("start_heading", &RobotParams::start_heading, closed(-pi, pi),
+                       "rad, the start heading when fixed_start_heading")
+                      .in_radians()
+                      .quiet_at_default(),
+                  real("log_lag", &RobotParams::log_lag, closed(0, 10),
+                       "s: each sample's position is where the robot is this long after its scan")
+                      .quiet_at_default()});
     return t;
+}
+
+RobotParams RobotParams::authors() {
+    RobotParams p;
+    p.radius = 0.17;
+    p.turn_rate = 1.83;
+    p.turn_control_step = authors_control_step;
+    p.bump_gaussian_turn = true;
+    p.fixed_start_heading = true;
+    p.start_heading = 0.0;
+    return p;
 }
 
 RandomWalk::RandomWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& params, Rng rng,
@@ -136,6 +163,15 @@ void RandomWalk::check_start(const WorldDescription& world, const BodyCollider& 
 }
 
 void RandomWalk::turn_to(double heading) {
+    if (p_.turn_control_step > 0) {
+        // Whole control steps, until the heading has reached or passed the target.
+        const double delta = wrap_pi(heading - state_.pose.heading);
+        const double per_step = p_.turn_rate * p_.turn_control_step;
+        const double steps = std::ceil(std::abs(delta) / per_step);
+        state_.t += steps * p_.turn_control_step;
+        state_.pose.heading = wrap_pi(state_.pose.heading + std::copysign(steps * per_step, delta));
+        return;
+    }
     heading = wrap_pi(heading);
     state_.t += std::abs(wrap_pi(heading - state_.pose.heading)) / p_.turn_rate;
     state_.pose.heading = heading;
@@ -145,11 +181,33 @@ void RandomWalk::bump() {
     const double h = rng_.uniform(-pi, pi);
     if (log_) log_->push_back({TurnEvent::Kind::bump, h});
     turn_to(h);
+    if (p_.bump_gaussian_turn) {
+        const double d = rng_.normal(0.0, p_.turn_sd);
+        if (log_) log_->push_back({TurnEvent::Kind::gaussian, d});
+        turn_to(state_.pose.heading + d);
+    }
     state_.steps_since_turn = 0;
     state_.bump_pending = false;
 }
 
 std::optional<ModelStep> RandomWalk::next(double t_end) {
+    auto step = walk(t_end, INFINITY);
+    if (step && p_.log_lag > 0) step->logged_pose = pose_after(p_.log_lag);
+    return step;
+}
+
+Pose RandomWalk::pose_after(double dt) const {
+    RandomWalk ahead(*this);
+    ahead.log_ = nullptr;
+    const double t_stop = state_.t + dt;
+    while (ahead.state_.t < t_stop) ahead.walk(t_stop, t_stop);
+    Pose p = state_.pose;  // the heading and height of now, the position of `dt` later
+    p.x = ahead.state_.pose.x;
+    p.y = ahead.state_.pose.y;
+    return p;
+}
+
+std::optional<ModelStep> RandomWalk::walk(double t_end, double stop_at) {
     const double step_len = p_.speed * p_.model_dt;
     int stuck = 0;  // bumps in a row without moving
     while (state_.t < t_end) {
@@ -170,12 +228,21 @@ std::optional<ModelStep> RandomWalk::next(double t_end) {
         Pose& q = state_.pose;
         const Vec2 u(std::cos(q.heading), std::sin(q.heading));
         const double free = body_->free_distance(Vec2(q.x, q.y), u, step_len);
+        const double reach = free >= step_len ? step_len : std::max(0.0, free - 1e-9);
+        const double duration = free >= step_len ? p_.model_dt : reach / p_.speed;
+        if (state_.t + duration > stop_at) {  // part of this move, at constant speed
+            const double d = std::min(reach, p_.speed * (stop_at - state_.t));
+            q.x += d * u.x();
+            q.y += d * u.y();
+            state_.t = stop_at;
+            return std::nullopt;
+        }
         if (free >= step_len) {
             q.x += step_len * u.x();
             q.y += step_len * u.y();
             state_.t += p_.model_dt;
             ++state_.steps_since_turn;
-            return ModelStep{state_.t, q, false};
+            return ModelStep{state_.t, q, false, std::nullopt};
         }
         // Bumper: stop at contact (a nanometre short of it), then turn to a uniform heading.
         const double moved = std::max(0.0, free - 1e-9);
@@ -183,7 +250,7 @@ std::optional<ModelStep> RandomWalk::next(double t_end) {
         q.y += moved * u.y();
         state_.t += moved / p_.speed;
         state_.bump_pending = true;
-        if (moved > p_.min_update_move) return ModelStep{state_.t, q, true};
+        if (moved > p_.min_update_move) return ModelStep{state_.t, q, true, std::nullopt};
     }
     return std::nullopt;
 }
@@ -241,7 +308,8 @@ std::unique_ptr<Agent> RandomWalkSpec::make(const World& world, std::uint64_t se
     auto body = std::make_shared<const BodyCollider>(world.description(), robot_.radius, robot_.height);
     RandomWalk::check_start(world.description(), *body);
     Rng rng(seed, Stream::walk);
-    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    if (robot_.fixed_start_heading) start.heading = robot_.start_heading;  // the start point is still drawn
     return std::make_unique<RandomWalk>(body, robot_, std::move(rng), start);
 }
 

@@ -48,7 +48,7 @@ std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std:
         if (i > 0 && !(t[i] > t[i - 1]))
             throw InputError(where() + "times must increase (" + format_number(t[i]) + " after " +
                              format_number(t[i - 1]) + ")");
-        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), 0.0, 0.0}, false};
+        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), 0.0, 0.0}, false, std::nullopt};
     }
     return steps;
 }

@@ -12,7 +12,7 @@
 namespace bvc3d::analysis {
 
 AliasingResult spatial_aliasing(const Eigen::Ref<const Centers>& centers, const Eigen::Ref<const RowMatrixXd>& maps,
-                                double d_th) {
+                                double d_th, std::size_t fixed_n) {
     if (!(d_th >= 0) || !std::isfinite(d_th))
         throw InputError("d_th must be a finite distance >= 0, got " + std::to_string(d_th));
     if (maps.rows() != centers.rows())
@@ -58,9 +58,9 @@ AliasingResult spatial_aliasing(const Eigen::Ref<const Centers>& centers, const 
             const auto aj = unit.row(j);
             for (const int c : nz) near += ai(c) * aj(c);
         });
-        out.sai(i) = (all - near) / static_cast<double>(n_bins);
+        out.sai(i) = (all - near) / static_cast<double>(fixed_n > 0 ? static_cast<Eigen::Index>(fixed_n) : n_bins);
     }
-    out.msai = out.sai.mean();
+    out.msai = fixed_n > 0 ? out.sai.sum() / static_cast<double>(fixed_n) : out.sai.mean();
     return out;
 }
 

@@ -15,7 +15,9 @@ struct AliasingResult {
 // Distances are sqrt(dx² + dy² [+ dz²]) in double, the same expression a numpy double loop evaluates.
 // Computed as (â_i · Σ_j â_j − Σ_{|c_i − c_j| <= d_th} â_i · â_j) / N with unit rows â, the near
 // bins found with a uniform grid and the dot products over â_i's non-zero cells.
+// fixed_n > 0 divides by that number instead of N, in SAI_i and in MSAI = Σ SAI_i / fixed_n (so
+// MSAI = Σ_i Σ_j cos / fixed_n², the authors' code with fixed_n = 2662).
 AliasingResult spatial_aliasing(const Eigen::Ref<const Centers>& centers, const Eigen::Ref<const RowMatrixXd>& maps,
-                                double d_th = 2.0);
+                                double d_th = 2.0, std::size_t fixed_n = 0);
 
 }  // namespace bvc3d::analysis

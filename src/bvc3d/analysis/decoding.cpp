@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -159,22 +160,38 @@ DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& 
     const std::vector<int> best =
         sparse_cost<T>(unit, second) <= dense_cost ? decode_sparse<T>(unit, second) : decode_dense<T>(unit, second);
 
-    DecodingResult out;
-    const bool split = positions.cols() == 3;  // horizontal and vertical parts of 3-D errors
-    std::vector<double> errors, horizontal, vertical;
-    errors.reserve(best.size());
-    for (std::size_t i = 0; i < best.size(); ++i) {
-        if (best[i] < 0) {
-            ++out.n_undecoded;
-            continue;
-        }
-        const auto s = static_cast<Eigen::Index>(half + i);
+    const auto distance = [&](Eigen::Index s, Eigen::Index b) {
         double d2 = 0;
         for (Eigen::Index d = 0; d < positions.cols(); ++d) {
-            const double diff = positions(s, d) - first.centers(best[i], d);
+            const double diff = positions(s, d) - first.centers(b, d);
             d2 += diff * diff;
         }
-        errors.push_back(std::sqrt(d2));
+        return std::sqrt(d2);
+    };
+    // Chance: the occupancy-weighted mean distance to the template bins (NaN without any).
+    double occupancy = 0;
+    for (const auto c : first.counts) occupancy += static_cast<double>(c);
+    const auto chance = [&](Eigen::Index s) {
+        double sum = 0;
+        for (Eigen::Index b = 0; b < first.centers.rows(); ++b)
+            sum += static_cast<double>(first.counts[static_cast<std::size_t>(b)]) * distance(s, b);
+        return occupancy > 0 ? sum / occupancy : std::numeric_limits<double>::quiet_NaN();
+    };
+
+    DecodingResult out;
+    const bool split = positions.cols() == 3;  // horizontal and vertical parts of 3-D errors
+    std::vector<double> errors, all, horizontal, vertical;
+    errors.reserve(best.size());
+    all.reserve(best.size());
+    for (std::size_t i = 0; i < best.size(); ++i) {
+        const auto s = static_cast<Eigen::Index>(half + i);
+        if (best[i] < 0) {
+            ++out.n_undecoded;
+            all.push_back(chance(s));
+            continue;
+        }
+        errors.push_back(distance(s, best[i]));
+        all.push_back(errors.back());
         if (split) {
             const double dx = positions(s, 0) - first.centers(best[i], 0), dy = positions(s, 1) - first.centers(best[i], 1);
             horizontal.push_back(std::sqrt(dx * dx + dy * dy));
@@ -189,12 +206,15 @@ DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& 
         out.median_vertical_m = median(std::move(vertical));
     }
     out.n_decoded = errors.size();
-    if (!errors.empty()) {
+    const auto summarize = [](std::vector<double> v, double& mean, double& med) {
+        if (v.empty()) return;
         double sum = 0;
-        for (const double e : errors) sum += e;
-        out.mean_m = sum / static_cast<double>(errors.size());
-        out.median_m = median(std::move(errors));
-    }
+        for (const double e : v) sum += e;
+        mean = sum / static_cast<double>(v.size());
+        med = median(std::move(v));
+    };
+    summarize(std::move(errors), out.mean_m, out.median_m);
+    if (occupancy > 0) summarize(std::move(all), out.mean_all_m, out.median_all_m);
     return out;
 }
 

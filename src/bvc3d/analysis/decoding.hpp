@@ -45,6 +45,17 @@ struct DecodingResult {
     double median_vertical_m = std::numeric_limits<double>::quiet_NaN();
     double mean_vertical_m = std::numeric_limits<double>::quiet_NaN();
     double median_vertical_chance_m = std::numeric_limits<double>::quiet_NaN();
+
+    // Over every second-half sample, an undecoded one counted at its chance error: the mean distance
+    // from its true position to the first half's template bins, each weighted by the number of
+    // first-half samples in it (the expected error of a guess drawn from the first half's occupancy).
+    double median_all_m = std::numeric_limits<double>::quiet_NaN();
+    double mean_all_m = std::numeric_limits<double>::quiet_NaN();
+
+    double frac_undecoded() const {
+        const std::size_t n = n_decoded + n_undecoded;
+        return n ? static_cast<double>(n_undecoded) / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
+    }
 };
 
 // Choices (docs/analysis.md):
@@ -53,7 +64,8 @@ struct DecodingResult {
 //   over those bins.
 // - A sample whose best cosine similarity is not positive (an all-zero population vector, or one
 //   that shares no active cell with any template) is not decoded; it is counted in n_undecoded and
-//   left out of the median and mean. Ties go to the first bin in matplotlib's order.
+//   left out of the median and mean, and counted at its chance error in median_all and mean_all.
+//   Ties go to the first bin in matplotlib's order.
 // - Needs at least 2 samples (InputError otherwise); analyze_trial reports fewer as undecoded.
 template <class T>
 DecodingResult decoding_error(std::span<const double> x, std::span<const double> y,

@@ -57,6 +57,15 @@ const std::vector<Metric>& metric_table() {
          "Vertical localization error (median)", 2, [](const TrialMetrics& m) { return m.decoding.median_vertical_m; }, 3},
         {"decode_vertical_chance_m", "vertical chance (m)", "median vertical error of a random guess (m)", "", 2,
          [](const TrialMetrics& m) { return m.decoding.median_vertical_chance_m; }, 3},
+        // Decoding's coverage: how many samples it left out, and errors that count them at chance.
+        {"frac_undecoded", "undecoded fraction", "fraction of samples not decoded",
+         "Fraction of second-half samples not decoded", 3,
+         [](const TrialMetrics& m) { return m.decoding.frac_undecoded(); }},
+        {"decode_median_all_m", "decoding median, all (m)", "median decoding error, undecoded at chance (m)",
+         "Localization error (median), undecoded samples at chance", 2,
+         [](const TrialMetrics& m) { return m.decoding.median_all_m; }},
+        {"decode_mean_all_m", "decoding mean, all (m)", "mean decoding error, undecoded at chance (m)", "", 2,
+         [](const TrialMetrics& m) { return m.decoding.mean_all_m; }},
     };
     return table;
 }

@@ -33,15 +33,23 @@ struct AnalysisParams {
     // configurations stay as they were.
     double voxel = 0.5;            // m
     std::optional<Box3> volume;
+    // Conventions of the authors' analysis code (docs/reproduction.md); at their defaults the paper's.
+    double mi_quantile = -1;  // the modality's rate-map threshold; -1: the same as `quantile`
+    int skip_samples = 0;     // recorded samples left out at the start
+    int msai_bins = 0;        // > 0: SAI and MSAI divide by this fixed number of bins instead of each trial's N
 
     // The keys (extent aside, which is a rectangle): gridsize, quantile, eps, min_samples, d_th,
-    // decoding_templates.
+    // decoding_templates, mi_quantile, skip_samples, msai_bins.
     static const params::Table<AnalysisParams>& table();
     // The defaults for positions of `dims` coordinates: DBSCAN's min_samples is 20 in 2-D (the
     // paper's) and 10 in 3-D (0.5 m voxels have 33 lattice neighbors within 1 m, the paper's
     // hexagons about 90; docs/flying.md#analysis).
     static AnalysisParams defaults(int dims);
     void validate() const;
+    double modality_quantile() const { return mi_quantile < 0 ? quantile : mi_quantile; }
+    // The authors' conventions on the paper's parameters: modality thresholded at the 20 %
+    // quantile, the first recorded sample dropped, MSAI over a fixed 2662².
+    static AnalysisParams authors();
 };
 
 struct TrialMetrics {
@@ -61,6 +69,7 @@ std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, 
 
 // Any number of samples: with none the maps have no bins (MI 0 for every cell, MSAI NaN); with
 // fewer than 2 nothing is decoded (NaN errors, n_undecoded = the second half's n − n/2 samples).
+// params.skip_samples are dropped first; the rest is analyzed as if it were all there was.
 template <class T>
 TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eigen::Ref<const RowMatrixX<T>>& rates,
                            const AnalysisParams& params = {});

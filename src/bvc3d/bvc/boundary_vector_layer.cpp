@@ -439,23 +439,26 @@ bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, con
 BoundaryVectorLayer::ScanPlan BoundaryVectorLayer::plan(const LidarSpec& sensor) const {
     ScanPlan plan;
     const int L = p_.n_layers();
-    plan.rows.assign(sensor.elevations.size(), 1);
+    const std::vector<double>& rows = sensor.row_labels();  // the elevations the returns carry
+    plan.rows.assign(rows.size(), 1);
     plan.skipped_bound.assign(L, 0.0);
     plan.beams = sensor.beam_count();
     if (p_.elevations.empty() || p_.reading == BvcReading::nearest_beam) return plan;  // reads every row
     // A row's beams are evenly spaced in azimuth (δ apart), so for any heading and direction
     // Σ_columns exp(-x²/2σ_θ²) <= 1 + √(2π)·σ_θ/δ (a unimodal function summed over a lattice).
+    // linspace labels are δ' = 2π/(n−1) > δ apart with one azimuth twice (0 and 2π): one term more.
     const double delta = two_pi / sensor.azimuth_count;
-    const double angular_sum = c_theta_ * (1.0 + std::sqrt(two_pi) * p_.sigma_theta / delta);
+    const double repeated = sensor.azimuth_labels == AzimuthLabels::linspace ? 1.0 : 0.0;
+    const double angular_sum = c_theta_ * (1.0 + std::sqrt(two_pi) * p_.sigma_theta / delta + repeated);
     const double h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
-    for (std::size_t i = 0; i < sensor.elevations.size(); ++i) {
+    for (std::size_t i = 0; i < rows.size(); ++i) {
         bool needed = false;
-        for (double psi : p_.elevations) needed = needed || std::abs(sensor.elevations[i] - psi) <= cut_row_;
+        for (double psi : p_.elevations) needed = needed || std::abs(rows[i] - psi) <= cut_row_;
         if (needed) continue;
         plan.rows[i] = 0;
-        plan.skipped_rows.push_back(sensor.elevations[i]);
+        plan.skipped_rows.push_back(rows[i]);
         for (int l = 0; l < L; ++l) {
-            const double x = sensor.elevations[i] - p_.elevations[l];
+            const double x = rows[i] - p_.elevations[l];
             plan.skipped_bound[l] += c_phi_ * std::exp(-x * x * h_p) * angular_sum * c_r_;
         }
     }

@@ -42,6 +42,12 @@ ModelSpec flying(const std::string& name, std::vector<double> elevations, int n_
     return m;
 }
 
+// The same model reading the spherical image with the authors' angle labels.
+ModelSpec as_authors(ModelSpec m) {
+    m.sensor = LidarSpec::spherical_as_authors();
+    return m;
+}
+
 }  // namespace
 
 const std::vector<ModelPreset>& model_presets() {
@@ -60,6 +66,13 @@ const std::vector<ModelPreset>& model_presets() {
              m.bvc.max_dist = 11.9;
              return m;
          }},
+        // The 3-D models reading the spherical image as the authors' code labels it.
+        {"3d-0.1-authors", "3d-0.1 with the authors' image labels and whole-column heading roll",
+         [] { return as_authors(layered("3d-0.1-authors", {0.0, 0.1}, 60)); }},
+        {"3d-0.2-authors", "3d-0.2 with the authors' image labels and whole-column heading roll",
+         [] { return as_authors(layered("3d-0.2-authors", {0.0, 0.2}, 60)); }},
+        {"3d-3l-authors", "3d-3l with the authors' image labels and whole-column heading roll",
+         [] { return as_authors(layered("3d-3l-authors", {0.0, 0.1, 0.2}, 40)); }},
         {"fly-up", "flying: full spherical scanner at the body's center, layers 0, 0.1, 0.2 rad (upward only) × 8 × 40",
          [] { return flying("fly-up", {0.0, 0.1, 0.2}, 40); }, true},
         {"fly-5l", "flying: full spherical scanner, layers -0.4, -0.2, 0, 0.2, 0.4 rad × 8 directions × 24 distances",

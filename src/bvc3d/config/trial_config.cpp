@@ -29,8 +29,8 @@ std::uint64_t text_hash(const std::string& s) {
 WorldDescription WorldSpec::resolve() const { return config::resolve_world(source, tilt_deg, lean); }
 
 std::string WorldSpec::label() const {
-    if (source == "cross") {
-        std::string l = "cross-" + format_number(tilt_deg.value_or(0.0));
+    if (config::world_preset_takes_tilt(source)) {
+        std::string l = source + "-" + format_number(tilt_deg.value_or(0.0));
         return lean == "+x+y" ? l : l + "_" + lean;
     }
     const auto presets = config::world_preset_names();

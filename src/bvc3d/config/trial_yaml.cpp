@@ -154,9 +154,9 @@ std::string trial_to_commented_yaml(const TrialConfig& t) {
     out.section("", "world");
     out.line("  ", "source", preset_world ? t.world.source : file_text(t.world.source),
              "a world preset (" + list(presets) + ") or a world YAML file");
-    if (t.world.source == "cross" || t.world.tilt_deg)
+    if (world_preset_takes_tilt(t.world.source) || t.world.tilt_deg)
         out.line("  ", "tilt_deg", format_number(t.world.tilt_deg.value_or(0.0)),
-                 "cross only: degrees the central walls lean");
+                 "cross and cross-webots only: degrees the central walls lean");
     if (preset_world && t.world.source.rfind("cross", 0) == 0)
         out.line("  ", "lean", params::CommentedYaml::scalar(t.world.lean), "the corner they lean toward");
     if (const std::string preset = preset_name_of(t.model); !preset.empty()) {

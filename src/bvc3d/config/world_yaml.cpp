@@ -228,10 +228,45 @@ FlightVolume flight_from_yaml(const YamlView& v, const WorldDescription& w) {
     return f;
 }
 
+// The one list of world presets: cross arenas, some with their tilt fixed by the name, and the
+// flying agents' worlds (no tilt).
+struct WorldPreset {
+    std::string name;
+    std::optional<double> fixed_tilt;  // none: the preset takes a tilt (default 0)
+    CrossArenaParams (*params)(double tilt_deg) = nullptr;  // a cross arena ...
+    WorldDescription (*fixed_world)() = nullptr;            // ... or a world of its own
+};
+
+CrossArenaParams paper_cross(double tilt_deg) { return CrossArenaParams{.tilt_deg = tilt_deg}; }
+
+const std::vector<WorldPreset>& world_presets() {
+    static const std::vector<WorldPreset> presets{
+        {"cross", std::nullopt, paper_cross},   {"cross-0", 0.0, paper_cross},  {"cross-30", 30.0, paper_cross},
+        {"cross-45", 45.0, paper_cross},        {"cross-60", 60.0, paper_cross},
+        {"cross-webots", std::nullopt, CrossArenaParams::webots},
+        {"flight-room", std::nullopt, nullptr, flight_room},
+        {"atrium", std::nullopt, nullptr, atrium},
+    };
+    return presets;
+}
+
+const WorldPreset* find_world_preset(const std::string& name) {
+    for (const auto& p : world_presets())
+        if (p.name == name) return &p;
+    return nullptr;
+}
+
 }  // namespace
 
 std::vector<std::string> world_preset_names() {
-    return {"cross", "cross-0", "cross-30", "cross-45", "cross-60", "flight-room", "atrium"};
+    std::vector<std::string> names;
+    for (const auto& p : world_presets()) names.push_back(p.name);
+    return names;
+}
+
+bool world_preset_takes_tilt(const std::string& name) {
+    const WorldPreset* p = find_world_preset(name);
+    return p && p->params && !p->fixed_tilt;
 }
 
 WorldDescription world_from_yaml(const YamlView& v) {
@@ -305,23 +340,21 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
 }
 
 WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
-    const auto presets = world_preset_names();
-    if (std::find(presets.begin(), presets.end(), name) != presets.end()) {
-        if (name == "flight-room" || name == "atrium") {
-            if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world, not to '" + name + "'");
-            return name == "atrium" ? atrium() : flight_room();
+    if (const WorldPreset* preset = find_world_preset(name)) {
+        if (preset->fixed_world) {
+            if (tilt_deg) throw InputError("a tilt only applies to the cross and cross-webots worlds, not to '" + name + "'");
+            return preset->fixed_world();
         }
-        CrossArenaParams p;
+        if (preset->fixed_tilt && tilt_deg)
+            throw InputError("a tilt only applies to the cross and cross-webots worlds; '" + name + "' fixes its own");
+        CrossArenaParams p = preset->params(preset->fixed_tilt ? *preset->fixed_tilt : tilt_deg.value_or(0.0));
         p.lean = lean;
-        if (name != "cross") {
-            if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world; '" + name + "' fixes its own");
-            p.tilt_deg = std::stod(name.substr(6));
-        } else if (tilt_deg) {
-            p.tilt_deg = *tilt_deg;
-        }
-        return cross_arena(p);
+        WorldDescription w = cross_arena(p);
+        if (!preset->fixed_tilt && name != "cross") w.name = name + "-" + format_number(p.tilt_deg);
+        return w;
     }
-    if (tilt_deg) throw InputError("a tilt only applies to the 'cross' world, not to '" + name + "'");
+    const auto presets = world_preset_names();
+    if (tilt_deg) throw InputError("a tilt only applies to the cross and cross-webots worlds, not to '" + name + "'");
     std::error_code ec;
     if (!std::filesystem::exists(name, ec)) {
         std::string list;
@@ -331,13 +364,32 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
     return load_world_file(name);
 }
 
+namespace {
+
+// The built-in sensors, by name.
+const std::vector<std::pair<std::string, LidarSpec>>& builtin_sensors() {
+    static const std::vector<std::pair<std::string, LidarSpec>> sensors{
+        {"horizontal", LidarSpec::horizontal()},
+        {"spherical", LidarSpec::spherical()},
+        {"spherical-full", LidarSpec::spherical_full()},
+        {"spherical-authors", LidarSpec::spherical_as_authors()},
+    };
+    return sensors;
+}
+
+const LidarSpec* find_builtin_sensor(const std::string& name) {
+    for (const auto& [n, spec] : builtin_sensors())
+        if (n == name) return &spec;
+    return nullptr;
+}
+
+}  // namespace
+
 LidarSpec sensor_from_yaml(const YamlView& v) {
     if (v.is_scalar()) {
         const std::string name = v.as_string();
-        if (name == "horizontal") return LidarSpec::horizontal();
-        if (name == "spherical") return LidarSpec::spherical();
-        if (name == "spherical-full") return LidarSpec::spherical_full();
-        v.fail("expected horizontal, spherical, spherical-full, or a sensor mapping");
+        if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
+        v.fail("expected horizontal, spherical, spherical-full, spherical-authors, or a sensor mapping");
     }
     if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping");
     const std::string preset = v.get("preset", "");
@@ -365,8 +417,7 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
 std::string builtin_sensor_name(const LidarSpec& s) {
     const auto& table = LidarSpec::table();
     const std::string text = params::yaml_lines(table, s, "");
-    for (const auto& [name, spec] : {std::pair{"horizontal", LidarSpec::horizontal()}, {"spherical", LidarSpec::spherical()},
-                                     {"spherical-full", LidarSpec::spherical_full()}})
+    for (const auto& [name, spec] : builtin_sensors())
         if (text == params::yaml_lines(table, spec, "")) return name;
     return "";
 }
@@ -383,12 +434,10 @@ std::string sensor_to_commented_yaml(const LidarSpec& s) {
 }
 
 LidarSpec resolve_sensor(const std::string& name) {
-    if (name == "horizontal") return LidarSpec::horizontal();
-    if (name == "spherical") return LidarSpec::spherical();
-    if (name == "spherical-full") return LidarSpec::spherical_full();
+    if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
     std::error_code ec;
     if (!std::filesystem::exists(name, ec))
-        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical', 'spherical-full' nor an existing YAML file");
+        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors' nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }

@@ -11,14 +11,16 @@ namespace bvc3d::config {
 
 // The names `--world` accepts besides a YAML file.
 std::vector<std::string> world_preset_names();
+// True for the presets that take a tilt (`cross`, `cross-webots`); the others fix their own.
+bool world_preset_takes_tilt(const std::string& name);
 
 WorldDescription world_from_yaml(const YamlView& v);
 WorldDescription load_world_file(const std::string& path);
 // The mesh files a world file refers to (paths as opened), for fingerprints.
 std::vector<std::string> world_file_meshes(const std::string& path);
 
-// A preset name ("cross", "cross-30", ...) or a YAML file. `tilt_deg` overrides the tilt of the
-// `cross` preset and is an error for anything else.
+// A preset name ("cross", "cross-30", "cross-webots", ...) or a YAML file. `tilt_deg` sets the tilt
+// of the presets that take one and is an error for anything else.
 WorldDescription resolve_world(const std::string& name_or_file, std::optional<double> tilt_deg = std::nullopt,
                                const std::string& lean = "+x+y");
 

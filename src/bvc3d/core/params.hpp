@@ -60,9 +60,16 @@ struct Field {
     std::size_t min_size = 0, max_size = std::numeric_limits<std::size_t>::max();  // reals
     std::function<Value(const S&)> get;
     std::function<void(S&, const Value&)> set;
+    // Canonical text (yaml_lines) leaves the key out while it holds its default: a key added after
+    // trial files were written keeps their text, hence their fingerprints, unchanged.
+    bool quiet_default = false;
 
     Field& in_radians() {
         radians = true;
+        return *this;
+    }
+    Field& quiet_at_default() {
+        quiet_default = true;
         return *this;
     }
     Field& sizes(std::size_t lo, std::size_t hi) {
@@ -116,29 +123,29 @@ private:
 template <class S>
 Field<S> real(const char* key, double S::*m, Limits limits, const char* doc) {
     return {key, doc, Kind::real, limits, {}, false, 0, 0, [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<double>(v); }};
+            [m](S& s, const Value& v) { s.*m = std::get<double>(v); }, false};
 }
 template <class S>
 Field<S> integer(const char* key, int S::*m, Limits limits, const char* doc) {
     return {key, doc, Kind::integer, limits, {}, false, 0, 0,
             [m](const S& s) { return Value(static_cast<long long>(s.*m)); },
-            [m](S& s, const Value& v) { s.*m = static_cast<int>(std::get<long long>(v)); }};
+            [m](S& s, const Value& v) { s.*m = static_cast<int>(std::get<long long>(v)); }, false};
 }
 template <class S>
 Field<S> flag(const char* key, bool S::*m, const char* doc) {
     return {key, doc, Kind::flag, {}, {}, false, 0, 0, [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<bool>(v); }};
+            [m](S& s, const Value& v) { s.*m = std::get<bool>(v); }, false};
 }
 template <class S>
 Field<S> text(const char* key, std::string S::*m, const char* doc) {
     return {key, doc, Kind::text, {}, {}, false, 0, 0, [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<std::string>(v); }};
+            [m](S& s, const Value& v) { s.*m = std::get<std::string>(v); }, false};
 }
 template <class S>
 Field<S> reals(const char* key, std::vector<double> S::*m, Limits each, const char* doc) {
     return {key, doc, Kind::reals, each, {}, false, 0, std::numeric_limits<std::size_t>::max(),
             [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<std::vector<double>>(v); }};
+            [m](S& s, const Value& v) { s.*m = std::get<std::vector<double>>(v); }, false};
 }
 // An enum member with its names, in the order the enum's values are listed.
 template <class S, class E>
@@ -154,18 +161,23 @@ Field<S> choice(const char* key, E S::*m, std::vector<std::pair<E, std::string>>
             [m, names](S& s, const Value& v) {
                 for (const auto& [e, n] : names)
                     if (n == std::get<std::string>(v)) s.*m = e;
-            }};
+            }, false};
 }
 
 }  // namespace bvc3d::params
 
 namespace bvc3d::params {
 
-// The struct as YAML lines `<indent>key: value`, in the table's order (reads back to the same values).
+// The struct as YAML lines `<indent>key: value`, in the table's order (reads back to the same
+// values); a quiet_at_default key holding the struct's default is left out.
 template <class S>
 std::string yaml_lines(const Table<S>& table, const S& s, const std::string& indent) {
     std::string out;
-    for (const auto& f : table.fields()) out += indent + f.key + ": " + to_text(f.get(s)) + "\n";
+    for (const auto& f : table.fields()) {
+        const Value v = f.get(s);
+        if (f.quiet_default && v == f.get(S{})) continue;
+        out += indent + f.key + ": " + to_text(v) + "\n";
+    }
     return out;
 }
 

@@ -82,8 +82,11 @@ TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world
 MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& p) {
     MetricsRecord r;
     r.scalars = analysis::scalar_metrics(m);
-    // How they were computed, so that `bvc3d analyze` starts from the same parameters.
-    for (const auto& f : analysis::AnalysisParams::table().fields()) r.parameters.emplace_back(f.key, f.get(p));
+    // How they were computed, so that `bvc3d analyze` starts from the same parameters (keys quiet at
+    // their defaults only when set, as in canonical text: files read back without them get the default).
+    static const analysis::AnalysisParams defaults;
+    for (const auto& f : analysis::AnalysisParams::table().fields())
+        if (!f.quiet_default || f.get(p) != f.get(defaults)) r.parameters.emplace_back(f.key, f.get(p));
     if (p.extent) r.arrays.push_back(array("extent", {4}, std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, false));
     if (m.dims == 3 && p.volume) {
         const auto& v = *p.volume;

@@ -138,11 +138,12 @@ void GroupRun::step(const ModelStep& s, bool learn, bool record) {
         }
     }
     if (record) {
+        const Pose& logged = s.logged();  // the scan's pose unless the agent logs with a lag
         result.t.push_back(s.t);
-        result.x.push_back(s.pose.x);
-        result.y.push_back(s.pose.y);
-        result.z.push_back(s.pose.z);
-        result.heading.push_back(s.pose.heading);
+        result.x.push_back(logged.x);
+        result.y.push_back(logged.y);
+        result.z.push_back(logged.z);
+        result.heading.push_back(logged.heading);
     }
     ++step_index;
     result.stats.bumps += s.bumped;

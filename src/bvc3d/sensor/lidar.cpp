@@ -37,6 +37,18 @@ LidarSpec LidarSpec::spherical_full() {
     return s;
 }
 
+LidarSpec LidarSpec::spherical_as_authors(bool upper_only) {
+    LidarSpec s = spherical(upper_only);
+    s.name = "spherical-authors";
+    s.azimuth_labels = AzimuthLabels::linspace;
+    s.heading_roll = HeadingRoll::whole_columns;
+    constexpr int image_rows = 90;  // linspace(π/2, −π/2, 90) over the whole image; the kept rows first
+    s.elevation_labels.resize(s.elevations.size());
+    for (std::size_t i = 0; i < s.elevation_labels.size(); ++i)
+        s.elevation_labels[i] = pi / 2 - static_cast<double>(i) * pi / (image_rows - 1);
+    return s;
+}
+
 const params::Table<LidarSpec>& LidarSpec::table() {
     using namespace params;
     static const Table<LidarSpec> t(
@@ -51,12 +63,27 @@ const params::Table<LidarSpec>& LidarSpec::table() {
          real("height", &LidarSpec::height, closed(0, 1000), "m above the agent's base"),
          real("max_range", &LidarSpec::max_range, open_closed(0, 1e5), "m, farthest return"),
          real("range_noise_sd", &LidarSpec::range_noise_sd, closed(0, 1000), "m, Gaussian noise added to each range"),
-         real("dropout", &LidarSpec::dropout, closed_open(0, 1), "probability that a beam returns nothing")});
+         real("dropout", &LidarSpec::dropout, closed_open(0, 1), "probability that a beam returns nothing"),
+         choice("azimuth_labels", &LidarSpec::azimuth_labels,
+                {{AzimuthLabels::exact, "exact"}, {AzimuthLabels::linspace, "linspace"}},
+                "column j's azimuth: exact (j·2π/n) or linspace (j·2π/(n−1), the authors' code)")
+             .quiet_at_default(),
+         choice("heading_roll", &LidarSpec::heading_roll,
+                {{HeadingRoll::exact, "exact"}, {HeadingRoll::whole_columns, "whole_columns"}},
+                "to the world frame: exact (+ heading) or whole_columns (rolled by whole columns, the authors' code)")
+             .quiet_at_default(),
+         reals("elevation_labels", &LidarSpec::elevation_labels, closed(-pi / 2, pi / 2),
+               "rad, the elevation each row's returns carry; [] for the rows' own")
+             .in_radians()
+             .quiet_at_default()});
     return t;
 }
 
 void LidarSpec::validate() const {
     table().check(*this);
+    if (!elevation_labels.empty() && elevation_labels.size() != elevations.size())
+        table().fail("elevation_labels", "must list one label per row (" + std::to_string(elevations.size()) +
+                                             "), got " + std::to_string(elevation_labels.size()));
     const double beams = static_cast<double>(elevations.size()) * azimuth_count;
     if (beams > max_beams)
         table().fail("azimuth_count", "makes " + std::to_string(elevations.size()) + " rows × " +
@@ -70,10 +97,14 @@ Lidar::Lidar(LidarSpec spec) : spec_(std::move(spec)) {
         cos_el_.push_back(std::cos(e));
         sin_el_.push_back(std::sin(e));
     }
-    for (int j = 0; j < spec_.azimuth_count; ++j) {
-        column_azimuth_.push_back(spec_.azimuth_offset + j * two_pi / spec_.azimuth_count);
+    const int n = spec_.azimuth_count;
+    for (int j = 0; j < n; ++j) {
+        column_azimuth_.push_back(spec_.azimuth_offset + j * two_pi / n);
         column_cos_.push_back(std::cos(column_azimuth_.back()));
         column_sin_.push_back(std::sin(column_azimuth_.back()));
+        column_label_.push_back(spec_.azimuth_labels == AzimuthLabels::exact || n == 1
+                                    ? column_azimuth_.back()
+                                    : spec_.azimuth_offset + j * two_pi / (n - 1));
     }
 }
 
@@ -87,6 +118,8 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
                          "): coordinates must be finite and within ±1e6 m");
     if (!pose.level()) {
         if (!rows.empty()) throw InputError("a row mask applies to level poses only");
+        if (!spec_.exact_labels())
+            throw InputError("sensor '" + spec_.name + "': angle labels other than exact apply to level poses only");
         scan_tilted(world, pose, out, noise);
         return;
     }
@@ -101,10 +134,21 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
     azimuths_.resize(n_cols);
     horizontal_.resize(n_cols);
     const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);
+    // The image rolled by whole columns (HeadingRoll::whole_columns): the heading in [0, 2π), truncated.
+    std::size_t roll = 0;
+    if (spec_.heading_roll == HeadingRoll::whole_columns) {
+        double h = std::fmod(pose.heading, two_pi);
+        if (h < 0) h += two_pi;
+        roll = static_cast<std::size_t>(std::floor(h / (two_pi / static_cast<double>(n_cols)))) % n_cols;
+    }
     for (std::size_t j = 0; j < n_cols; ++j) {
-        azimuths_[j] = wrap_pi(pose.heading + column_azimuth_[j]);
+        if (spec_.heading_roll == HeadingRoll::whole_columns)
+            azimuths_[j] = wrap_pi(column_label_[(j + roll) % n_cols]);
+        else
+            azimuths_[j] = wrap_pi(pose.heading + column_label_[j]);
         horizontal_[j] = Vec2(ch * column_cos_[j] - sh * column_sin_[j], sh * column_cos_[j] + ch * column_sin_[j]);
     }
+    const std::vector<double>& row_label = spec_.row_labels();
     // Every row to cast in one call, column by column: the rays of one ray packet then share an
     // azimuth or two and meet the same walls, which Embree traverses a third faster than packets
     // that sweep 16 columns of one row. Each ray's range is its own; the returns keep the beam
@@ -127,7 +171,7 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
         for (std::size_t j = 0; j < n_cols; ++j) {
             double r = ranges_[j * n_cast + c];
             if (r == RayCaster::no_hit || (noisy && !add_noise(r, noise, i * n_cols + j))) continue;
-            out.push_back({r, azimuths_[j], spec_.elevations[i]});
+            out.push_back({r, azimuths_[j], row_label[i]});
         }
     }
 }

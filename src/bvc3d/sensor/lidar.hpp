@@ -21,6 +21,19 @@ struct LidarReturn {
 };
 using Scan = std::vector<LidarReturn>;
 
+// How a scan's returns are labeled with angles (docs/worlds.md#sensors). The defaults give each
+// return its beam's own direction, turned into the world frame exactly; the others transcribe how
+// the authors' code labeled its range image.
+enum class AzimuthLabels {
+    exact,     // column j: azimuth_offset + j·2π/n
+    linspace,  // column j: azimuth_offset + j·2π/(n − 1), numpy.linspace(0, 2π, n) (first and last both 0)
+};
+enum class HeadingRoll {
+    exact,          // allocentric azimuth = heading + the column's label
+    whole_columns,  // the image rolled by the heading truncated to whole columns: column j gets the
+                    // label of column (j + floor(heading / (2π/n))) mod n, heading taken in [0, 2π)
+};
+
 // A beam table: every elevation (row, top first) × azimuth_count columns at robot-frame azimuth
 // azimuth_offset + j·2π/azimuth_count. Beam index = row·azimuth_count + column.
 struct LidarSpec {
@@ -32,6 +45,11 @@ struct LidarSpec {
     double max_range = 20.0;      // m
     double range_noise_sd = 0.0;  // m, Gaussian noise added to each range
     double dropout = 0.0;         // probability that a beam returns nothing
+    // Angle labels (level poses only when not exact): the beams are cast in their own directions
+    // whatever the labels; only the angles the returns carry change.
+    AzimuthLabels azimuth_labels = AzimuthLabels::exact;
+    HeadingRoll heading_roll = HeadingRoll::exact;
+    std::vector<double> elevation_labels;  // rad, one per row; empty: the rows' own elevations
 
     // The paper's 2-D scanner: 720 beams, 0.5° apart, at 0.08 m.
     static LidarSpec horizontal();
@@ -40,12 +58,22 @@ struct LidarSpec {
     // The flying agents' scanner: all 90 rows of the spherical one, both halves, at the body's
     // center (height 0; docs/flying.md#models).
     static LidarSpec spherical_full();
+    // The same image labeled as the authors' code labels it: columns linspace(0, 2π, 180), rows
+    // linspace(π/2, −π/2, 90), rolled by the heading truncated to whole 2° columns.
+    static LidarSpec spherical_as_authors(bool upper_only = true);
 
     std::size_t beam_count() const { return elevations.size() * static_cast<std::size_t>(azimuth_count); }
-    // Same beams, same noise: scans are identical whatever the names.
+    // The elevation the returns of each row carry.
+    const std::vector<double>& row_labels() const { return elevation_labels.empty() ? elevations : elevation_labels; }
+    bool exact_labels() const {
+        return azimuth_labels == AzimuthLabels::exact && heading_roll == HeadingRoll::exact && elevation_labels.empty();
+    }
+    // Same beams, same labels, same noise: scans are identical whatever the names.
     bool same_beams(const LidarSpec& o) const {
         return elevations == o.elevations && azimuth_count == o.azimuth_count && azimuth_offset == o.azimuth_offset &&
-               height == o.height && max_range == o.max_range && range_noise_sd == o.range_noise_sd && dropout == o.dropout;
+               height == o.height && max_range == o.max_range && range_noise_sd == o.range_noise_sd &&
+               dropout == o.dropout && azimuth_labels == o.azimuth_labels && heading_roll == o.heading_roll &&
+               elevation_labels == o.elevation_labels;
     }
     static const params::Table<LidarSpec>& table();
     void validate() const;  // throws params::ParamError naming the bad field
@@ -83,6 +111,7 @@ private:
 
     LidarSpec spec_;
     std::vector<double> cos_el_, sin_el_, column_azimuth_, column_cos_, column_sin_;
+    std::vector<double> column_label_;  // the azimuth label of each column (azimuth_labels)
     // Scratch space reused between scans: a Lidar is not shared between threads.
     mutable std::vector<Vec3> dirs_;
     mutable std::vector<Vec2> horizontal_;

@@ -26,6 +26,16 @@ std::pair<double, double> lean_signs(const std::string& lean) {
 
 }  // namespace
 
+CrossArenaParams CrossArenaParams::webots(double tilt_deg) {
+    constexpr double outer_wall_center = 5.0, outer_wall_thickness = 0.3;
+    constexpr double wall_height = 2.4, ceiling_thickness = 0.3;
+    CrossArenaParams p;
+    p.tilt_deg = tilt_deg;
+    p.half_width = outer_wall_center - outer_wall_thickness / 2;  // 4.85
+    p.height = wall_height - ceiling_thickness / 2;               // 2.25: the slab is centered on the walls' tops
+    return p;
+}
+
 WorldDescription cross_arena(const CrossArenaParams& p) {
     const auto [sx, sy] = lean_signs(p.lean);
     require(std::isfinite(p.tilt_deg) && p.tilt_deg >= 0.0 && p.tilt_deg < 90.0,

@@ -46,6 +46,12 @@ struct CrossArenaParams {
     double wall_thickness = 0.3;
     double start_offset = 4.0;  // start corners at (±offset, ±offset)
     double flight_clearance = 0.2;  // the flight volume: the floor × [clearance, height - clearance]
+
+    // The arena as the authors built it in Webots (docs/worlds.md#presets): outer walls 0.3 m thick
+    // centered on ±5 m, so their inner faces stand at ±4.85 m, and 2.4 m high under a 0.3 m
+    // ceiling slab whose underside is at 2.25 m; the central cross as the paper's (7 × 0.3 m,
+    // floor to ceiling). Only the inner faces and the ceiling's underside can be reached or seen.
+    static CrossArenaParams webots(double tilt_deg = 0.0);
 };
 
 // Checks the parameters (throws InputError naming the parameter) and builds the arena.
