@@ -25,7 +25,7 @@ ROW = re.compile(r"^\s*(\d+)\s+([-\d., ]+?)\s+(\d+)\s+([-\d.naN]+)\s+([-\d.naN]+
 
 def elevations_of(row):
     """The trial's elevations as a tuple of floats, from the trials.csv row."""
-    text = row.get("model.bvc.elevations") or ""
+    text = row.get("swept:model.bvc.elevations") or ""
     if row.get("model") == "3d-3l":
         return (0.0, 0.1, 0.2)
     return tuple(float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", text))

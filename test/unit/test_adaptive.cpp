@@ -2,7 +2,11 @@
 // on the same walk by hand, the shelf world, determinism and bad input.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
@@ -78,6 +82,29 @@ TEST(Adaptive, ChoosesALayerThatSeesTheShelf) {
     EXPECT_NE(std::find(e.begin(), e.end(), 0.6), e.end()) << "chose " << elevations_text(e);
     EXPECT_EQ(c.model.bvc.elevations, e);
     EXPECT_EQ(c.model.bvc.n_cells(), 960);
+}
+
+TEST(Adaptive, TheShelfChangesTheCriterionOnlyOfLayersThatSeeIt) {
+    // The same world without its shelf: the walk is the same (the shelf is above the robot), the
+    // level layer's criterion is unchanged to the bit, the upward layer's is not.
+    const World with_shelf(config::load_world_file(shelf_world));
+    std::ifstream in(shelf_world);
+    std::string text, line;
+    while (std::getline(in, line))
+        if (line.find("the shelf") == std::string::npos) text += line + "\n";
+    const auto tmp = std::filesystem::temp_directory_path() / ("bvc3d-noshelf-" + std::to_string(::getpid()) + ".yaml");
+    std::ofstream(tmp) << text;
+    const World no_shelf(config::load_world_file(tmp.string()));
+    std::filesystem::remove(tmp);
+    const auto walk = exploration_walk(with_shelf, RandomWalkSpec{}, 5, 10.0, 2.0);
+    const auto walk_bare = exploration_walk(no_shelf, RandomWalkSpec{}, 5, 10.0, 2.0);
+    ASSERT_EQ(walk.size(), walk_bare.size());
+    EXPECT_EQ(walk.back().pose.x, walk_bare.back().pose.x);
+    const std::vector<std::vector<double>> sets{{0.0}, {0.6}};
+    const auto a = score_elevation_sets(with_shelf, spherical_base(), walk, sets, 960, 5, {}, 2);
+    const auto b = score_elevation_sets(no_shelf, spherical_base(), walk, sets, 960, 5, {}, 2);
+    EXPECT_EQ(a[0].msai, b[0].msai);
+    EXPECT_NE(a[1].msai, b[1].msai);
 }
 
 TEST(Adaptive, SameSeedSameChoiceWhateverTheThreads) {
