@@ -81,7 +81,7 @@ void choose(const ChooseOptions& o) {
     std::printf("chosen: %s rad, %d per axis (MSAI %.4f)\n", elevations_text(c.chosen.elevations).c_str(), c.chosen.n_per_axis,
                 c.chosen.msai);
     AtomicFile file(o.out);
-    file.stream() << "# chosen by bvc3d choose-elevations: world " << o.world << (o.tilt ? " tilt " + format_number(*o.tilt) : "")
+    file.stream() << "# chosen by bvc3d choose-elevations: world " << o.world << (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "")
                   << ", sensor " << o.sensor << ", " << format_number(p.explore_minutes) << " min walk, seed " << p.seed
                   << ", budget " << p.budget << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai)
                   << "\n"

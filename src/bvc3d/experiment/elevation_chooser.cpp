@@ -118,7 +118,8 @@ std::vector<double> ChooserParams::candidate_elevations() const {
     if (!(elevation_step > 0)) return out;
     // Multiples of the step from the minimum, with a little slack so that 0.4 is reached from 0 by 0.05.
     for (int i = 0;; ++i) {
-        const double e = elevation_min + i * elevation_step;
+        // Rounded to 12 decimals, so that 0.05 · 3 is the 0.15 a user would type.
+        const double e = std::round((elevation_min + i * elevation_step) * 1e12) / 1e12;
         if (e > elevation_max + 1e-9 * std::max(1.0, std::abs(elevation_max))) break;
         out.push_back(std::min(e, elevation_max));
     }
