@@ -49,7 +49,8 @@ public:
     const std::vector<ModelStep>& steps() const { return *steps_; }
     std::string kind() const override { return "trajectory"; }
     void validate() const override {}
-    // Checks that every pose lies within the world's geometry (a path in another frame is a mistake).
+    // Every pose lies within the world's geometry (a path in another frame is a mistake).
+    void check_world(const WorldDescription& world) const override;
     std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override;

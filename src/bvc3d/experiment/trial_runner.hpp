@@ -14,22 +14,19 @@
 #include <vector>
 
 #include "bvc3d/config/trial_config.hpp"
+#include "bvc3d/core/cancel.hpp"  // Interrupted: thrown when RunControl::stop is set, after the checkpoint
 #include "bvc3d/recorder/trial_record.hpp"
 #include "bvc3d/sensor/return_source.hpp"
 
 namespace bvc3d {
-
-// Thrown when RunControl::stop is set; the group's checkpoint (if any) was written first.
-class Interrupted : public std::runtime_error {
-public:
-    Interrupted() : std::runtime_error("interrupted") {}
-};
 
 struct RunControl {
     const std::atomic<bool>* stop = nullptr;            // checked every few steps
     std::function<void(double seconds_done, std::int64_t steps_done)> progress;  // every few hundred steps
     std::filesystem::path checkpoint;                   // empty: no checkpoints
     double checkpoint_minutes = 0;                      // > 0: also every this many simulated minutes
+    // Warnings (a checkpoint that cannot be used, ...); default: a line on standard error.
+    std::function<void(const std::string& message)> warn;
 };
 
 // Where each model's returns come from. Models given the same source share it. Default: the
