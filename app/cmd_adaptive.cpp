@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <optional>
 
@@ -68,11 +69,18 @@ void choose(const ChooseOptions& o) {
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
     const World world(config::resolve_world(o.world, o.tilt, o.lean));
     const RandomWalkSpec agent;
+    InterruptGuard guard;
+    p.stop = &stop_flag();
     std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n", o.world.c_str(),
                 format_number(p.explore_minutes).c_str(), static_cast<unsigned long long>(p.seed),
                 elevations_text(p.candidate_elevations()).c_str());
-    const ElevationChoice c = o.sets.empty() ? choose_elevations(world, base, agent, p)
-                                              : choose_from_sets(world, base, agent, parse_sets(o.sets), p);
+    ElevationChoice c;
+    try {
+        c = o.sets.empty() ? choose_elevations(world, base, agent, p) : choose_from_sets(world, base, agent, parse_sets(o.sets), p);
+    } catch (const Interrupted&) {
+        std::fprintf(stderr, "\nbvc3d: interrupted; nothing was written.\n");
+        std::exit(130);
+    }
     std::printf("%zu walk steps; criterion = MSAI of the network on the walk (lower is better)\n", c.walk_steps);
     std::printf("%5s  %-28s %10s %8s %10s\n", "round", "elevations (rad)", "n_per_axis", "MSAI", "MI>1 frac");
     for (const auto& s : c.candidates)
@@ -111,7 +119,7 @@ void add_adaptive_command(CLI::App& app) {
     cmd->add_option("--seed", o->params.seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
     cmd->add_option("--sets", o->sets,
                     "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
-    cmd->add_option("--jobs", o->params.jobs, "Threads sharing the candidates")->capture_default_str();
+    cmd->add_option("--jobs", o->params.jobs, "Threads sharing the candidates; 0 (the default): one per core");
     cmd->add_option("--out", o->out, "Model YAML file to write")->required();
     cmd->callback([o] { choose(*o); });
 }

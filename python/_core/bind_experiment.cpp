@@ -99,13 +99,12 @@ follow instead of the random walk. Protocol keywords and their defaults:
             p.jobs = jobs;
             ModelSpec base = model_preset("3d-0.2");
             base.sensor = config::resolve_sensor(sensor);
-            ElevationChoice c;
-            {
-                pyb::gil_scoped_release release;
+            const ElevationChoice c = interruptible([&](const std::atomic<bool>& stop) {
+                p.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
                 const World w(config::resolve_world(world, tilt_deg));
-                c = sets ? choose_from_sets(w, base, RandomWalkSpec{}, *sets, p)
-                         : choose_elevations(w, base, RandomWalkSpec{}, p);
-            }
+                return sets ? choose_from_sets(w, base, RandomWalkSpec{}, *sets, p)
+                            : choose_elevations(w, base, RandomWalkSpec{}, p);
+            });
             pyb::list candidates;
             for (const auto& s : c.candidates)
                 candidates.append(pyb::dict(pyb::arg("elevations") = s.elevations, pyb::arg("n_per_axis") = s.n_per_axis,

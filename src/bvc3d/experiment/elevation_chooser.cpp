@@ -187,7 +187,7 @@ std::vector<CandidateScore> score_elevation_sets(const World& world, const Model
                                                  const std::vector<ModelStep>& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
-                                                 int jobs, const SourceFactory& sources) {
+                                                 int jobs, const SourceFactory& sources, const std::atomic<bool>* stop) {
     if (jobs < 0) throw InputError("jobs must be >= 0");
     if (walk.size() < 2) throw InputError("the exploratory walk needs at least 2 steps");
     std::vector<TrialConfig> trials;
@@ -216,7 +216,9 @@ std::vector<CandidateScore> score_elevation_sets(const World& world, const Model
                 index.push_back(i);
             }
             if (mine.empty()) return;
-            const GroupResult r = run_trial_group(world, mine, {}, replay_factory(sources, walk.size(), noise_seed));
+            RunControl control;
+            control.stop = stop;
+            const GroupResult r = run_trial_group(world, mine, control, replay_factory(sources, walk.size(), noise_seed));
             for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(r, m, mine[m].model, analysis);
         } catch (...) {
             errors[k] = std::current_exception();
@@ -254,7 +256,8 @@ ElevationChoice choose_elevations(const World& world, const ModelSpec& base, con
             set.insert(std::upper_bound(set.begin(), set.end(), e), e);
             sets.push_back(std::move(set));
         }
-        auto scores = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources);
+        auto scores = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
+                                           params.stop);
         for (auto& s : scores) s.round = round;
         choice.candidates.insert(choice.candidates.end(), scores.begin(), scores.end());
         const CandidateScore& top = scores[best_of(scores)];
@@ -278,7 +281,8 @@ ElevationChoice choose_from_sets(const World& world, const ModelSpec& base, cons
     const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
     ElevationChoice c;
     c.walk_steps = walk.size();
-    c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources);
+    c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
+                                           params.stop);
     for (auto& s : c.candidates) s.round = static_cast<int>(s.elevations.size());
     c.chosen = c.candidates[best_of(c.candidates)];
     if (std::isnan(c.chosen.msai)) throw InputError("the exploratory walk gave no bins to measure aliasing on");

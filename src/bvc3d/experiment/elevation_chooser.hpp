@@ -6,6 +6,7 @@
 // and, per step, one shared scan (the trial runner shares sources between models).
 // Takes: a world, a base model (its sensor, σs, n_dir, place cells), an agent, a BVC budget and a
 // candidate range. Gives: the criterion of every candidate set considered and the chosen set.
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -28,6 +29,7 @@ struct ChooserParams {
     double explore_minutes = 30;    // simulated minutes of the exploratory walk
     std::uint64_t seed = 0;         // the walk's seed (and the candidates' initial weights)
     int jobs = 0;                   // threads the candidates are split between; 0: every core
+    const std::atomic<bool>* stop = nullptr;  // when set: Interrupted within a few steps
 
     static const params::Table<ChooserParams>& table();
     // InputError for impossible values, an empty candidate range, or a budget too small for the layers.
@@ -61,11 +63,13 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
 // The criterion of each elevation set on one walk. `sources` gives each model's returns by walk
 // step (e.g. recorded scans; default: the model's sensor ray-cast in `world`; called from worker
 // threads); the second pass reads the same steps again. `jobs` threads share the sets (0: every core).
+// `stop`, when set, ends the runs with Interrupted.
 std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
                                                  const std::vector<ModelStep>& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
-                                                 int jobs = 0, const SourceFactory& sources = {});
+                                                 int jobs = 0, const SourceFactory& sources = {},
+                                                 const std::atomic<bool>* stop = nullptr);
 
 // The greedy search: round 1 scores each candidate elevation alone; each later round adds one
 // elevation (not yet in the set) to the round's best. Deterministic: ties go to the set considered first.
