@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -67,6 +68,8 @@ void choose(const ChooseOptions& o) {
     base.sensor = config::resolve_sensor(o.sensor);
     p.validate(base.bvc.n_dir);
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
+    // Fail before minutes of work, not after.
+    if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty()) ensure_writable_directory(folder);
     const World world(config::resolve_world(o.world, o.tilt, o.lean));
     const RandomWalkSpec agent;
     InterruptGuard guard;
