@@ -94,5 +94,6 @@ void add_experiment_commands(CLI::App& app);
 void add_sweep_command(CLI::App& app);
 void add_flight_command(CLI::App& app);
 void add_view_command(CLI::App& app);  // view/cmd_view.cpp
+void add_adaptive_command(CLI::App& app);  // cmd_adaptive.cpp
 
 }  // namespace bvc3d::cli

@@ -6,6 +6,8 @@
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/experiment/elevation_chooser.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 
 namespace bvc3d::py {
@@ -113,6 +115,41 @@ for its parameters (see flying_walk); authors_choices: a list of the authors' ch
 `bvc3d paper --authors-choices`; ["all"] for all of them; protocol keywords still apply after them).
 Protocol keywords and their defaults:
 )doc" + describe(Protocol::table(), Protocol{}))
+            .c_str());
+    m.def(
+        "choose_elevations",
+        [](const std::string& world, std::optional<double> tilt_deg, const std::string& sensor, std::uint64_t seed,
+           std::optional<std::vector<std::vector<double>>> sets, int jobs, const pyb::kwargs& kwargs) {
+            ChooserParams p;
+            apply_kwargs(p, ChooserParams::table(), kwargs);
+            p.seed = seed;
+            p.jobs = jobs;
+            ModelSpec base = model_preset("3d-0.2");
+            base.sensor = config::resolve_sensor(sensor);
+            const ElevationChoice c = interruptible([&](const std::atomic<bool>& stop) {
+                p.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
+                const World w(config::resolve_world(world, tilt_deg));
+                return sets ? choose_from_sets(w, base, RandomWalkSpec{}, *sets, p)
+                            : choose_elevations(w, base, RandomWalkSpec{}, p);
+            });
+            pyb::list candidates;
+            for (const auto& s : c.candidates)
+                candidates.append(pyb::dict(pyb::arg("elevations") = s.elevations, pyb::arg("n_per_axis") = s.n_per_axis,
+                                            pyb::arg("round") = s.round, pyb::arg("msai") = s.msai,
+                                            pyb::arg("frac_multimodal") = s.frac_multimodal));
+            return pyb::dict(pyb::arg("elevations") = c.chosen.elevations, pyb::arg("n_per_axis") = c.chosen.n_per_axis,
+                             pyb::arg("msai") = c.chosen.msai, pyb::arg("candidates") = candidates,
+                             pyb::arg("walk_steps") = c.walk_steps, pyb::arg("model_yaml") = config::model_to_yaml(c.model));
+        },
+        pyb::arg("world") = WorldSpec{}.source, pyb::arg("tilt_deg") = pyb::none(), pyb::arg("sensor") = "spherical",
+        pyb::arg("seed") = 0, pyb::arg("sets") = pyb::none(), pyb::arg("jobs") = ChooserParams{}.jobs,
+        (R"doc(The agent's choice of BVC elevations from its own exploratory walk, as `bvc3d choose-elevations`
+does it: the criterion (MSAI of the place-cell network on the walk, lower is better) of each
+candidate set of the greedy search, or of the given `sets` (lists of elevations, rad). Returns a
+dict: elevations, n_per_axis, msai (of the chosen set), candidates (a list of dicts: elevations,
+n_per_axis, round, msai, frac_multimodal), walk_steps, model_yaml. seed: the walk's; jobs: threads
+(0: every core). Keywords and their defaults:
+)doc" + describe(ChooserParams::table(), ChooserParams{}))
             .c_str());
     pyb::list metrics;
     for (const auto& mt : analysis::metric_table()) {

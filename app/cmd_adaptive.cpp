@@ -1,0 +1,130 @@
+// bvc3d choose-elevations: the agent chooses its BVC layers' elevations from a short exploratory walk
+// (docs/adaptive.md).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
+#include "bvc3d/experiment/elevation_chooser.hpp"
+#include "cli_common.hpp"
+
+namespace bvc3d::cli {
+
+namespace {
+
+struct ChooseOptions {
+    std::string world = "cross", lean = "+x+y", sensor = "spherical", agent = "ground", layers = "1-4", sets, out;
+    std::optional<double> tilt;
+    ChooserParams params;
+};
+
+// "2", "1-4": the fewest and most layers.
+std::pair<int, int> parse_layers(const std::string& text) {
+    const auto dash = text.find('-');
+    const auto whole = [&](const std::string& s) {
+        const double v = parse_number(s, "--layers");
+        if (v != static_cast<int>(v) || v < 1) throw InputError("--layers: '" + text + "' is not N or MIN-MAX with whole numbers >= 1");
+        return static_cast<int>(v);
+    };
+    if (dash == std::string::npos) return {whole(text), whole(text)};
+    return {whole(text.substr(0, dash)), whole(text.substr(dash + 1))};
+}
+
+// "0,0.2;0,0.1,0.2": elevation sets, each sorted.
+std::vector<std::vector<double>> parse_sets(const std::string& text) {
+    std::vector<std::vector<double>> sets(1);
+    std::string item;
+    const auto flush = [&] {
+        if (!item.empty()) sets.back().push_back(parse_number(item, "--sets"));
+        item.clear();
+    };
+    for (char ch : text) {
+        if (ch == ',' || ch == ';') flush();
+        if (ch == ';') sets.emplace_back();
+        if (ch != ',' && ch != ';') item += ch;
+    }
+    flush();
+    for (auto& s : sets) {
+        if (s.empty()) throw InputError("--sets: '" + text + "' has an empty set (give sets as 0,0.2;0,0.1,0.2)");
+        std::sort(s.begin(), s.end());
+    }
+    return sets;
+}
+
+void choose(const ChooseOptions& o) {
+    if (o.agent != "ground")
+        throw InputError("--agent: '" + o.agent + "' is not an agent this build has (ground: the paper's random walk)");
+    ChooserParams p = o.params;
+    std::tie(p.min_layers, p.max_layers) = parse_layers(o.layers);
+    ModelSpec base = model_preset("3d-0.2");
+    base.sensor = config::resolve_sensor(o.sensor);
+    p.validate(base.bvc.n_dir);
+    if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
+    // Fail before minutes of work, not after.
+    if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty()) ensure_writable_directory(folder);
+    const World world(config::resolve_world(o.world, o.tilt, o.lean));
+    const RandomWalkSpec agent;
+    InterruptGuard guard;
+    p.stop = &stop_flag();
+    std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n", o.world.c_str(),
+                format_number(p.explore_minutes).c_str(), static_cast<unsigned long long>(p.seed),
+                elevations_text(p.candidate_elevations()).c_str());
+    ElevationChoice c;
+    try {
+        c = o.sets.empty() ? choose_elevations(world, base, agent, p) : choose_from_sets(world, base, agent, parse_sets(o.sets), p);
+    } catch (const Interrupted&) {
+        std::fprintf(stderr, "\nbvc3d: interrupted; nothing was written.\n");
+        std::exit(130);
+    }
+    std::printf("%zu walk steps; criterion = MSAI of the network on the walk (lower is better)\n", c.walk_steps);
+    std::printf("%5s  %-28s %10s %8s %10s\n", "round", "elevations (rad)", "n_per_axis", "MSAI", "MI>1 frac");
+    for (const auto& s : c.candidates)
+        std::printf("%5d  %-28s %10d %8.4f %10.3f\n", s.round, elevations_text(s.elevations).c_str(), s.n_per_axis, s.msai,
+                    s.frac_multimodal);
+    std::printf("chosen: %s rad, %d per axis (MSAI %.4f)\n", elevations_text(c.chosen.elevations).c_str(), c.chosen.n_per_axis,
+                c.chosen.msai);
+    AtomicFile file(o.out);
+    file.stream() << "# chosen by bvc3d choose-elevations: world " << o.world << (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "")
+                  << ", sensor " << o.sensor << ", " << format_number(p.explore_minutes) << " min walk, seed " << p.seed
+                  << ", budget " << p.budget << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai)
+                  << "\n"
+                  << config::model_to_yaml(c.model);
+    file.commit();
+    std::printf("wrote %s\n", o.out.c_str());
+}
+
+}  // namespace
+
+void add_adaptive_command(CLI::App& app) {
+    auto o = std::make_shared<ChooseOptions>();
+    auto* cmd = app.add_subcommand("choose-elevations",
+                                   "Choose the BVC layers' elevations from a short exploratory walk; write the model YAML");
+    cmd->add_option("--world", o->world, "World preset or YAML file")->capture_default_str();
+    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
+    cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
+    cmd->add_option("--sensor", o->sensor, "Sensor preset or YAML file")->capture_default_str();
+    cmd->add_option("--agent", o->agent, "Who explores: ground (the paper's random walk)")->capture_default_str();
+    cmd->add_option("--budget", o->params.budget, "BVCs shared by the layers")->capture_default_str();
+    cmd->add_option("--layers", o->layers, "Number of layers: N or MIN-MAX")->capture_default_str();
+    cmd->add_option("--min-elevation", o->params.elevation_min, "Lowest candidate elevation, rad")->capture_default_str();
+    cmd->add_option("--max-elevation", o->params.elevation_max, "Highest candidate elevation, rad")->capture_default_str();
+    cmd->add_option("--elevation-step", o->params.elevation_step, "Spacing of the candidate elevations, rad")->capture_default_str();
+    cmd->add_option("--explore-minutes", o->params.explore_minutes, "Simulated minutes of the exploratory walk")
+        ->capture_default_str();
+    cmd->add_option("--seed", o->params.seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
+    cmd->add_option("--sets", o->sets,
+                    "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
+    cmd->add_option("--jobs", o->params.jobs, "Threads sharing the candidates; 0 (the default): one per core");
+    cmd->add_option("--out", o->out, "Model YAML file to write")->required();
+    cmd->callback([o] { choose(*o); });
+}
+
+}  // namespace bvc3d::cli

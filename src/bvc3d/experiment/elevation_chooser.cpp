@@ -1,0 +1,293 @@
+#include "bvc3d/experiment/elevation_chooser.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <thread>
+
+#include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/analysis/trial_metrics.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
+#include "bvc3d/core/random.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+// A source read twice over: step n of the second pass reads walk step n again, so both passes see
+// the same scans (and the same sensor noise).
+class ReplaySource : public ReturnSource {
+public:
+    ReplaySource(std::shared_ptr<ReturnSource> inner, std::uint64_t walk_steps)
+        : inner_(std::move(inner)), walk_steps_(walk_steps) {}
+    const LidarSpec* beam_table() const override { return inner_->beam_table(); }
+    void returns(std::uint64_t step, const Pose& pose, const std::vector<char>& rows, Scan& out) override {
+        inner_->returns(step % walk_steps_, pose, rows, out);
+    }
+
+private:
+    std::shared_ptr<ReturnSource> inner_;
+    std::uint64_t walk_steps_;
+};
+
+// One factory per worker thread: each distinct inner source is wrapped once, so models that share
+// it still share one scan per step.
+SourceFactory replay_factory(const SourceFactory& inner, std::uint64_t walk_steps, std::uint64_t noise_seed) {
+    auto wrapped = std::make_shared<std::vector<std::pair<std::shared_ptr<ReturnSource>, std::shared_ptr<ReturnSource>>>>();
+    return [=](const ModelSpec& model, const World& world) -> std::shared_ptr<ReturnSource> {
+        std::shared_ptr<ReturnSource> made = inner ? inner(model, world) : nullptr;
+        for (const auto& [from, replay] : *wrapped) {
+            const LidarSpec* table = from->beam_table();
+            if (made ? from == made : table && table->same_beams(model.sensor)) return replay;
+        }
+        if (!made) made = std::make_shared<RayCastSource>(world, model.sensor, noise_seed);
+        auto replay = std::make_shared<ReplaySource>(made, walk_steps);
+        wrapped->emplace_back(made, replay);
+        return replay;
+    };
+}
+
+// The walk, then the walk again: the agent the candidates' trials run on.
+std::shared_ptr<const AgentSpec> two_passes(const std::vector<ModelStep>& walk) {
+    std::vector<ModelStep> steps;
+    steps.reserve(2 * walk.size());
+    const double t0 = walk.front().t;
+    const double period = walk.back().t - t0 + (walk.back().t - walk[walk.size() - 2].t);
+    for (int pass = 0; pass < 2; ++pass)
+        for (ModelStep s : walk) {
+            s.t = s.t - t0 + pass * period;
+            steps.push_back(s);
+        }
+    return std::make_shared<TrajectorySpec>(std::move(steps), "exploratory walk, two passes");
+}
+
+// Learning through the first pass exactly: the runner hands out a step while the last one ended
+// before the phase's end, so the phase ends between the first pass's last two steps.
+Protocol two_pass_protocol(const std::vector<ModelStep>& walk) {
+    const double last = walk.back().t - walk.front().t;
+    const double before = walk[walk.size() - 2].t - walk.front().t;
+    Protocol p;
+    p.explore_hours = 0.5 * (last + before) / 3600.0;
+    p.sample_hours = 2.0 * (last + 1.0) / 3600.0;  // past the second pass's end: the path runs out first
+    return p;
+}
+
+CandidateScore score(const GroupResult& r, std::size_t model, const ModelSpec& spec,
+                     const analysis::AnalysisParams& analysis) {
+    const auto& rec = r.models.at(model);
+    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()), rec.n_place);
+    const auto m = analysis::analyze_trial<float>(r.x, r.y, rates, analysis);
+    CandidateScore s;
+    s.elevations = spec.bvc.elevations;
+    s.n_per_axis = spec.bvc.n_per_axis;
+    s.msai = m.aliasing.msai;
+    s.frac_multimodal = m.modality_summary.frac_multimodal;
+    return s;
+}
+
+// The lowest criterion; NaN (no bins) never wins, ties go to the first.
+std::size_t best_of(const std::vector<CandidateScore>& scores) {
+    std::size_t best = 0;
+    for (std::size_t i = 0; i < scores.size(); ++i)
+        if (std::isnan(scores[best].msai) || scores[i].msai < scores[best].msai) best = i;
+    return best;
+}
+
+}  // namespace
+
+const params::Table<ChooserParams>& ChooserParams::table() {
+    using namespace params;
+    static const Table<ChooserParams> t(
+        "elevation chooser",
+        {integer("budget", &ChooserParams::budget, at_least(1), "BVCs shared by the layers"),
+         integer("min_layers", &ChooserParams::min_layers, at_least(1), "fewest layers the search returns"),
+         integer("max_layers", &ChooserParams::max_layers, at_least(1), "most layers the search returns"),
+         real("elevation_min", &ChooserParams::elevation_min, closed(-std::numbers::pi / 2, std::numbers::pi / 2), "rad, lowest candidate elevation"),
+         real("elevation_max", &ChooserParams::elevation_max, closed(-std::numbers::pi / 2, std::numbers::pi / 2), "rad, highest candidate elevation"),
+         real("elevation_step", &ChooserParams::elevation_step, above(0), "rad, spacing of the candidate elevations"),
+         real("explore_minutes", &ChooserParams::explore_minutes, above(0), "simulated minutes of the exploratory walk")});
+    return t;
+}
+
+std::vector<double> ChooserParams::candidate_elevations() const {
+    std::vector<double> out;
+    if (!(elevation_step > 0)) return out;
+    // Multiples of the step from the minimum, with a little slack so that 0.4 is reached from 0 by 0.05.
+    for (int i = 0;; ++i) {
+        // Rounded to 12 decimals, so that 0.05 · 3 is the 0.15 a user would type.
+        const double e = std::round((elevation_min + i * elevation_step) * 1e12) / 1e12;
+        if (e > elevation_max + 1e-9 * std::max(1.0, std::abs(elevation_max))) break;
+        out.push_back(std::min(e, elevation_max));
+    }
+    return out;
+}
+
+void ChooserParams::validate(int n_dir) const {
+    table().check(*this);
+    if (min_layers > max_layers)
+        throw InputError("elevation chooser: min_layers (" + std::to_string(min_layers) + ") exceeds max_layers (" +
+                         std::to_string(max_layers) + ")");
+    if (elevation_min > elevation_max)
+        throw InputError("elevation chooser: empty candidate range: elevation_min " + format_number(elevation_min) +
+                         " > elevation_max " + format_number(elevation_max));
+    const auto n = static_cast<int>(candidate_elevations().size());
+    if (n < min_layers)
+        throw InputError("elevation chooser: the candidate range holds " + std::to_string(n) + " elevation(s), fewer than min_layers = " +
+                         std::to_string(min_layers));
+    const int layers = std::min(max_layers, n);
+    if (budget / (n_dir * layers) < 2)
+        throw InputError("elevation chooser: a budget of " + std::to_string(budget) + " BVCs is too small for " +
+                         std::to_string(layers) + " layers of " + std::to_string(n_dir) +
+                         " directions (each direction needs at least 2 distances: budget >= " +
+                         std::to_string(2 * n_dir * layers) + ")");
+}
+
+std::string elevations_text(const std::vector<double>& elevations) {
+    std::string s;
+    for (double e : elevations) s += (s.empty() ? "" : ", ") + format_number(e);
+    return s;
+}
+
+ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>& elevations, int budget) {
+    if (elevations.empty()) throw InputError("a candidate set needs at least one elevation");
+    ModelSpec m = base;
+    const int per_axis = budget / (base.bvc.n_dir * static_cast<int>(elevations.size()));
+    if (per_axis < 2)
+        throw InputError("a budget of " + std::to_string(budget) + " BVCs is too small for " +
+                         std::to_string(elevations.size()) + " layers of " + std::to_string(base.bvc.n_dir) + " directions");
+    m.bvc.elevations = elevations;
+    m.bvc.n_per_axis = per_axis;
+    m.name = "adaptive[" + elevations_text(elevations) + "]";
+    m.validate();
+    return m;
+}
+
+std::vector<ModelStep> exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
+                                        double d_th) {
+    agent.validate();
+    const auto walker = agent.make(world, seed);
+    std::vector<ModelStep> steps;
+    while (const auto s = walker->next(minutes * 60.0)) steps.push_back(*s);
+    // A pair farther apart than d_th, or aliasing has nothing to compare.
+    for (std::size_t i = 0; i < steps.size(); ++i)
+        for (std::size_t j = i + 1; j < steps.size(); ++j) {
+            const double dx = steps[i].pose.x - steps[j].pose.x, dy = steps[i].pose.y - steps[j].pose.y;
+            if (dx * dx + dy * dy > d_th * d_th) return steps;
+        }
+    throw InputError("the exploratory walk (" + format_number(minutes) + " min, " + std::to_string(steps.size()) +
+                     " steps) never gets two positions more than d_th = " + format_number(d_th) +
+                     " m apart: explore longer");
+}
+
+std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
+                                                 const std::vector<ModelStep>& walk,
+                                                 const std::vector<std::vector<double>>& sets, int budget,
+                                                 std::uint64_t seed, const analysis::AnalysisParams& analysis,
+                                                 int jobs, const SourceFactory& sources, const std::atomic<bool>* stop) {
+    if (jobs < 0) throw InputError("jobs must be >= 0");
+    if (walk.size() < 2) throw InputError("the exploratory walk needs at least 2 steps");
+    std::vector<TrialConfig> trials;
+    const auto agent = two_passes(walk);
+    const Protocol protocol = two_pass_protocol(walk);
+    for (const auto& set : sets) {
+        TrialConfig t;
+        t.model = model_with_elevations(base, set, budget);
+        t.protocol = protocol;
+        t.agent = agent;
+        t.analysis = analysis;
+        t.seed = seed;
+        trials.push_back(std::move(t));
+    }
+    const std::uint64_t noise_seed = hash_u64(seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
+    const std::size_t threads = std::clamp<std::size_t>(static_cast<std::size_t>(jobs > 0 ? jobs : std::max(1u, std::thread::hardware_concurrency())), 1, std::max<std::size_t>(sets.size(), 1));
+    std::vector<CandidateScore> out(sets.size());
+    std::vector<std::exception_ptr> errors(threads);
+    // Thread k runs sets k, k + threads, ...: one group each, sharing its scans between its sets.
+    auto work = [&](std::size_t k) {
+        try {
+            std::vector<TrialConfig> mine;
+            std::vector<std::size_t> index;
+            for (std::size_t i = k; i < trials.size(); i += threads) {
+                mine.push_back(trials[i]);
+                index.push_back(i);
+            }
+            if (mine.empty()) return;
+            RunControl control;
+            control.stop = stop;
+            const GroupResult r = run_trial_group(world, mine, control, replay_factory(sources, walk.size(), noise_seed));
+            for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(r, m, mine[m].model, analysis);
+        } catch (...) {
+            errors[k] = std::current_exception();
+        }
+    };
+    if (threads == 1) {
+        work(0);
+    } else {
+        std::vector<std::thread> pool;
+        for (std::size_t k = 0; k < threads; ++k) pool.emplace_back(work, k);
+        for (auto& th : pool) th.join();
+    }
+    for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
+    return out;
+}
+
+ElevationChoice choose_elevations(const World& world, const ModelSpec& base, const AgentSpec& agent,
+                                  const ChooserParams& params, const analysis::AnalysisParams& analysis,
+                                  const SourceFactory& sources) {
+    params.validate(base.bvc.n_dir);
+    analysis.validate();
+    const std::vector<double> pool = params.candidate_elevations();
+    const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
+
+    ElevationChoice choice;
+    choice.walk_steps = walk.size();
+    std::vector<double> best_set;
+    const int max_layers = std::min<int>(params.max_layers, static_cast<int>(pool.size()));
+    for (int round = 1; round <= max_layers; ++round) {
+        std::vector<std::vector<double>> sets;
+        for (double e : pool) {
+            if (std::find(best_set.begin(), best_set.end(), e) != best_set.end()) continue;
+            auto set = best_set;
+            set.insert(std::upper_bound(set.begin(), set.end(), e), e);
+            sets.push_back(std::move(set));
+        }
+        auto scores = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
+                                           params.stop);
+        for (auto& s : scores) s.round = round;
+        choice.candidates.insert(choice.candidates.end(), scores.begin(), scores.end());
+        const CandidateScore& top = scores[best_of(scores)];
+        const bool improves = round == 1 || top.msai < choice.chosen.msai;
+        if (!improves && round > params.min_layers) break;
+        choice.chosen = top;
+        best_set = top.elevations;
+    }
+    if (std::isnan(choice.chosen.msai)) throw InputError("the exploratory walk gave no bins to measure aliasing on");
+    choice.model = model_with_elevations(base, choice.chosen.elevations, params.budget);
+    return choice;
+}
+
+ElevationChoice choose_from_sets(const World& world, const ModelSpec& base, const AgentSpec& agent,
+                                 const std::vector<std::vector<double>>& sets, const ChooserParams& params,
+                                 const analysis::AnalysisParams& analysis, const SourceFactory& sources) {
+    if (sets.empty()) throw InputError("no elevation sets to choose from");
+    ChooserParams::table().check(params);
+    analysis.validate();
+    for (const auto& set : sets) model_with_elevations(base, set, params.budget);  // fail before the walk
+    const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
+    ElevationChoice c;
+    c.walk_steps = walk.size();
+    c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
+                                           params.stop);
+    for (auto& s : c.candidates) s.round = static_cast<int>(s.elevations.size());
+    c.chosen = c.candidates[best_of(c.candidates)];
+    if (std::isnan(c.chosen.msai)) throw InputError("the exploratory walk gave no bins to measure aliasing on");
+    c.model = model_with_elevations(base, c.chosen.elevations, params.budget);
+    return c;
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,122 @@
+"""Adaptive elevations: `bvc3d choose-elevations` and `bvc3d.choose_elevations` (docs/adaptive.md).
+
+The oracle for the criterion: the chosen model run as an ordinary trial on the chooser's own walk
+(twice: learning, then frozen) through `run_trial` with a trajectory, and its MSAI computed here
+with numpy from the returned rates (hexbin bins from matplotlib, the SAI sum written out).
+"""
+import math
+import re
+
+import numpy as np
+import pytest
+import yaml
+
+import bvc3d
+
+SETS = "0,0.2;0.1"
+ROW = re.compile(r"^\s*(\d+)\s+([-\d., ]+?)\s+(\d+)\s+([-\d.]+|nan)\s+([-\d.]+|nan)\s*$")
+
+
+def printed_table(stdout):
+    """{elevations: criterion} from the program's table of candidates."""
+    rows = [ROW.match(l) for l in stdout.splitlines()]
+    return {tuple(float(v) for v in m.group(2).split(",")): float(m.group(4)) for m in rows if m}
+
+
+def test_cli_prints_every_candidate_and_writes_the_model_with_the_criterion(cli, tmp_path):
+    out = tmp_path / "chosen.yaml"
+    res = cli("choose-elevations", "--world", "cross", "--tilt", 45, "--sets", SETS, "--explore-minutes", 4,
+              "--seed", 3, "--jobs", 2, "--out", out, check=True)
+    table = printed_table(res.stdout)
+    assert set(table) == {(0.0, 0.2), (0.1,)}
+    text = out.read_text()
+    best = min(table, key=table.get)
+    assert "criterion (MSAI of the network on the walk): " in text
+    crit = float(text.split("criterion (MSAI of the network on the walk): ")[1].split()[0])
+    assert crit == pytest.approx(table[best], abs=5e-5)  # the table prints 4 decimals
+    model = yaml.safe_load(text)
+    assert model["bvc"]["elevations"] == list(best)
+    assert model["bvc"]["n_per_axis"] == 960 // (8 * len(best))
+    # The written file is a model the program reads.
+    cli("config", "--model", out, check=True)
+
+
+def test_python_binding_matches_the_program(cli, tmp_path):
+    res = bvc3d.choose_elevations("cross", 45.0, seed=3, sets=[[0.0, 0.2], [0.1]], jobs=1, explore_minutes=4)
+    by_set = {tuple(c["elevations"]): c["msai"] for c in res["candidates"]}
+    out = cli("choose-elevations", "--world", "cross", "--tilt", 45, "--sets", SETS, "--explore-minutes", 4,
+              "--seed", 3, "--jobs", 1, "--out", tmp_path / "m.yaml", check=True).stdout
+    printed = printed_table(out)
+    assert set(printed) == set(by_set)
+    for key, v in printed.items():
+        assert by_set[key] == pytest.approx(v, abs=5e-5)
+    assert res["elevations"] == list(min(by_set, key=by_set.get))
+    assert yaml.safe_load(res["model_yaml"])["bvc"]["elevations"] == res["elevations"]
+
+
+def numpy_msai(x, y, rates, gridsize=50, q=10.0, d_th=2.0):
+    """MSAI as docs/analysis.md defines it, from matplotlib's hexbin and numpy alone."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    maps = []
+    fig, ax = plt.subplots()
+    for c in range(rates.shape[1]):
+        hb = ax.hexbin(x, y, C=rates[:, c].astype(np.float64), gridsize=gridsize, reduce_C_function=np.mean)
+        v = np.ma.getdata(hb.get_array()).astype(np.float64)
+        centers = hb.get_offsets().copy()
+        hb.remove()
+        v[v < np.percentile(v, q)] = 0
+        m = v.max()
+        maps.append(v / m if m > 0 else v)
+    plt.close(fig)
+    a = np.array(maps).T  # bins × cells
+    norm = np.linalg.norm(a, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = (a @ a.T) / np.outer(norm, norm)
+    cos[~np.isfinite(cos)] = 0
+    far = np.linalg.norm(centers[:, None, :] - centers[None, :, :], axis=2) > d_th
+    return float((cos * far).sum(axis=1).mean() / len(a))
+
+
+def test_criterion_against_numpy_on_the_walk_run_as_a_trial(tmp_path):
+    res = bvc3d.choose_elevations("cross", 60.0, seed=2, sets=[[0.0, 0.3]], jobs=1, explore_minutes=3)
+    walk = bvc3d.random_walk(bvc3d.World.cross(tilt_deg=60.0), 3 / 60, 2)
+    t = np.asarray(walk["t"]) - walk["t"][0]
+    period = t[-1] + (t[-1] - t[-2])
+    both = {k: np.concatenate([np.asarray(walk[k])] * 2) for k in ("x", "y", "heading")}
+    both["t"] = np.concatenate([t, t + period])
+    last, before = t[-1], t[-2]
+    model = tmp_path / "chosen.yaml"
+    model.write_text(res["model_yaml"])
+    trial = bvc3d.run_trial(str(model), "cross", 60.0, seed=2, trajectory=both,
+                            explore_hours=0.5 * (last + before) / 3600, sample_hours=2 * (last + 1) / 3600)
+    assert len(trial["x"]) == len(t)
+    assert numpy_msai(trial["x"], trial["y"], trial["rates"]) == pytest.approx(res["msai"], rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--budget", "40", "--layers", "1-4"], "too small for 4 layers"),
+    (["--min-elevation", "0.3", "--max-elevation", "0.1"], "empty candidate range"),
+    (["--explore-minutes", "0.05"], "explore longer"),
+    (["--layers", "3-2"], "exceeds max_layers"),
+    (["--layers", "two"], "--layers"),
+    (["--agent", "submarine"], "--agent"),
+    (["--sets", "0,0.2;;0.1"], "empty set"),
+    (["--sensor", "no-such-sensor"], "no-such-sensor"),
+])
+def test_bad_input_is_refused_with_exit_2_and_no_file(cli, tmp_path, args, words):
+    out = tmp_path / "m.yaml"
+    res = cli("choose-elevations", "--world", "cross", "--tilt", 30, *args, "--out", out)
+    assert res.returncode == 2, res.stderr
+    assert words in res.stderr
+    assert not out.exists()
+    assert not list(tmp_path.iterdir())
+
+
+def test_python_bad_input_raises_input_error():
+    with pytest.raises(bvc3d.InputError, match="empty candidate range"):
+        bvc3d.choose_elevations("cross", 30.0, elevation_min=0.3, elevation_max=0.1)
+    with pytest.raises(bvc3d.InputError, match="unknown argument"):
+        bvc3d.choose_elevations("cross", 30.0, elevations_max=0.1)
+    assert math.isfinite(bvc3d.choose_elevations("cross", 30.0, sets=[[0.0]], explore_minutes=3, jobs=1)["msai"])
