@@ -217,7 +217,7 @@ INTERRUPT = textwrap.dedent("""
         if call == "run_trial":
             bvc3d.run_trial(explore_hours=50, sample_hours=1)
         elif call == "random_walk":
-            bvc3d.random_walk(bvc3d.World.cross(), 400, 0)
+            bvc3d.random_walk(bvc3d.World.cross(), 800, 0)  # seconds of work; the signal comes at 0.3 s
         else:
             rng = np.random.default_rng(0)  # DBSCAN per cell over 20000 bins with ~600 neighbors each
             analysis.modality(rng.uniform(0, 100, (20000, 2)), np.ones((20000, 300)), eps=10.0, min_samples=5)
@@ -232,7 +232,7 @@ def test_ctrl_c_interrupts_long_python_calls(call):
     proc = subprocess.Popen([PYTHON, "-c", INTERRUPT, call], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=dict(os.environ, PYTHONPATH=PYTHONPATH))
     assert proc.stdout.readline().strip() == "ready"
-    time.sleep(1.5)  # well inside the call
+    time.sleep(0.3)  # inside the call (each runs for seconds at least)
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)
