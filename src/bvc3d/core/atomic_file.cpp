@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstring>
 
 #include "bvc3d/core/error.hpp"
@@ -27,24 +28,47 @@ AtomicFile::~AtomicFile() {
     std::filesystem::remove(temp_, ec);
 }
 
+namespace {
+// Why the last write failed: the system's reason when it left one.
+std::string write_failure(const std::filesystem::path& target, int error) {
+    return "cannot write '" + target.string() + "': " + (error ? std::strerror(error) : "write error");
+}
+}  // namespace
+
 std::ofstream& AtomicFile::stream() {
     if (!out_.is_open()) {
-        out_.open(temp_, std::ios::out | std::ios::trunc);
-        if (!out_) throw InputError("cannot write '" + target_.string() + "': " + std::strerror(errno));
+        errno = 0;
+        out_.open(temp_, std::ios::out | std::ios::trunc | std::ios::binary);
+        if (!out_) throw InputError(write_failure(target_, errno));
     }
     return out_;
 }
 
+void AtomicFile::write(std::string_view bytes) {
+    std::ofstream& out = stream();
+    errno = 0;
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw InputError(write_failure(target_, errno));
+}
+
 void AtomicFile::commit() {
     if (out_.is_open()) {
+        errno = 0;
         out_.flush();
-        if (!out_) throw InputError("error while writing '" + target_.string() + "'");
+        if (!out_) throw InputError(write_failure(target_, errno));
         out_.close();
+        if (out_.fail()) throw InputError(write_failure(target_, errno));
     }
     std::error_code ec;
     std::filesystem::rename(temp_, target_, ec);
     if (ec) throw InputError("cannot write '" + target_.string() + "': " + ec.message());
     committed_ = true;
+}
+
+void write_file_atomically(const std::filesystem::path& target, std::string_view bytes) {
+    AtomicFile file(target);
+    file.write(bytes);
+    file.commit();
 }
 
 void ensure_writable_directory(const std::filesystem::path& dir) {
