@@ -153,8 +153,7 @@ TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
 }
 
 std::unique_ptr<Agent> TrajectorySpec::make(const World& world, std::uint64_t) const {
-    Eigen::AlignedBox3d box;
-    for (const auto& v : world.mesh().vertices) box.extend(v);
+    const Eigen::AlignedBox3d box = world.description().bounds();
     for (std::size_t i = 0; i < steps_->size(); ++i) {
         const Pose& p = (*steps_)[i].pose;
         if (!box.contains(p.position()))
