@@ -1,5 +1,4 @@
 // bvc3d run / paper / analyze: trials, the paper's experiment, and analysis of trial files.
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -37,29 +36,6 @@ std::vector<std::string> split(const std::string& s) {
     for (std::string item; std::getline(ss, item, ',');)
         if (!item.empty()) out.push_back(item);
     return out;
-}
-
-// Runs the report module, `python3 -m bvc3d.report DIR`, as a child process (no shell); returns
-// its exit status.
-int run_report(const std::filesystem::path& dir) {
-    const char* py_env = std::getenv("BVC3D_PYTHON");
-    const std::string python = py_env ? py_env : BVC3D_PYTHON;
-    const char* path_env = std::getenv("BVC3D_PYTHONPATH");
-    std::string pythonpath = path_env ? path_env : BVC3D_PYTHON_DIR;
-    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing) pythonpath += std::string(":") + existing;
-    std::fflush(stdout);  // our lines first, then the report's
-    const pid_t pid = ::fork();
-    if (pid < 0) return -1;
-    if (pid == 0) {
-        ::setenv("PYTHONPATH", pythonpath.c_str(), 1);
-        ::execl(python.c_str(), python.c_str(), "-m", "bvc3d.report", dir.c_str(), static_cast<char*>(nullptr));
-        std::perror(("bvc3d: cannot run " + python).c_str());
-        ::_exit(127);
-    }
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace
@@ -117,7 +93,7 @@ void summarize(const std::filesystem::path& out, const std::vector<std::filesyst
     write_trials_csv(out / "trials.csv", trials);
     write_summary_csv(out / "summary.csv", rows);
     write_summary_markdown(out / "summary.md", rows);
-    if (report && run_report(out) != 0)
+    if (report && run_python_module("bvc3d.report", {out.string()}) != 0)
         throw InputError("the report (figures) failed; the trial files and summary are in '" + out.string() +
                          "'; rerun with: python3 -m bvc3d.report " + out.string());
 }

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     bvc3d::cli::add_model_commands(app);
     bvc3d::cli::add_experiment_commands(app);
     bvc3d::cli::add_sweep_command(app);
+    bvc3d::cli::add_recording_commands(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -162,11 +162,12 @@ void RandomWalk::restore_state(const std::string& text) {
     restore(w);
 }
 
-std::unique_ptr<Agent> RandomWalkSpec::make(const World& world, std::uint64_t seed) const {
+std::unique_ptr<Agent> RandomWalkSpec::make(const World* world, std::uint64_t seed) const {
     validate();
-    auto body = std::make_shared<const BodyCollider>(world.description(), robot_.radius, robot_.height);
+    if (!world) throw InputError("the random walk needs a world to walk in");
+    auto body = std::make_shared<const BodyCollider>(world->description(), robot_.radius, robot_.height);
     Rng rng(seed, Stream::walk);
-    const Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    const Pose start = RandomWalk::draw_start(world->description(), *body, rng);
     return std::make_unique<RandomWalk>(body, robot_, std::move(rng), start);
 }
 
@@ -174,7 +175,7 @@ std::string RandomWalkSpec::key() const { return "robot:\n" + params::yaml_lines
 
 std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params) {
     if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0");
-    const auto walk = RandomWalkSpec(params).make(world, seed);
+    const auto walk = RandomWalkSpec(params).make(&world, seed);
     std::vector<ModelStep> steps;
     steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
     while (auto s = walk->next(hours * 3600.0)) steps.push_back(*s);

@@ -80,7 +80,7 @@ public:
     const RobotParams& robot() const { return robot_; }
     std::string kind() const override { return "random_walk"; }
     void validate() const override { robot_.validate(); }
-    std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
+    std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override { return 1.0 / robot_.model_dt; }
 

@@ -32,23 +32,27 @@ void Trajectory::restore_state(const std::string& state) {
 
 std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std::vector<double>& x,
                                         const std::vector<double>& y, const std::vector<double>& z,
-                                        const std::vector<double>& heading, const std::string& source) {
+                                        const std::vector<double>& heading, const std::string& source,
+                                        const std::vector<double>& pitch, const std::vector<double>& roll) {
     const std::size_t n = t.size();
-    if (x.size() != n || y.size() != n || heading.size() != n || (!z.empty() && z.size() != n))
-        throw InputError(source + ": t, x, y, z and heading must have the same length");
+    if (x.size() != n || y.size() != n || heading.size() != n || (!z.empty() && z.size() != n) ||
+        (!pitch.empty() && pitch.size() != n) || (!roll.empty() && roll.size() != n))
+        throw InputError(source + ": t, x, y, z, heading, pitch and roll must have the same length");
     if (n == 0) throw InputError(source + ": the trajectory has no rows");
     std::vector<ModelStep> steps(n);
     for (std::size_t i = 0; i < n; ++i) {
         const double zi = z.empty() ? 0.0 : z[i];
+        const double pi_ = pitch.empty() ? 0.0 : pitch[i], ri = roll.empty() ? 0.0 : roll[i];
         const auto where = [&] { return source + ": row " + std::to_string(i) + ": "; };
-        for (double v : {t[i], x[i], y[i], zi, heading[i]})
+        for (double v : {t[i], x[i], y[i], zi, heading[i], pi_, ri})
             if (!std::isfinite(v)) throw InputError(where() + "every value must be finite");
+        if (std::abs(pi_) > pi / 2) throw InputError(where() + "pitch must lie within ±90°");
         if (std::abs(x[i]) > 1e6 || std::abs(y[i]) > 1e6 || std::abs(zi) > 1e6)
             throw InputError(where() + "coordinates must lie within ±1e6 m");
         if (i > 0 && !(t[i] > t[i - 1]))
             throw InputError(where() + "times must increase (" + format_number(t[i]) + " after " +
                              format_number(t[i - 1]) + ")");
-        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), 0.0, 0.0}, false};
+        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), pi_, wrap_pi(ri)}, false};
     }
     return steps;
 }
@@ -85,7 +89,7 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
     std::ifstream in(path);
     if (!in) throw InputError(name + (std::filesystem::exists(path, ec) ? " cannot be read" : " does not exist"));
     std::vector<std::string> columns;  // from the header, if any
-    std::vector<double> t, x, y, z, heading;
+    std::vector<double> t, x, y, z, heading, pitch, roll;
     bool degrees = false;
     std::string line;
     for (int line_no = 1; std::getline(in, line); ++line_no) {
@@ -98,9 +102,16 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             for (const auto& c : {"t", "x", "y"})
                 if (std::find(columns.begin(), columns.end(), c) == columns.end())
                     throw InputError(at + "the header lacks the column '" + c + "'");
-            const bool h = std::find(columns.begin(), columns.end(), "heading") != columns.end();
-            degrees = std::find(columns.begin(), columns.end(), "heading_deg") != columns.end();
-            if (h == degrees) throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
+            const auto has = [&](const char* c) { return std::find(columns.begin(), columns.end(), c) != columns.end(); };
+            degrees = has("heading_deg");
+            if (has("heading") == degrees) throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
+            for (const auto& c : columns)
+                if (c != "t" && c != "x" && c != "y" && c != "z" && c != "heading" && c != "heading_deg" && c != "pitch" &&
+                    c != "roll" && c != "pitch_deg" && c != "roll_deg")
+                    throw InputError(at + "unknown column '" + c +
+                                     "' (known: t, x, y, z, heading or heading_deg, pitch or pitch_deg, roll or roll_deg)");
+            if ((has("pitch") && has("pitch_deg")) || (has("roll") && has("roll_deg")))
+                throw InputError(at + "give each angle in radians or in degrees, not both");
             continue;
         }
         if (columns.empty()) {
@@ -123,9 +134,13 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             else if (col == "z") z.push_back(v);
             else if (col == "heading") heading.push_back(v);
             else if (col == "heading_deg") heading.push_back(deg_to_rad(v));
+            else if (col == "pitch") pitch.push_back(v);
+            else if (col == "pitch_deg") pitch.push_back(deg_to_rad(v));
+            else if (col == "roll") roll.push_back(v);
+            else if (col == "roll_deg") roll.push_back(deg_to_rad(v));
         }
     }
-    return trajectory_steps(t, x, y, z, heading, name);
+    return trajectory_steps(t, x, y, z, heading, name, pitch, roll);
 }
 
 namespace {
@@ -137,8 +152,13 @@ std::uint64_t hash_steps(const std::vector<ModelStep>& steps) {
         std::memcpy(&bits, &v, sizeof bits);
         h = hash_u64(h, bits, 0x51);
     };
-    for (const auto& s : steps)
+    for (const auto& s : steps) {
         for (double v : {s.t, s.pose.x, s.pose.y, s.pose.z, s.pose.heading}) mix(v);
+        if (!s.pose.level()) {  // level paths keep the keys they always had
+            mix(s.pose.pitch);
+            mix(s.pose.roll);
+        }
+    }
     return h;
 }
 
@@ -152,7 +172,9 @@ TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
     return TrajectorySpec(read_trajectory_file(path), path.string());
 }
 
-std::unique_ptr<Agent> TrajectorySpec::make(const World& world, std::uint64_t) const {
+std::unique_ptr<Agent> TrajectorySpec::make(const World* world_or_null, std::uint64_t) const {
+    if (!world_or_null) return std::make_unique<Trajectory>(steps_);
+    const World& world = *world_or_null;
     const Eigen::AlignedBox3d box = world.description().bounds();
     for (std::size_t i = 0; i < steps_->size(); ++i) {
         const Pose& p = (*steps_)[i].pose;

@@ -30,6 +30,7 @@ void write_identity(hid_t f, const TrialIdentity& id) {
     h5::write_attr(f, "sample_hours", id.sample_hours);
     h5::write_attr(f, "config", id.config);
     h5::write_attr(f, "fingerprint", id.fingerprint);
+    for (const auto& [name, value] : id.data_source) h5::write_attr(f, name, value);
 }
 
 void write_array(hid_t loc, const NamedArray& a) {
@@ -151,6 +152,41 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     d.rates = h5::read_floats(s, "rates");
     d.n_place = dims[1];
     return d;
+}
+
+TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc) {
+    auto lock = h5::hdf5_lock();
+    const auto f = open_trial(path);
+    const auto s = h5::open_group(f, "samples");
+    const char* name = bvc ? "bvc_rates" : "rates";
+    if (!h5::exists(s, name))
+        throw InputError("trial file '" + path.string() + "' has no " + (bvc ? "BVC rates (samples/bvc_rates): rerun it recording them" : "samples/rates"));
+    TrialRates r;
+    r.t = h5::read_doubles(s, "t");
+    r.x = h5::read_doubles(s, "x");
+    r.y = h5::read_doubles(s, "y");
+    r.z = h5::exists(s, "z") ? h5::read_doubles(s, "z") : std::vector<double>(r.x.size(), 0.0);
+    r.heading = h5::read_doubles(s, "heading");
+    const auto dims = h5::dims(s, name);
+    const std::size_t n = r.x.size();
+    if (dims.size() != 2 || dims[0] != n || r.y.size() != n || r.z.size() != n || r.t.size() != n || r.heading.size() != n)
+        throw InputError("trial file '" + path.string() + "': samples/" + name + " has the wrong shape");
+    r.rates = h5::read_floats(s, name);
+    r.n_cells = dims[1];
+    return r;
+}
+
+TrialWeights read_trial_weights(const std::filesystem::path& path) {
+    auto lock = h5::hdf5_lock();
+    const auto f = open_trial(path);
+    if (!h5::exists(f, "weights")) throw InputError("trial file '" + path.string() + "' has no weights");
+    const auto dims = h5::dims(f, "weights");
+    if (dims.size() != 2) throw InputError("trial file '" + path.string() + "': weights has the wrong shape");
+    TrialWeights w;
+    w.values = h5::read_floats(f, "weights");
+    w.n_place = dims[0];
+    w.n_bvc = dims[1];
+    return w;
 }
 
 TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names) {

@@ -25,6 +25,9 @@ struct TrialIdentity {
     std::uint64_t seed = 0;
     double tilt_deg = NAN;  // cross arenas only
     double explore_hours = NAN, sample_hours = NAN;
+    // Where the returns came from when not from the world (a replayed recording: its name and
+    // files), written as text attributes of these names when present.
+    std::vector<std::pair<std::string, std::string>> data_source;
 };
 
 // A named array of a trial file, row-major with the given shape.
@@ -64,6 +67,22 @@ struct TrialFileData : TrialIdentity {
     std::size_t n_place = 0;
 };
 TrialFileData read_trial_samples(const std::filesystem::path& path);  // throws InputError
+
+// The recorded samples' positions and one kind of rates: place-cell rates (`rates`) or BVC rates
+// (`bvc_rates`, present when the trial recorded them; InputError naming the file otherwise).
+struct TrialRates {
+    std::vector<double> t, x, y, z, heading;  // z all 0 for ground trials
+    std::vector<float> rates;                 // samples × cells
+    std::size_t n_cells = 0;
+};
+TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc);
+
+// The trained weights (n_place × n_bvc, row-major) of a trial file.
+struct TrialWeights {
+    std::vector<float> values;
+    std::size_t n_place = 0, n_bvc = 0;
+};
+TrialWeights read_trial_weights(const std::filesystem::path& path);
 
 // The named scalar metrics of a file, for summaries; a metric the file lacks (written before it
 // existed) reads as NaN.
