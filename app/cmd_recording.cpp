@@ -520,19 +520,10 @@ void add_export_scans(CLI::App& app) {
             line.show("scan", i + 1, steps.size());
             const Pose& p = steps[i].pose;
             lidar.scan(world, p, scan, NoiseKey{noise_seed, i});
-            const Eigen::Matrix3d R = p.rotation();
             recording::PoseRecord pose;
-            pose.world_from_sensor.linear() = R;
-            pose.world_from_sensor.translation() = p.position() + R * Vec3(0, 0, lidar.spec().height);
+            pose.world_from_sensor = sensor_pose(p, lidar.spec().height);
             pose.time = steps[i].t;
-            recording::PointCloud cloud;
-            cloud.xyz.reserve(3 * scan.size());
-            for (const auto& r : scan) {
-                const Vec3 v(r.range * std::cos(r.elevation) * std::cos(r.azimuth),
-                             r.range * std::cos(r.elevation) * std::sin(r.azimuth), r.range * std::sin(r.elevation));
-                const Vec3 s = R.transpose() * v;
-                cloud.xyz.insert(cloud.xyz.end(), {s.x(), s.y(), s.z()});
-            }
+            recording::PointCloud cloud = points_from_returns(scan, pose.world_from_sensor.linear());
             if (cloud.size() == 0)
                 throw InputError("step " + std::to_string(i) + " at (" + num(p.x) + ", " + num(p.y) +
                                  "): the sensor sees nothing, and a recording's scan cannot be empty");

@@ -3,11 +3,14 @@
 The compiled core does the work; this package re-exports it with numpy in and numpy out.
 Stages follow the data flow: World -> agent (random_walk, read_trajectory) -> Sensor scan ->
 BoundaryVectorLayer -> PlaceCellNetwork -> recorded samples -> bvc3d.analysis -> bvc3d.report.
+Real LiDAR recordings: Recording.open(scans, poses) -> recording.returns / recording.replay ->
+localize (docs/recordings.md).
 """
-from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Sensor, World, metric_table, model_presets,
-                    model_sensor, random_walk, read_trajectory, run_trial)
+from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Recording, Sensor, World, localize, metric_table,
+                    model_presets, model_sensor, random_walk, read_trajectory, replay_simulated, run_trial)
 from . import analysis
 
-__all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Sensor", "World", "analysis", "metric_table",
-           "model_presets", "model_sensor", "random_walk", "read_trajectory", "run_trial"]
+__all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording", "Sensor", "World", "analysis",
+           "localize", "metric_table", "model_presets", "model_sensor", "random_walk", "read_trajectory",
+           "replay_simulated", "run_trial"]
 __version__ = "0.1.0"

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
@@ -244,4 +245,18 @@ TEST(World, PointCloudWorldScansAndBounds) {
     const Scan s = Lidar(LidarSpec::horizontal()).scan(world, Pose::on_floor(0, 0, 0.3));
     ASSERT_EQ(s.size(), 720u);
     for (const auto& r : s) ASSERT_NEAR(r.range, 3.9, 1e-3);  // between sphere centers the ring is slightly deeper
+}
+
+TEST(World, CopiesOutliveTheOriginalWithSpheres) {
+    // Copies of a World share its caster: the caster must not point into the original's data.
+    std::optional<World> copy;
+    {
+        WorldDescription w;
+        w.name = "one";
+        w.spheres.push_back(SphereSet{{Vec3(2, 0, 0)}, 0.5});
+        w.walkable = Polygon2::rectangle(-1, -1, 1, 1);
+        const World original(w);
+        copy.emplace(original);
+    }
+    EXPECT_NEAR(copy->rays().cast(Vec3::Zero(), Vec3::UnitX(), 10.0), 1.5, 1e-12);
 }

@@ -29,9 +29,13 @@ std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 0xcbf29ce484222325
     return h;
 }
 
+// A folder's name; for a list file, the name of the folder holding it (the recording's folder);
+// for a single scan, its stem.
 std::string recording_name(const fs::path& scans) {
-    const fs::path p = scans.has_filename() ? scans : scans.parent_path();
-    return fs::is_directory(p) ? p.filename().string() : p.stem().string();
+    const fs::path p = fs::absolute(scans.has_filename() ? scans : scans.parent_path()).lexically_normal();
+    if (fs::is_directory(p)) return p.filename().string();
+    if (scan_format_of(p)) return p.stem().string();
+    return p.parent_path().filename().string();
 }
 
 }  // namespace

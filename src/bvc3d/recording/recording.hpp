@@ -21,7 +21,7 @@ struct RecordingOptions {
 };
 
 struct Recording {
-    std::string name;  // the scan folder's or list file's name
+    std::string name;  // the scan folder's name (a list file's: the folder holding it; one scan's: its stem)
     std::filesystem::path scans_source, poses_source;
     std::vector<ScanEntry> scans;   // in recording order
     std::vector<PoseRecord> poses;  // world_from_sensor of each scan (paired, extrinsics applied)

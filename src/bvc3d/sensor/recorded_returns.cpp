@@ -81,6 +81,25 @@ void returns_from_points(std::span<const double> xyz, const Eigen::Matrix3d& R, 
     }
 }
 
+recording::PointCloud points_from_returns(const Scan& scan, const Eigen::Matrix3d& R) {
+    recording::PointCloud cloud;
+    cloud.xyz.reserve(3 * scan.size());
+    for (const auto& r : scan) {
+        const double c = std::cos(r.elevation);
+        const Vec3 v(r.range * c * std::cos(r.azimuth), r.range * c * std::sin(r.azimuth), r.range * std::sin(r.elevation));
+        const Vec3 p = R.transpose() * v;
+        cloud.xyz.insert(cloud.xyz.end(), {p.x(), p.y(), p.z()});
+    }
+    return cloud;
+}
+
+Eigen::Isometry3d sensor_pose(const Pose& agent, double height) {
+    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+    m.linear() = agent.rotation();
+    m.translation() = agent.position() + m.linear() * Vec3(0, 0, height);
+    return m;
+}
+
 void filter_returns(Scan& scan, const RecordedReturnParams& p, ReturnSelection selection) {
     std::erase_if(scan, [&](const LidarReturn& r) {
         return !(r.range >= p.min_range && r.range <= p.max_range) || !keeps_elevation(r.elevation, p, selection);

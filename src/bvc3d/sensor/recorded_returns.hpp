@@ -40,6 +40,12 @@ struct RecordedReturnParams {
 void returns_from_points(std::span<const double> xyz, const Eigen::Matrix3d& world_from_sensor,
                          const RecordedReturnParams& params, ReturnSelection selection, Scan& out);
 
+// The other way (exporting simulated scans as a recording): world-frame returns as points in the
+// frame of a sensor with rotation `world_from_sensor` (p = Rᵀ·v).
+recording::PointCloud points_from_returns(const Scan& scan, const Eigen::Matrix3d& world_from_sensor);
+// Where a simulated sensor is: `height` above the agent's base along its up axis, turned with it.
+Eigen::Isometry3d sensor_pose(const Pose& agent, double height);
+
 // Drops the returns outside the range limits and the selection, in place (order kept).
 void filter_returns(Scan& scan, const RecordedReturnParams& params, ReturnSelection selection);
 

@@ -31,7 +31,7 @@ void check_device(RTCDevice device, const char* what) {
 }  // namespace
 
 RayCaster::RayCaster(const TriangleMesh& mesh, const std::vector<SphereSet>& spheres)
-    : impl_(std::make_unique<Impl>()), spheres_(&spheres) {
+    : impl_(std::make_unique<Impl>()), spheres_(spheres) {
     std::size_t n_spheres = 0;
     for (const auto& set : spheres) {
         if (!(set.radius > 0) || !std::isfinite(set.radius))
@@ -93,7 +93,7 @@ RayCaster::~RayCaster() = default;
 
 double RayCaster::refine(unsigned geom, unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const {
     if (geom >= first_sphere_geom_) {
-        const SphereSet& set = (*spheres_)[geom - first_sphere_geom_];
+        const SphereSet& set = spheres_[geom - first_sphere_geom_];
         return refine_sphere(set.centers[prim], set.radius, origin, dir, t_float);
     }
     const Vec3& n = plane_normal_[prim];

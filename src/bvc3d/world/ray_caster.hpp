@@ -38,7 +38,7 @@ private:
     std::vector<Vec3> plane_point_, plane_normal_;  // per triangle, double precision
     // Embree geometry IDs: the triangles (if any) first, then one per sphere set, in order.
     unsigned first_sphere_geom_ = 0;
-    const std::vector<SphereSet>* spheres_ = nullptr;  // the World's own, which outlives its caster
+    std::vector<SphereSet> spheres_;  // its own copy: a caster is shared by copies of a World
 };
 
 }  // namespace bvc3d
