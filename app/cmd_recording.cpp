@@ -324,7 +324,7 @@ void add_localize(CLI::App& app) {
         PreprocessOptions preprocess;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--templates", o->templates, "Templates: a trial file (may contain {model}) or a scan folder/list");
+    cmd->add_option("--templates", o->templates, "Templates: a trial file ({model} stands for each model's name) or a scan folder/list");
     cmd->add_option("--template-poses", o->template_poses, "Pose file of the template scans");
     cmd->add_option("--queries", o->queries, "Queries: a trial file (may contain {model}) or a scan folder/list");
     cmd->add_option("--query-poses", o->query_poses, "Pose file of the query scans");
@@ -391,7 +391,7 @@ void add_localize(CLI::App& app) {
             std::vector<TrialConfig> trials;
             for (std::size_t k = 0; k < specs.size(); ++k)
                 trials.push_back(replay_trial(source, specs[k], false,
-                                              bvc ? nullptr : weights_from(with_model(o->weights, models[k]))));
+                                              bvc ? nullptr : weights_from(with_model(o->weights, specs[k].name))));
             if (!bvc && o->weights.empty())
                 std::fprintf(stderr, "bvc3d: warning: place-cell rates without --weights come from untrained (seed 0) weights\n");
             RunControl control;
@@ -405,7 +405,7 @@ void add_localize(CLI::App& app) {
         std::vector<LocalizeRow> rows;
         for (std::size_t k = 0; k < specs.size(); ++k) {
             auto rates_of = [&](const Side& s) {
-                if (!s.file.empty()) return side_from_file(with_model(s.file, models[k]), specs[k], bvc);
+                if (!s.file.empty()) return side_from_file(with_model(s.file, specs[k].name), specs[k], bvc);
                 const ReplayRates r = replay_rates(replays.at(s.recording.get()), k, bvc);
                 return rows_of(r.rates, r.xyz, s.keep);
             };

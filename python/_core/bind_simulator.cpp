@@ -134,16 +134,21 @@ void bind_simulator(pyb::module_& m) {
     bind_world(m);
     m.def(
         "random_walk",
-        [](const World& w, double hours, std::uint64_t seed) {
+        [](const World& w, double hours, std::uint64_t seed, const pyb::kwargs& kwargs) {
+            RobotParams robot;
+            apply_kwargs(robot, RobotParams::table(), kwargs);
             std::vector<ModelStep> steps;
             {
                 pyb::gil_scoped_release release;
-                steps = random_walk(w, hours, seed);
+                steps = random_walk(w, hours, seed, robot);
             }
             return steps_to_dict(steps);
         },
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
-        "The paper's random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step");
+        (R"doc(The paper's random walk: dict of arrays t, x, y, z, heading, bumped, one entry per model step.
+Robot keywords and their defaults (the paper's robot):
+)doc" + describe(RobotParams::table(), RobotParams{}))
+            .c_str());
     m.def(
         "read_trajectory", [](const std::filesystem::path& path) { return steps_to_dict(read_trajectory_file(path)); },
         pyb::arg("path"),
