@@ -297,10 +297,11 @@ def aliasing_figure(rec, work, out):
 
 # ------------------------------------------------------------------------------------ place cells
 
-PLACE_MODELS = ["2d", "3d-3l", "hall-up4"]
-WALK_HOURS = 1.0    # of the random walk through the map, learning
+# (model, hours of the learning walk): the three models on one hour; the 2-D model also on four
+# (cheap), to see what longer learning changes.
+PLACE_RUNS = [("2d", 1.0), ("2d", 4.0), ("3d-3l", 1.0), ("hall-up4", 1.0)]
 BODY_HEIGHT = 1.6   # m: the robot is a person carrying the sensor (radius 0.25 m)
-SETTLE = 20         # network steps per scan to reach its response to that scan alone
+SETTLE = 20         # network steps per scan; its response is the mean of the last SETTLE // 2
 
 
 def model_arg(name):
@@ -340,20 +341,18 @@ def write_matrix_poses(path, poses, times):
 
 
 def settled_place_rates(bvc, weights):
-    """Each row's place-cell response on its own: the trained network reset, then driven by that
-    BVC vector for SETTLE steps (frozen). Also how much the last step still changed the rates."""
+    """Each row's place-cell response on its own: the trained network, reset, driven by that BVC
+    vector for SETTLE steps (frozen); the response is the mean rate over the last SETTLE // 2 steps,
+    which smooths the period-2 swing that recurrent inhibition gives some inputs."""
     import bvc3d
     net = bvc3d.PlaceCellNetwork(bvc.shape[1])
     net.weights = weights
     out = np.empty((len(bvc), weights.shape[0]), np.float32)
-    change = 0.0
     for i, v in enumerate(np.asarray(bvc, np.float64)):
         net.reset()
-        for _ in range(SETTLE - 1):
-            before = net.step(v, False)
-        out[i] = net.step(v, False)
-        change = max(change, float(np.abs(out[i] - before).max()))
-    return out, change
+        steps = [net.step(v, False) for _ in range(SETTLE)]
+        out[i] = np.mean(steps[SETTLE - SETTLE // 2:], axis=0)
+    return out
 
 
 def summary_row(label, model, rates, result):
@@ -384,54 +383,71 @@ def place_cells(rec, work):
         "  - point_cloud: {file: hall-map.ply, radius: %g, crop_z: [0.2, 40]}\n" % SPHERE +
         "walkable: {polygon: [" + ", ".join(f"[{x:.3f}, {y:.3f}]" for x, y in hull) + "]}\n")
     world = bvc3d.World.from_yaml(floor / "hall-map.yaml")
-    walk = bvc3d.random_walk(world, WALK_HOURS, 0, height=BODY_HEIGHT)
-    path = {k: walk[k] for k in ("t", "x", "y", "heading")}
-    path["z"] = np.full(len(walk["t"]), height)
-    grid_path = {"t": np.arange(len(grid), dtype=float), "x": grid[:, 0], "y": grid[:, 1], "z": grid[:, 2],
-                 "heading": np.zeros(len(grid))}
-    covered = np.mean(np.min(np.hypot(grid[:, None, 0] - walk["x"][None, ::10], grid[:, None, 1] - walk["y"][None, ::10]),
-                             axis=1) <= GRID)
-    log(f"walk: {len(walk['t'])} steps, {np.sum(walk['bumped'])} bumps, {100 * covered:.0f}% of templates within "
-        f"{GRID} m of it")
     queries = bvc3d.Recording.open(rec, floor / "poses.csv")
     qxyz = queries.poses[:, :3, 3]
     sensor = str(HERE / "hall-os64.yaml")
-    rows, per_query = [], []
-    for name in PLACE_MODELS:
-        cache = floor / f"{name}.npz"
+    grid_path = {"t": np.arange(len(grid), dtype=float), "x": grid[:, 0], "y": grid[:, 1], "z": grid[:, 2],
+                 "heading": np.zeros(len(grid))}
+    # The real scans' poses, level, for simulated stand-ins of the real scans in the map.
+    heading = np.arctan2(queries.poses[:, 1, 0], queries.poses[:, 0, 0])
+    query_path = {"t": np.arange(len(qxyz), dtype=float), "x": qxyz[:, 0], "y": qxyz[:, 1], "z": qxyz[:, 2],
+                  "heading": heading}
+    rows, per_query, walks = [], [], []
+    for name, hours in PLACE_RUNS:
+        walk = bvc3d.random_walk(world, hours, 0, height=BODY_HEIGHT)
+        path = {k: walk[k] for k in ("t", "x", "y", "heading")}
+        path["z"] = np.full(len(walk["t"]), height)
+        step = max(1, len(walk["x"]) // 20000)
+        covered = np.mean(np.min(np.hypot(grid[:, None, 0] - walk["x"][None, ::step],
+                                          grid[:, None, 1] - walk["y"][None, ::step]), axis=1) <= GRID)
+        walks.append([name, hours, len(walk["t"]), int(np.sum(walk["bumped"])), f"{covered:.3f}"])
+        cache = floor / f"{name}-{hours:g}h.npz"
         if not cache.exists():
             start = time.time()
             learned = bvc3d.replay_simulated(str(floor / "hall-map.yaml"), path, sensor, model_arg(name), learn=True)
-            templates = bvc3d.replay_simulated(str(floor / "hall-map.yaml"), grid_path, sensor, model_arg(name))
-            np.savez(cache, weights=learned["weights"], templates=templates["bvc_rates"],
-                     queries=queries.replay(model_arg(name))["bvc_rates"])
-            log(f"{name}: learned and replayed in {time.time() - start:.0f} s")
-        data = np.load(cache)
-        place_t, change_t = settled_place_rates(data["templates"], data["weights"])
-        place_q, change_q = settled_place_rates(data["queries"], data["weights"])
-        active = np.mean(place_t.max(axis=0) > 0)
-        log(f"{name}: settling changed rates by at most {max(change_t, change_q):.2g} in the last step; "
-            f"{100 * active:.0f}% of place cells active on some template")
-        for rates, t, q in (("bvc", data["templates"], data["queries"]), ("place", place_t, place_q)):
+            bvc_file = floor / f"{name}-bvc.npz"  # the BVC rates do not depend on the walk
+            if not bvc_file.exists():
+                np.savez(bvc_file,
+                         templates=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), grid_path, sensor,
+                                                          model_arg(name))["bvc_rates"],
+                         queries=queries.replay(model_arg(name))["bvc_rates"])
+            np.savez(cache, weights=learned["weights"])
+            log(f"{name}, {hours:g} h: learned in {time.time() - start:.0f} s")
+        sim_file = floor / f"{name}-simulated-queries.npz"
+        if not sim_file.exists():
+            np.savez(sim_file, queries=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), query_path, sensor,
+                                                              model_arg(name))["bvc_rates"])
+        bvc = np.load(floor / f"{name}-bvc.npz")
+        W = np.load(cache)["weights"]
+        simulated = np.load(sim_file)["queries"]
+        place_t = settled_place_rates(bvc["templates"], W)
+        cases = [("real", "place", place_t, settled_place_rates(bvc["queries"], W)),
+                 ("simulated", "place", place_t, settled_place_rates(simulated, W))]
+        if hours == 1.0:
+            cases = [("real", "bvc", bvc["templates"], bvc["queries"]),
+                     ("simulated", "bvc", bvc["templates"], simulated)] + cases
+        for queries_kind, rates, t, q in cases:
             r = bvc3d.localize(t, grid, q, qxyz)
-            rows.append(summary_row("floor frame", name, rates, r))
-            per_query += [[name, rates, i, *qxyz[i, :2], r["decoded"][i], r["error"][i]] for i in range(len(q))]
+            rows.append(summary_row(f"{hours:g}", name, rates, r) + [queries_kind, f"{np.mean(q.max(axis=1) == 0):.3f}"])
+            per_query += [[name, hours, rates, queries_kind, i, *qxyz[i, :2], r["decoded"][i], r["error"][i]]
+                          for i in range(len(q))]
+        log(f"{name}, {hours:g} h: {100 * np.mean(place_t.max(axis=0) > 0):.0f}% of place cells active on some "
+            f"template, {100 * np.mean(place_t.max(axis=1) == 0):.0f}% of templates with no active cell")
     with open(HERE / "place-cells.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["frame", "model", "rates", "median_m", "mean_m", "within_1m", "within_2m", "undecoded",
-                    "chance_median_m", "chance_within_2m", "nearest_median_m", "nearest_within_1m"])
+        w.writerow(["walk_hours", "model", "rates", "median_m", "mean_m", "within_1m", "within_2m", "undecoded",
+                    "chance_median_m", "chance_within_2m", "nearest_median_m", "nearest_within_1m", "queries",
+                    "silent_queries"])
         for row in rows:
             w.writerow([f"{v:.4g}" if isinstance(v, float) else v for v in row])
     with open(work / "place-cells-queries.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["model", "rates", "query", "x", "y", "decoded", "error_m"])
+        w.writerow(["model", "walk_hours", "rates", "queries", "query", "x", "y", "decoded", "error_m"])
         w.writerows(per_query)
-    with open(HERE / "place-cells-walk.csv", "w", newline="") as f:
+    with open(HERE / "place-cells-walks.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["quantity", "value"])
-        w.writerows([["walk_hours", WALK_HOURS], ["steps", len(walk["t"])], ["bumps", int(np.sum(walk["bumped"]))],
-                     ["templates_within_grid_of_walk", f"{covered:.3f}"], ["body_height_m", BODY_HEIGHT],
-                     ["settle_steps", SETTLE]])
+        w.writerow(["model", "walk_hours", "steps", "bumps", "templates_within_0.5m_of_walk"])
+        w.writerows(walks)
     log("wrote", HERE / "place-cells.csv")
 
 
