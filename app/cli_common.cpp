@@ -75,10 +75,11 @@ std::string num(double v) { return format_number(v); }
 
 int run_python_module(const std::string& module, const std::vector<std::string>& args) {
     const char* py_env = std::getenv("BVC3D_PYTHON");
-    const std::string python = py_env ? py_env : BVC3D_PYTHON;
+    const std::string python = py_env && *py_env ? py_env : BVC3D_PYTHON;
     const char* path_env = std::getenv("BVC3D_PYTHONPATH");
-    std::string pythonpath = path_env ? path_env : BVC3D_PYTHON_DIR;
-    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing) pythonpath += std::string(":") + existing;
+    std::string pythonpath = path_env && *path_env ? path_env : BVC3D_PYTHON_DIR;
+    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && pythonpath != existing)
+        pythonpath += std::string(":") + existing;  // as the report's command (cmd_experiment.cpp) does
     std::vector<std::string> argv_text{python, "-m", module};
     argv_text.insert(argv_text.end(), args.begin(), args.end());
     std::vector<char*> argv;

@@ -60,5 +60,6 @@ void add_model_commands(CLI::App& app);
 void add_experiment_commands(CLI::App& app);
 void add_sweep_command(CLI::App& app);
 void add_recording_commands(CLI::App& app);
+void add_view_command(CLI::App& app);  // view/cmd_view.cpp
 
 }  // namespace bvc3d::cli

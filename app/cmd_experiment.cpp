@@ -1,4 +1,5 @@
 // bvc3d run / paper / analyze: trials, the paper's experiment, and analysis of trial files.
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -36,6 +37,55 @@ std::vector<std::string> split(const std::string& s) {
     for (std::string item; std::getline(ss, item, ',');)
         if (!item.empty()) out.push_back(item);
     return out;
+}
+
+// Text as one shell word: as it is when safe, else single-quoted.
+std::string shell_word(const std::string& s) {
+    const bool safe = !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                                         "_-./:=+,@%") == std::string::npos;
+    if (safe) return s;
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+// How the report module runs: the interpreter (BVC3D_PYTHON, else the one found at build time) and
+// the PYTHONPATH that finds the package (BVC3D_PYTHONPATH, else the build's python folder, then any
+// PYTHONPATH already set).
+struct ReportCommand {
+    std::string python, pythonpath;
+    // The command as a shell line that works as printed: `PYTHONPATH=... /usr/bin/python3 -m bvc3d.report DIR`.
+    std::string shell_line(const std::filesystem::path& dir) const {
+        return "PYTHONPATH=" + shell_word(pythonpath) + " " + shell_word(python) + " -m bvc3d.report " +
+               shell_word(dir.string());
+    }
+};
+
+ReportCommand report_command() {
+    const char* py_env = std::getenv("BVC3D_PYTHON");
+    const char* path_env = std::getenv("BVC3D_PYTHONPATH");
+    ReportCommand c{py_env && *py_env ? py_env : BVC3D_PYTHON, path_env && *path_env ? path_env : BVC3D_PYTHON_DIR};
+    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && c.pythonpath != existing)
+        c.pythonpath += std::string(":") + existing;
+    return c;
+}
+
+// Runs the report module as a child process (no shell); returns its exit status.
+int run_report(const ReportCommand& command, const std::filesystem::path& dir) {
+    std::fflush(stdout);  // our lines first, then the report's
+    const pid_t pid = ::fork();
+    if (pid < 0) return -1;
+    if (pid == 0) {
+        ::setenv("PYTHONPATH", command.pythonpath.c_str(), 1);
+        ::execl(command.python.c_str(), command.python.c_str(), "-m", "bvc3d.report", dir.c_str(),
+                static_cast<char*>(nullptr));
+        std::perror(("bvc3d: cannot run " + command.python).c_str());
+        ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace
@@ -93,9 +143,11 @@ void summarize(const std::filesystem::path& out, const std::vector<std::filesyst
     write_trials_csv(out / "trials.csv", trials);
     write_summary_csv(out / "summary.csv", rows);
     write_summary_markdown(out / "summary.md", rows);
-    if (report && run_python_module("bvc3d.report", {out.string()}) != 0)
+    if (!report) return;
+    const ReportCommand command = report_command();
+    if (run_report(command, out) != 0)
         throw InputError("the report (figures) failed; the trial files and summary are in '" + out.string() +
-                         "'; rerun with: python3 -m bvc3d.report " + out.string());
+                         "'; rerun it with:\n  " + command.shell_line(out));
 }
 
 namespace {
@@ -246,8 +298,9 @@ void add_paper(CLI::App& app) {
                     "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
     cmd->add_flag("--no-report", o->no_report, "Skip the figures (trial files and summary only)");
     cmd->footer(
-        "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and (via python3 -m bvc3d.report)\n"
-        "figures and report.md. Completed trials are skipped on a rerun; Ctrl-C stops cleanly and can be resumed.");
+        "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and the figures and report.md (the\n"
+        "Python module bvc3d.report, run with " BVC3D_PYTHON " or $BVC3D_PYTHON). Completed trials are skipped on\n"
+        "a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
         const auto trials = paper_trials(*o);
         const ExperimentOutcome outcome = run_local_experiment(trials, o->out, o->jobs, o->checkpoint_minutes);

@@ -1,9 +1,11 @@
-// bvc3d bvc: what a model's boundary vector cells respond to at one pose.
+// bvc3d bvc: what a model's boundary vector cells respond to at one pose; bvc3d config: trials, models
+// and sensors as YAML with every key.
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/atomic_file.hpp"
@@ -25,6 +27,12 @@ std::string sparkline(const double* v, int n, int width) {
     return s;
 }
 
+std::string preset_list() {
+    std::string s;
+    for (const auto& n : model_preset_names()) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
 void add_bvc(CLI::App& app) {
     auto* cmd = app.add_subcommand("bvc", "Show the boundary vector cell rates of a model at one pose");
     struct Options {
@@ -32,7 +40,7 @@ void add_bvc(CLI::App& app) {
         std::optional<double> tilt;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--model", o->model, "Model preset (2d, 3d-0.1, 3d-0.2, 3d-3l, 2d-8beam) or model YAML")
+    cmd->add_option("--model", o->model, "Model preset (" + preset_list() + ") or model YAML")
         ->capture_default_str();
     cmd->add_option("--world", o->world, "World preset or YAML file")->capture_default_str();
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's central walls in degrees");
@@ -80,8 +88,41 @@ void add_bvc(CLI::App& app) {
     });
 }
 
+void add_config(CLI::App& app) {
+    auto* cmd = app.add_subcommand("config", "Print a trial, model or sensor as YAML: every key, its value and meaning");
+    struct Options {
+        std::string trial, model, sensor;
+    };
+    auto o = std::make_shared<Options>();
+    auto* trial = cmd->add_option("--trial", o->trial, "A trial YAML file, every key filled in (default: the default trial)");
+    auto* model = cmd->add_option("--model", o->model, "A model preset (" + preset_list() + ") or model YAML file");
+    auto* sensor = cmd->add_option("--sensor", o->sensor, "A sensor: horizontal, spherical or a sensor YAML file");
+    trial->excludes(model)->excludes(sensor);
+    model->excludes(sensor);
+    cmd->footer(
+        "Without options: the default trial (the paper's protocol, cross arena, 3d-0.2, seed 0). Values are exact\n"
+        "(shortest round-trip numbers): saved to a file and read back (bvc3d run --config FILE, --model FILE,\n"
+        "--sensor FILE), the text gives the same trial, model or sensor, with the same results.");
+    cmd->callback([o] {
+        std::string text;
+        if (!o->model.empty()) {
+            text = config::model_to_commented_yaml(config::resolve_model(o->model));
+        } else if (!o->sensor.empty()) {
+            text = config::sensor_to_commented_yaml(config::resolve_sensor(o->sensor));
+        } else {
+            TrialConfig t;
+            if (!o->trial.empty()) t = config::load_trial_file(o->trial);
+            text = config::trial_to_commented_yaml(t);
+        }
+        std::fwrite(text.data(), 1, text.size(), stdout);
+    });
+}
+
 }  // namespace
 
-void add_model_commands(CLI::App& app) { add_bvc(app); }
+void add_model_commands(CLI::App& app) {
+    add_bvc(app);
+    add_config(app);
+}
 
 }  // namespace bvc3d::cli

@@ -11,12 +11,13 @@ int main(int argc, char** argv) {
         "bvc3d: boundary vector cells and place cells in simulated 3-D worlds.\n"
         "Reproduces Gerstenslager, Dukenbaev & Minai (IJCNN 2025) and goes beyond it; see README.md and docs/."};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "bvc3d 0.1.0");
+    app.set_version_flag("--version", "bvc3d " BVC3D_VERSION);
     bvc3d::cli::add_simulator_commands(app);
     bvc3d::cli::add_model_commands(app);
     bvc3d::cli::add_experiment_commands(app);
     bvc3d::cli::add_sweep_command(app);
     bvc3d::cli::add_recording_commands(app);
+    bvc3d::cli::add_view_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

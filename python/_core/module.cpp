@@ -47,6 +47,7 @@ pyb::object from_value(const params::Value& v) {
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "bvc3d compiled core (use the `bvc3d` package)";
+    m.attr("__version__") = BVC3D_VERSION;  // the project's version, from CMakeLists.txt
     pybind11::register_exception<bvc3d::InputError>(m, "InputError", PyExc_ValueError);
     bvc3d::py::bind_simulator(m);
     bvc3d::py::bind_model(m);

@@ -6,11 +6,10 @@ BoundaryVectorLayer -> PlaceCellNetwork -> recorded samples -> bvc3d.analysis ->
 Real LiDAR recordings: Recording.open(scans, poses) -> recording.returns / recording.replay ->
 localize (docs/recordings.md).
 """
-from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Recording, Sensor, World, localize, metric_table,
-                    model_presets, model_sensor, random_walk, read_trajectory, replay_simulated, run_trial)
+from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Recording, Sensor, World, __version__, localize,
+                    metric_table, model_presets, model_sensor, random_walk, read_trajectory, replay_simulated, run_trial)
 from . import analysis
 
 __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording", "Sensor", "World", "analysis",
            "localize", "metric_table", "model_presets", "model_sensor", "random_walk", "read_trajectory",
            "replay_simulated", "run_trial"]
-__version__ = "0.1.0"

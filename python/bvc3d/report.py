@@ -1,9 +1,14 @@
 """Figures and report.md for a folder of bvc3d trial files.
 
-    /usr/bin/python3 -m bvc3d.report DIR
+    PYTHONPATH=build/python /usr/bin/python3 -m bvc3d.report DIR
 
 DIR holds the trial files (*.h5) and the tables `bvc3d paper` writes (trials.csv, summary.csv,
-summary.md). Figures are PNG files in DIR/figures; DIR/report.md shows the table and every figure.
+summary.md). Figures are PNG files in DIR/figures; DIR/report.md states how the trials were run and
+analyzed (read from the trial files) and shows the table and every figure.
+
+Every figure says what it shows: the worlds, the models, the seeds (one trial, or the mean ± sd over
+seeds), with axis labels and units. Legends sit outside the axes, bars too small to see are marked
+and labeled with their value, and error bars of quantities that cannot be negative stop at 0.
 """
 import argparse
 import csv
@@ -27,6 +32,12 @@ from ._core import metric_table
 DPI = 120
 # Metrics with a figure of their own: (axis label, title), from the analysis stage's one table.
 METRICS = {m["name"]: (m["label"], m["title"]) for m in metric_table if m["title"]}
+DIGITS = {m["name"]: m["digits"] for m in metric_table}
+METRIC_NAMES = {m["name"] for m in metric_table}
+# Units of the analysis parameters a trial file's /metrics attributes record (the others have none).
+UNITS = {"eps": "m", "d_th": "m"}
+# A bar lower than this fraction of the axis height is hard to see: it gets a mark and its value.
+TINY = 0.015
 
 
 def read_csv(path):
@@ -39,6 +50,49 @@ def num(s):
         return float(s)
     except (TypeError, ValueError):
         return math.nan
+
+
+def fmt(v):
+    """A number as short text (45, 0.1, 1e-06), anything else as it is."""
+    if isinstance(v, bytes):
+        v = v.decode()
+    if isinstance(v, (int, np.integer)) and not isinstance(v, bool):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return f"{float(v):g}"
+    return str(v)
+
+
+def seed_list(seeds):
+    """Seeds as short text: "0", "0, 1, 4", "0–9"."""
+    seeds = sorted(seeds)
+    if len(seeds) > 2 and seeds == list(range(seeds[0], seeds[-1] + 1)):
+        return f"{seeds[0]}–{seeds[-1]}"
+    return ", ".join(map(str, seeds))
+
+
+def protocol_text(attrs):
+    """What a trial's protocol did, from its file's attributes."""
+    kind = fmt(attrs.get("protocol", "unknown protocol"))
+    explore, sample = fmt(attrs.get("explore_hours", "?")), fmt(attrs.get("sample_hours", "?"))
+    if kind == "online":
+        return f"online: one {sample} h phase, recorded while learning"
+    if kind == "explore_then_sample":
+        return (f"explore_then_sample: {explore} h of exploration with learning on (not recorded), then {sample} h "
+                f"of sampling with learning frozen (recorded)")
+    return f"{kind}: explore_hours {explore}, sample_hours {sample}"
+
+
+def analysis_text(metrics_group):
+    """How a trial's metrics were computed: the /metrics attributes that are not metrics, and the grid."""
+    parts = [f"{k} {fmt(v)}" + (f" {UNITS[k]}" if k in UNITS else "")
+             for k, v in metrics_group.attrs.items() if k not in METRIC_NAMES]
+    if "extent" in metrics_group:
+        x0, x1, y0, y1 = metrics_group["extent"][:]
+        parts.append(f"grid over x {x0:g} to {x1:g} m, y {y0:g} to {y1:g} m")
+    else:
+        parts.append("grid over each trial's trajectory")
+    return ", ".join(parts)
 
 
 class Folder:
@@ -58,6 +112,8 @@ class Folder:
         self.worlds = sorted(worlds, key=lambda w: (math.isnan(tilt[w]), tilt[w], w))
         self.tilt = tilt
         self.seeds = sorted({int(r["seed"]) for r in self.trials})
+        counts = [int(num(r.get("n_seeds"))) if not math.isnan(num(r.get("n_seeds"))) else 1 for r in self.summary]
+        self.seeds_per_condition = sorted(set(counts)) or [1]
 
     def file(self, model, world, seed=None):
         seed = self.seeds[0] if seed is None else seed
@@ -69,12 +125,47 @@ class Folder:
     def stat(self, model, world, metric):
         for r in self.summary:
             if r["model"] == model and r["world"] == world:
-                return num(r[metric + "_mean"]), num(r[metric + "_sd"])
+                return num(r.get(metric + "_mean")), num(r.get(metric + "_sd"))
         return math.nan, math.nan
+
+    def replicated(self):
+        """Some condition has more than one seed: values are means, with a spread."""
+        return max(self.seeds_per_condition) > 1
+
+    def non_negative(self, metric):
+        """Every trial's value of the metric is >= 0 (then so is any mean, and error bars stop at 0)."""
+        values = [num(r.get(metric)) for r in self.trials]
+        return all(v >= 0 for v in values if not math.isnan(v))
+
+    def spread_text(self):
+        """What one bar or point is: a trial, or a mean ± sd over seeds."""
+        seeds = seed_list(self.seeds)
+        if not self.replicated():
+            return f"one trial each (seed {seeds})" if len(self.seeds) == 1 else f"one trial each (seeds {seeds})"
+        n = self.seeds_per_condition
+        count = f"{n[0]}" if len(n) == 1 else f"{n[0]}–{n[-1]}"
+        return f"mean ± sd over {count} seeds ({seeds}); error bars stop at 0"
+
+    def tilt_axis(self):
+        """All worlds are cross arenas told apart by their tilt (the x axis is then the tilt)."""
+        tilts = [self.tilt[w] for w in self.worlds]
+        return all(not math.isnan(t) for t in tilts) and len(set(tilts)) == len(tilts)
 
     def world_label(self, w):
         t = self.tilt.get(w, math.nan)
         return f"{t:g}°" if not math.isnan(t) else w
+
+    def settings(self):
+        """Per trial (in trials.csv order): (protocol text, analysis text, seed), read from the files."""
+        out = []
+        for r in self.trials:
+            path = os.path.join(self.path, r["name"] + ".h5")
+            try:
+                with h5py.File(path, "r") as f:
+                    out.append((protocol_text(f.attrs), analysis_text(f["metrics"]), int(f.attrs.get("seed", r["seed"]))))
+            except (OSError, KeyError) as e:
+                out.append((f"unreadable ({os.path.basename(path)}: {e})", "unreadable", int(r["seed"])))
+        return out
 
 
 def hexmap(ax, centers, values, extent=None, cmap="viridis", vmin=None, vmax=None):
@@ -86,36 +177,93 @@ def hexmap(ax, centers, values, extent=None, cmap="viridis", vmin=None, vmax=Non
                      reduce_C_function=np.mean, linewidths=0.0)
 
 
-def fig_bars(folder, metric, out):
+def legend_outside(ax, title):
+    """The legend to the right of the axes, where it cannot cover data."""
+    return ax.legend(title=title, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8,
+                     title_fontsize=8, frameon=False)
+
+
+def error_bars(means, sds, clip):
+    """Asymmetric (2, n) error bars: +sd up, -sd down, but not below 0 when the quantity cannot be negative."""
+    means, sds = np.asarray(means, float), np.nan_to_num(np.asarray(sds, float))
+    sds = np.where(np.isnan(means), 0.0, sds)
+    lower = np.minimum(sds, np.maximum(np.nan_to_num(means), 0.0)) if clip else sds
+    return np.vstack([lower, sds])
+
+
+def mark_small_bars(ax, bars, means, tops, digits):
+    """Bars too low to see (0, or below TINY of the axis height) get a thick line at their base and their
+    value written above them (n/a for a missing value)."""
+    lo, hi = ax.get_ylim()
+    marks = []
+    for bar, mean, top in zip(bars, means, tops):
+        if not (math.isnan(mean) or abs(mean) < TINY * (hi - lo)):
+            continue
+        x0, width = bar.get_x(), bar.get_width()
+        ax.plot([x0, x0 + width], [0, 0], color=bar.get_facecolor(), lw=3, solid_capstyle="butt", zorder=3)
+        text = "n/a" if math.isnan(mean) else (f"{mean:.{digits}f}" if digits >= 0 else f"{mean:g}")
+        marks.append(ax.annotate(text, xy=(x0 + width / 2, 0 if math.isnan(top) else top), xytext=(0, 2),
+                                 textcoords="offset points", rotation=90, ha="center", va="bottom", fontsize=6.5))
+    return marks
+
+
+def bars_figure(folder, metric):
+    """One bar per model and world (mean ± sd over seeds, or one trial), as a matplotlib Figure."""
     label, title = METRICS[metric]
     fig, ax = plt.subplots(figsize=(7, 3.6))
     n = len(folder.models)
     width = 0.8 / max(n, 1)
     x = np.arange(len(folder.worlds))
+    clip = folder.non_negative(metric)
+    drawn = []
     for i, m in enumerate(folder.models):
         stats = [folder.stat(m, w, metric) for w in folder.worlds]
-        means = [s[0] for s in stats]
-        sds = [0 if math.isnan(s[1]) else s[1] for s in stats]
-        ax.bar(x + (i - (n - 1) / 2) * width, means, width, yerr=sds if len(folder.seeds) > 1 else None,
-               label=m, capsize=2)
-    ax.set_xticks(x, [folder.world_label(w) for w in folder.worlds])
-    ax.set_xlabel("tilt of the central walls")
+        means = np.array([s[0] for s in stats])
+        yerr = error_bars(means, [s[1] for s in stats], clip) if folder.replicated() else None
+        bars = ax.bar(x + (i - (n - 1) / 2) * width, np.nan_to_num(means), width, yerr=yerr, label=m, capsize=2)
+        tops = np.nan_to_num(means) + (yerr[1] if yerr is not None else 0)
+        drawn.append((bars, means, np.where(np.isnan(means), np.nan, tops)))
+    lo, hi = ax.get_ylim()
+    if hi - lo <= 0 or (clip and hi <= 0):
+        ax.set_ylim(0, 1)
+    elif clip:
+        ax.set_ylim(bottom=min(lo, 0.0))
+    marks = [m for bars, means, tops in drawn for m in mark_small_bars(ax, bars, means, tops, DIGITS.get(metric, 3))]
+    lo, hi = ax.get_ylim()
+    if any(m.xy[1] > lo + 0.8 * (hi - lo) for m in marks):  # a value label high up: room for its text
+        ax.set_ylim(top=hi + 0.15 * (hi - lo))
+    if folder.tilt_axis():
+        ax.set_xticks(x, [f"{folder.tilt[w]:g}" for w in folder.worlds])
+        ax.set_xlabel("tilt of the central walls (°), cross arena")
+    else:
+        ax.set_xticks(x, folder.worlds)
+        ax.set_xlabel("world")
     ax.set_ylabel(label)
-    ax.set_title(title + (f" (mean ± sd, {len(folder.seeds)} seeds)" if len(folder.seeds) > 1 else ""))
-    ax.legend(fontsize=8, ncol=min(n, 5))
+    ax.set_title(f"{title}\n{folder.spread_text()}", fontsize=10)
+    legend_outside(ax, "model")
     fig.tight_layout()
+    return fig
+
+
+def save(fig, out):
     fig.savefig(out, dpi=DPI)
     plt.close(fig)
 
 
-def fig_sai_grid(folder, out):
+def fig_bars(folder, metric, out):
+    save(bars_figure(folder, metric), out)
+
+
+def sai_grid_figure(folder):
+    """The SAI of every bin, one trial per panel (the first seed): rows models, columns worlds."""
+    seed = folder.seeds[0]
     nr, nc = len(folder.models), len(folder.worlds)
-    fig, axes = plt.subplots(nr, nc, figsize=(2.6 * nc + 0.8, 2.5 * nr), squeeze=False)
+    fig, axes = plt.subplots(nr, nc, figsize=(2.6 * nc + 0.8, 2.5 * nr), squeeze=False, sharex=True, sharey=True)
     vmax = 0
     data = {}
     for m in folder.models:
         for w in folder.worlds:
-            path = folder.file(m, w)
+            path = folder.file(m, w, seed)
             if path and os.path.exists(path):
                 with h5py.File(path, "r") as f:
                     data[m, w] = (f["metrics/bin_centers"][:], f["metrics/sai"][:], f["metrics"].attrs["msai"])
@@ -124,22 +272,29 @@ def fig_sai_grid(folder, out):
     for i, m in enumerate(folder.models):
         for j, w in enumerate(folder.worlds):
             ax = axes[i][j]
-            ax.set_xticks([])
-            ax.set_yticks([])
             ax.set_aspect("equal")
+            ax.tick_params(labelsize=7)
+            where = f"{folder.world_label(w)} tilt" if folder.tilt_axis() else w
             if (m, w) in data:
                 c, sai, msai = data[m, w]
                 im = hexmap(ax, c, sai, cmap="inferno", vmin=0, vmax=vmax)
-                ax.set_title(f"MSAI {msai:.3f}", fontsize=8)
+                ax.set_title(f"{m}, {where}: MSAI {msai:.4f}", fontsize=8)
+            else:
+                ax.set_title(f"{m}, {where}: no trial file", fontsize=8)
             if j == 0:
-                ax.set_ylabel(m)
+                ax.set_ylabel("y (m)", fontsize=8)
             if i == nr - 1:
-                ax.set_xlabel(folder.world_label(w))
+                ax.set_xlabel("x (m)", fontsize=8)
     if im is not None:
-        fig.colorbar(im, ax=axes, shrink=0.6, label="SAI")
-    fig.suptitle("Spatial aliasing index per bin (rows: models, columns: tilt)")
-    fig.savefig(out, dpi=DPI)
-    plt.close(fig)
+        fig.colorbar(im, ax=axes, shrink=0.6, label="SAI (similarity to bins > d_th away)")
+    others = f" of seeds {seed_list(folder.seeds)}" if len(folder.seeds) > 1 else ""
+    fig.suptitle(f"Spatial aliasing index per bin: one trial per panel, seed {seed}{others}\n"
+                 f"(rows: models; columns: worlds)")
+    return fig
+
+
+def fig_sai_grid(folder, out):
+    save(sai_grid_figure(folder), out)
 
 
 def modality_kind(mi):
@@ -167,15 +322,15 @@ def pick_example_cell(mi, maps, want):
     return cell, f"{prefix}a {kind} one" if prefix else kind
 
 
-def fig_place_fields(folder, out):
+def place_fields_figure(folder):
     """Example fields at the largest tilt: a multimodal cell (MI > 1) of the first model and a
     unimodal cell (MI == 1) of the last model. Each panel is titled by what it shows: a model
     without a cell of the wanted kind gets its largest cell of another kind, said so in the title.
-    Returns the panel titles."""
-    world = folder.worlds[-1]
+    Returns the figure and the panel titles."""
+    world, seed = folder.worlds[-1], folder.seeds[0]
     panels = []
     for model, want in ((folder.models[0], "multimodal"), (folder.models[-1], "unimodal")):
-        path = folder.file(model, world)
+        path = folder.file(model, world, seed)
         if not path:
             continue
         with h5py.File(path, "r") as f:
@@ -183,7 +338,7 @@ def fig_place_fields(folder, out):
             maps = f["metrics/rate_maps"][:]
             centers = f["metrics/bin_centers"][:]
         cell, what = pick_example_cell(mi, maps, want)
-        where = f"{folder.world_label(world)} tilt"
+        where = (f"{folder.world_label(world)} tilt" if folder.tilt_axis() else world) + f", seed {seed}"
         if cell is None:
             panels.append((f"{model}: {what}\n{where}", None, None))
         else:
@@ -191,44 +346,55 @@ def fig_place_fields(folder, out):
             panels.append((f"{what}:{sep}{model} cell {cell} (MI = {int(mi[cell])})\n{where}", centers, maps[:, cell]))
     fig, axes = plt.subplots(1, max(len(panels), 1), figsize=(4.2 * max(len(panels), 1), 4))
     axes = np.atleast_1d(axes)
+    im = None
     for ax, (title, centers, values) in zip(axes, panels):
         if values is not None:
-            hexmap(ax, centers, values, cmap="viridis", vmin=0, vmax=1)
-        else:
-            ax.set_xticks([])
-            ax.set_yticks([])
+            im = hexmap(ax, centers, values, cmap="viridis", vmin=0, vmax=1)
         ax.set_aspect("equal")
         ax.set_title(title, fontsize=9)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
     fig.tight_layout()
-    fig.savefig(out, dpi=DPI)
-    plt.close(fig)
-    return [p[0] for p in panels]
+    if im is not None:
+        fig.colorbar(im, ax=list(axes), shrink=0.8, label="rate map (thresholded, 1 = the cell's peak)")
+    return fig, [p[0] for p in panels]
 
 
-def fig_trajectory(folder, out):
-    path = folder.file(folder.models[0], folder.worlds[0])
+def fig_place_fields(folder, out):
+    fig, titles = place_fields_figure(folder)
+    save(fig, out)
+    return titles
+
+
+def trajectory_figure(folder):
+    model, world, seed = folder.models[0], folder.worlds[0], folder.seeds[0]
+    path = folder.file(model, world, seed)
     with h5py.File(path, "r") as f:
         x, y, t = f["samples/x"][:], f["samples/y"][:], f["samples/t"][:]
     fig, ax = plt.subplots(figsize=(4.6, 4.6))
     ax.plot(x, y, lw=0.2, color="tab:blue")
     ax.set_aspect("equal")
     hours = (t[-1] - t[0]) / 3600 if len(t) else 0
-    ax.set_title(f"Sampling trajectory: {len(x)} model steps in {hours:.1f} h")
+    ax.set_title(f"Sampling trajectory: {len(x)} model steps in {hours:.2g} h\n"
+                 f"{world}, seed {seed} (trial {os.path.basename(path)[:-3]})", fontsize=9)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     fig.tight_layout()
-    fig.savefig(out, dpi=DPI)
-    plt.close(fig)
+    return fig
 
 
-def fig_environments(folder, out):
+def fig_trajectory(folder, out):
+    save(trajectory_figure(folder), out)
+
+
+def environments_figure(folder):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     import bvc3d
 
     worlds = [w for w in folder.worlds if not math.isnan(folder.tilt[w])]
     if not worlds:
-        return False
+        return None
     fig = plt.figure(figsize=(3.4 * len(worlds), 3.6))
     for i, w in enumerate(worlds):
         ax = fig.add_subplot(1, len(worlds), i + 1, projection="3d")
@@ -243,11 +409,19 @@ def fig_environments(folder, out):
         ax.set_ylim(-5, 5)
         ax.set_zlim(0, 2.5)
         ax.set_box_aspect((10, 10, 2.5))
-        ax.set_title(f"{folder.world_label(w)} tilt", fontsize=9)
+        lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
+        size = " × ".join(f"{d:g}" for d in hi - lo)
+        ax.set_title(f"{w}: central walls tilted {folder.tilt[w]:g}°\narena {size} m (x × y × z)", fontsize=9)
         ax.set_axis_off()
-    fig.tight_layout()
-    fig.savefig(out, dpi=DPI)
-    plt.close(fig)
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.86, wspace=0.0)  # room for two-line titles
+    return fig
+
+
+def fig_environments(folder, out):
+    fig = environments_figure(folder)
+    if fig is None:
+        return False
+    save(fig, out)
     return True
 
 
@@ -263,7 +437,7 @@ def as_number(values):
         return list(values), False
 
 
-def fig_sweep(folder, keys, metric, out):
+def sweep_figure(folder, keys, metric):
     """A metric against the first swept key, one line per combination of the other keys."""
     label, title = METRICS[metric]
     x_key, others = keys[0], keys[1:]
@@ -273,23 +447,28 @@ def fig_sweep(folder, keys, metric, out):
     fig, ax = plt.subplots(figsize=(7, 3.8))
     xs_all = list(dict.fromkeys(r[x_key] for r in folder.summary))
     numeric = as_number(xs_all)[1]
+    clip = folder.non_negative(metric)
     for combo, rows in lines.items():
         xs = [float(r[x_key]) if numeric else xs_all.index(r[x_key]) for r in rows]
-        means = [num(r[metric + "_mean"]) for r in rows]
-        sds = [0.0 if math.isnan(num(r[metric + "_sd"])) else num(r[metric + "_sd"]) for r in rows]
-        name = ", ".join(f"{k[6:]}={v}" for k, v in zip(others, combo)) or None
-        ax.errorbar(xs, means, yerr=sds, marker="o", capsize=3, label=name)
+        means = [num(r.get(metric + "_mean")) for r in rows]
+        yerr = error_bars(means, [num(r.get(metric + "_sd")) for r in rows], clip) if folder.replicated() else None
+        name = (combo[0] if len(others) == 1 else ", ".join(f"{k[6:]}={v}" for k, v in zip(others, combo))) or None
+        ax.errorbar(xs, means, yerr=yerr, marker="o", capsize=3, label=name)
     if not numeric:
         ax.set_xticks(range(len(xs_all)), xs_all, rotation=20, fontsize=8)
     ax.set_xlabel(x_key[6:])
     ax.set_ylabel(label)
-    seeds = len(folder.seeds)
-    ax.set_title(title + (f" (mean ± sd over {seeds} seeds)" if seeds > 1 else ""))
+    if clip:
+        ax.set_ylim(bottom=min(ax.get_ylim()[0], 0.0))
+    ax.set_title(f"{title}\n{folder.spread_text()}", fontsize=10)
     if others:
-        ax.legend(fontsize=7)
+        legend_outside(ax, ", ".join(k[6:] for k in others))
     fig.tight_layout()
-    fig.savefig(out, dpi=DPI)
-    plt.close(fig)
+    return fig
+
+
+def fig_sweep(folder, keys, metric, out):
+    save(sweep_figure(folder, keys, metric), out)
 
 
 def make_sweep_report(folder, figdir):
@@ -300,8 +479,42 @@ def make_sweep_report(folder, figdir):
         fig_sweep(folder, keys, metric, os.path.join(figdir, name))
         shown = [k[6:] for k in keys]
         figures.append((name, f"{METRICS[metric][1]} against {shown[0]}" +
-                        (f", one line per value of {', '.join(shown[1:])}." if shown[1:] else ".")))
+                        (f", one line per value of {', '.join(shown[1:])}" if shown[1:] else "") +
+                        f": {folder.spread_text()}."))
     return figures
+
+
+def grouped(values):
+    """Distinct values with their counts, most common first: [(value, count)]."""
+    counts = {}
+    for v in values:
+        counts[v] = counts.get(v, 0) + 1
+    return sorted(counts.items(), key=lambda kv: -kv[1])
+
+
+def setting_lines(folder):
+    """The report's account of how the trials were run and analyzed, from the trial files."""
+    settings = folder.settings()
+    n = len(settings)
+    lines = []
+    for what, index in (("Protocol", 0), ("Analysis", 1)):
+        groups = grouped(s[index] for s in settings)
+        if len(groups) == 1:
+            lines.append(f"- **{what}** ({'the same for all' if n > 1 else 'the'} {n} trial{'s' if n > 1 else ''}): "
+                         f"{groups[0][0]}.")
+        else:
+            lines.append(f"- **{what} differs between trials** — compare with care:")
+            lines += [f"  - {value} ({count} trial{'s' if count > 1 else ''})" for value, count in groups]
+    seeds = sorted({s[2] for s in settings})
+    if folder.replicated():
+        per = folder.seeds_per_condition
+        count = f"{per[0]}" if len(per) == 1 else f"{per[0]} to {per[-1]}"
+        lines.append(f"- **Seeds**: {seed_list(seeds)} ({count} per condition). Tables and bars show the mean over "
+                     f"seeds ± the sample standard deviation; error bars of quantities that cannot be negative stop at 0.")
+    else:
+        lines.append(f"- **Seeds**: {seed_list(seeds)}, one trial per condition: every value in the table and the figures "
+                     f"is a single trial's (no means, no spreads; run more seeds with `--seeds N` for those).")
+    return lines
 
 
 def write_report(folder, figures):
@@ -309,7 +522,7 @@ def write_report(folder, figures):
         table = f.read()
     lines = ["# bvc3d experiment report", "",
              f"{len(folder.trials)} trials: {len(folder.conditions)} conditions (models {', '.join(folder.models)}; "
-             f"worlds {', '.join(folder.worlds)}), seeds {', '.join(map(str, folder.seeds))}.", "",
+             f"worlds {', '.join(folder.worlds)}).", "", *setting_lines(folder), "",
              "## Summary", "", table, "", "## Figures", ""]
     for name, sentence in figures:
         lines += [f"### {name.split('.')[0].replace('_', ' ')}", "", sentence, "", f"![{name}](figures/{name})", ""]
@@ -335,25 +548,29 @@ def make_report(path):
         if draw(os.path.join(figdir, name)) is not False:
             figures.append((name, sentence))
 
+    seed = folder.seeds[0]
+    one = f"seed {seed}" + (f" (the first of seeds {seed_list(folder.seeds)})" if len(folder.seeds) > 1 else "")
+    bars = f"Bars: {folder.spread_text()}."
     add("environments.png", "The arenas in 3-D (ceiling and floor left out): the central cross walls lean toward the "
         "+x,+y corner by the given tilt while their footprint stays put.", lambda p: fig_environments(folder, p))
-    add("trajectory.png", "The robot's random walk during the sampling phase of one trial: coverage of the arena.",
-        lambda p: fig_trajectory(folder, p))
-    add("place_fields.png", "Rate maps of two example place cells at the largest tilt: a multimodal (aliased, "
+    add("trajectory.png", f"The robot's random walk during the sampling phase of one trial ({folder.worlds[0]}, {one}): "
+        "coverage of the arena.", lambda p: fig_trajectory(folder, p))
+    add("place_fields.png", f"Rate maps of two example place cells at the largest tilt ({one}): a multimodal (aliased, "
         "MI > 1) cell of the first model and a unimodal (MI = 1) cell of the last model. A model without a cell of "
         "that kind shows another cell, and the panel's title says so.", lambda p: fig_place_fields(folder, p))
-    add("mi_active.png", "Fraction of place cells with at least one field (MI > 0), per model and tilt.",
+    add("mi_active.png", f"Fraction of place cells with at least one field (MI > 0), per model and tilt. {bars}",
         lambda p: fig_bars(folder, "frac_active", p))
-    add("mi_mean.png", "Mean modality index of the active cells: fields per cell; 1 is a single place field.",
+    add("mi_mean.png", f"Mean modality index of the active cells: fields per cell; 1 is a single place field. {bars}",
         lambda p: fig_bars(folder, "mean_mi_active", p))
-    add("mi_multimodal.png", "Fraction of multimodal place cells (MI > 1): cells that fire in several places.",
+    add("mi_multimodal.png", f"Fraction of multimodal place cells (MI > 1): cells that fire in several places. {bars}",
         lambda p: fig_bars(folder, "frac_multimodal", p))
     add("sai_grid.png", "Spatial aliasing index of every bin: how similar its population vector is to those of "
-        "bins more than 2 m away. Bright regions are aliased.", lambda p: fig_sai_grid(folder, p))
-    add("msai.png", "Mean spatial aliasing index per model and tilt: lower is better.",
+        f"bins more than d_th away. Bright regions are aliased. One trial per panel: {one}.",
+        lambda p: fig_sai_grid(folder, p))
+    add("msai.png", f"Mean spatial aliasing index per model and tilt: lower is better. {bars}",
         lambda p: fig_bars(folder, "msai", p))
     add("decoding.png", "Median position error when each sample of the second half is decoded to the cosine-"
-        "nearest rate-map bin of the first half: the direct measure of localization.",
+        f"nearest rate-map bin of the first half: the direct measure of localization. {bars}",
         lambda p: fig_bars(folder, "decode_median_m", p))
     write_report(folder, figures)
     return figures

@@ -80,6 +80,12 @@ def test_figures_and_report(paper_dir):
     for name in expected:
         assert f"(figures/{name})" in report
     assert "| 3d-3l | cross-60 |" in report
+    # How the trials were run and analyzed, from the files; one seed: no means, no spreads.
+    assert (f"explore_then_sample: {HOURS} h of exploration with learning on (not recorded), then {HOURS} h of "
+            "sampling with learning frozen (recorded)") in report
+    assert "gridsize 50, min_samples 20, quantile 0.1" in report and "eps 1 m" in report and "d_th 2 m" in report
+    assert "**Seeds**: 0, one trial per condition" in report
+    assert "±" not in report and "standard deviation" not in report
 
 
 def test_report_module_works_on_its_own(paper_dir, tmp_path):

@@ -13,6 +13,7 @@
 #include "bvc3d/analysis/trial_metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"
 #include "bvc3d/recorder/checkpoint_file.hpp"
@@ -400,4 +401,86 @@ TEST(Seams, ParameterTablesCheckTheSameWayEverywhere) {
     // Angles in degrees where a key takes radians.
     const ModelSpec deg = config::model_from_yaml(config::YamlView::load_string("bvc: {elevations_deg: [0, 10]}\n", "m.yaml"));
     EXPECT_EQ(deg.bvc.elevations[1], deg_to_rad(10.0));
+}
+
+// What `bvc3d config` prints reads back to the same configuration: equal canonical text (so equal
+// fingerprints and results) and bit-identical numbers, for presets and for awkward values.
+TEST(Seams, CommentedYamlReadsBackToTheSameConfiguration) {
+    using config::YamlView;
+    for (const auto& name : model_preset_names()) {
+        const ModelSpec m = model_preset(name);
+        const std::string text = config::model_to_commented_yaml(m);
+        const ModelSpec back = config::model_from_yaml(YamlView::load_string(text, "m.yaml"));
+        EXPECT_EQ(config::model_to_yaml(back), config::model_to_yaml(m)) << text;
+        EXPECT_EQ(back.place.alpha_pb, std::sqrt(0.5));  // the exact value, not a rounded one
+        EXPECT_EQ(config::preset_name_of(back), name);
+    }
+    LidarSpec odd = LidarSpec::spherical(false);
+    odd.name = "odd: name #1";
+    odd.elevations[3] = 0.1 + 0.2;
+    odd.azimuth_offset = pi / 7;
+    odd.range_noise_sd = 1e-300;
+    for (const LidarSpec& s : {LidarSpec::horizontal(), LidarSpec::spherical(), odd}) {
+        const LidarSpec back = config::sensor_from_yaml(YamlView::load_string(config::sensor_to_commented_yaml(s), "s.yaml"));
+        EXPECT_EQ(params::yaml_lines(LidarSpec::table(), back, ""), params::yaml_lines(LidarSpec::table(), s, ""));
+        EXPECT_EQ(back.elevations, s.elevations);
+        EXPECT_EQ(back.name, s.name);
+    }
+    EXPECT_EQ(config::builtin_sensor_name(LidarSpec::spherical()), "spherical");
+    EXPECT_EQ(config::builtin_sensor_name(odd), "");
+
+    const auto read_back = [](const TrialConfig& t) {
+        const std::string text = config::trial_to_commented_yaml(t);
+        const TrialConfig back = config::trial_from_yaml(YamlView::load_string(text, "t.yaml"));
+        EXPECT_EQ(back.canonical(), t.canonical()) << text;
+        EXPECT_EQ(back.fingerprint(), t.fingerprint());
+        return back;
+    };
+    read_back(TrialConfig{});
+    TrialConfig t;
+    t.world = WorldSpec{"cross", 37.5, "-x+y"};
+    t.model = model_preset("3d-3l");
+    t.model.name = "my model: #2";
+    t.model.sensor = odd;
+    t.model.bvc.sigma_phi = 0.1 + 0.2;
+    t.model.bvc.elevations = {0.0, pi / 7, -1e-17};
+    t.model.place.eta = 1.0 / 3.0;
+    t.protocol.kind = Protocol::Kind::online;
+    t.protocol.sample_hours = 0.123456789012345678;
+    t.protocol.record_bvc = true;
+    RobotParams robot;
+    robot.turn_sd = pi / 5;
+    t.agent = std::make_shared<RandomWalkSpec>(robot);
+    t.analysis.quantile = 1.0 / 3.0;
+    t.analysis.decoding_templates = analysis::DecodingTemplates::means;
+    t.arena_extent = true;
+    t.seed = 9007199254740993ull;
+    const TrialConfig back = read_back(t);
+    EXPECT_EQ(back.model.bvc.elevations, t.model.bvc.elevations);
+    EXPECT_EQ(back.model.name, t.model.name);
+    // A world file and a trajectory file, written as absolute paths.
+    TrialConfig files;
+    files.world = WorldSpec{std::string(BVC3D_SOURCE_DIR) + "/configs/worlds/two-rooms.yaml", std::nullopt, "+x+y"};
+    const auto track = temp_file("config-track.csv", "t,x,y,heading\n0,-3,-1,0\n0.5,-2.9,-1,0\n");
+    files.agent = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(track));
+    files.protocol = Protocol{Protocol::Kind::online, 0, 0.0001, false};
+    read_back(files);
+    EXPECT_NE(config::trial_to_commented_yaml(files).find("trajectory: " + track.string()), std::string::npos);
+    // A path given as arrays has no file to name.
+    TrialConfig arrays;
+    arrays.agent = std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {0, 0}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
+    EXPECT_THROW(config::trial_to_commented_yaml(arrays), InputError);
+    fs::remove(track);
+}
+
+// Text that needs quoting in YAML is quoted, and reads back as itself.
+TEST(Seams, CommentedYamlQuotesTextThatNeedsIt) {
+    for (const std::string text : {"plain", "+x+y", "-x-y", "a: b", "#x", "x #y", "", "null", "~", "- x", "[a]",
+                                   "{a}", "it's \"q\"", "back\\slash", "colon:", "*star", "tab\there", " lead"}) {
+        params::CommentedYaml out;
+        out.line("", "name", params::CommentedYaml::scalar(text), "a label");
+        const auto v = config::YamlView::load_string(out.str(), "q.yaml");
+        EXPECT_EQ(v["name"].as_string(), text) << out.str();
+    }
+    EXPECT_EQ(params::CommentedYaml::scalar("+x+y"), "+x+y");
 }

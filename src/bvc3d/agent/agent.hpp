@@ -10,6 +10,7 @@
 #include <string>
 
 #include "bvc3d/core/geometry.hpp"
+#include "bvc3d/core/params.hpp"
 #include "bvc3d/world/world.hpp"
 
 namespace bvc3d {
@@ -49,6 +50,9 @@ public:
     virtual std::string key() const = 0;
     // Model steps per second of agent time, on average (for buffer sizes and duration checks).
     virtual double steps_per_second() const = 0;
+    // The trial YAML keys that give this agent back (`robot:` and its keys, `trajectory: FILE`), with
+    // their descriptions (`bvc3d config`); InputError if there are none (a path given as arrays).
+    virtual void write_yaml(params::CommentedYaml& out) const = 0;
 };
 
 }  // namespace bvc3d

@@ -173,6 +173,11 @@ std::unique_ptr<Agent> RandomWalkSpec::make(const World* world, std::uint64_t se
 
 std::string RandomWalkSpec::key() const { return "robot:\n" + params::yaml_lines(RobotParams::table(), robot_, "  "); }
 
+void RandomWalkSpec::write_yaml(params::CommentedYaml& out) const {
+    out.section("", "robot", "the random walk's robot (or, instead, trajectory: FILE, a given path)");
+    out.fields(RobotParams::table(), robot_, "  ");
+}
+
 std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params) {
     if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0");
     const auto walk = RandomWalkSpec(params).make(&world, seed);

@@ -83,6 +83,7 @@ public:
     std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override { return 1.0 / robot_.model_dt; }
+    void write_yaml(params::CommentedYaml& out) const override;
 
 private:
     RobotParams robot_;

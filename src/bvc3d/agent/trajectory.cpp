@@ -169,7 +169,16 @@ TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source)
       hash_(hash_steps(*steps_)) {}
 
 TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
-    return TrajectorySpec(read_trajectory_file(path), path.string());
+    TrajectorySpec spec(read_trajectory_file(path), path.string());
+    spec.file_ = std::filesystem::absolute(path);
+    return spec;
+}
+
+void TrajectorySpec::write_yaml(params::CommentedYaml& out) const {
+    if (file_.empty())
+        throw InputError("trajectory '" + source_ + "' was given as arrays: write it to a file to describe the trial in YAML");
+    out.line("", "trajectory", params::CommentedYaml::scalar(file_.string()),
+             "a given path instead of the random walk: a file of t, x, y, [z], heading rows");
 }
 
 std::unique_ptr<Agent> TrajectorySpec::make(const World* world_or_null, std::uint64_t) const {

@@ -58,11 +58,13 @@ public:
     std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override;
+    void write_yaml(params::CommentedYaml& out) const override;
 
 private:
     std::shared_ptr<const std::vector<ModelStep>> steps_;
     std::string source_;
     std::uint64_t hash_ = 0;  // of the rows, for the key
+    std::filesystem::path file_;  // the file it was read from (absolute), empty for arrays
 };
 
 }  // namespace bvc3d

@@ -130,8 +130,13 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
     std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
     std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
-    std::size_t valid = 0, lookups = 0, misses = 0;
-    const bool use_memo = memo_useful_ || ++memo_probe_ % 16 == 0;
+    std::size_t valid = 0;
+    // A beam table comes row by row; returns whose elevation changes nearly every time are an
+    // irregular point set, whose azimuths never repeat: the memo is left alone for them.
+    std::size_t changes = 0;
+    const std::size_t probe = std::min<std::size_t>(returns.size(), 64);
+    for (std::size_t j = 1; j < probe; ++j) changes += !(returns[j].elevation == returns[j - 1].elevation);
+    const bool use_memo = probe < 64 || changes < 56;
     double last_phi = NAN;
     bool any_kept = true, any_dropped = false, skipped_row = false;
 
@@ -166,12 +171,8 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         const double* ang = direct_weight_.data();
         int n_dirs;
         if (use_memo) {
-            ++lookups;
             const std::size_t slot = slot_of(azimuth);
-            if (!(cache_key_[slot] == azimuth)) {
-                ++misses;
-                fill_angular(slot, azimuth);
-            }
+            if (!(cache_key_[slot] == azimuth)) fill_angular(slot, azimuth);
             dir = cache_dir_.data() + slot * K;
             ang = cache_weight_.data() + slot * K;
             n_dirs = cache_count_[slot];
@@ -230,7 +231,6 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             }
         }
     }
-    if (use_memo && lookups > 0) memo_useful_ = misses * 4 < lookups * 3;
     for (int axis = 0; axis < L * K; ++axis)
         std::copy(out_data + static_cast<std::size_t>(axis) * stride, out_data + static_cast<std::size_t>(axis) * stride + M,
                   result.begin() + static_cast<std::ptrdiff_t>(axis) * M);

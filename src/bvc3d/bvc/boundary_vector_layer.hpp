@@ -104,11 +104,8 @@ private:
     int angular_weights(double azimuth, int* dir, double* weight) const;
     mutable std::vector<double> cache_key_, cache_weight_;
     mutable std::vector<int> cache_count_, cache_dir_;
-    // Irregular point sets (real LiDAR) repeat no azimuth: the memo then only evicts useful cache
-    // lines, so a step whose memo mostly missed makes the next steps compute the factors directly
-    // (into direct_*), checking again every 16th step. Either way the numbers are the same.
-    mutable bool memo_useful_ = true;
-    mutable unsigned memo_probe_ = 0;
+    // Irregular point sets (real LiDAR) repeat no azimuth: the memo would only evict useful cache
+    // lines, so their factors are computed directly (into direct_*). The numbers are the same.
     mutable std::vector<int> direct_dir_;
     mutable std::vector<double> direct_weight_;
 

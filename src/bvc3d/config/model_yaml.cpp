@@ -1,5 +1,6 @@
 #include "bvc3d/config/model_yaml.hpp"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "bvc3d/config/world_yaml.hpp"
@@ -39,6 +40,33 @@ std::string model_to_yaml(const ModelSpec& m) {
     return "name: " + m.name + "\nsensor:\n" + params::yaml_lines(LidarSpec::table(), m.sensor, "  ") + "bvc:\n" +
            params::yaml_lines(BvcParams::table(), m.bvc, "  ") + "place:\n" +
            params::yaml_lines(PlaceParams::table(), m.place, "  ");
+}
+
+void write_model(params::CommentedYaml& out, const ModelSpec& m, const std::string& indent) {
+    out.line(indent, "name", params::CommentedYaml::scalar(m.name), "a label: trial names and tables show it");
+    if (const std::string builtin = builtin_sensor_name(m.sensor); !builtin.empty()) {
+        out.line(indent, "sensor", builtin, "horizontal, spherical, or a sensor mapping (bvc3d config --sensor NAME)");
+    } else {
+        out.section(indent, "sensor", "the scanner the model reads (docs/worlds.md#sensors)");
+        write_sensor(out, m.sensor, indent + "  ");
+    }
+    out.section(indent, "bvc", "the boundary vector cells");
+    out.fields(BvcParams::table(), m.bvc, indent + "  ");
+    out.section(indent, "place", "the place-cell network");
+    out.fields(PlaceParams::table(), m.place, indent + "  ");
+}
+
+std::string model_to_commented_yaml(const ModelSpec& m) {
+    params::CommentedYaml out;
+    out.comment("", "A model (docs/model.md#custom-models-yaml): every key. Read by --model FILE.");
+    write_model(out, m, "");
+    return out.str();
+}
+
+std::string preset_name_of(const ModelSpec& m) {
+    const auto names = model_preset_names();
+    if (std::find(names.begin(), names.end(), m.name) == names.end()) return "";
+    return model_to_yaml(model_preset(m.name)) == model_to_yaml(m) ? m.name : "";
 }
 
 }  // namespace bvc3d::config

@@ -1,10 +1,12 @@
 #include "bvc3d/config/trial_yaml.hpp"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d::config {
 
@@ -98,5 +100,50 @@ TrialConfig trial_from_yaml(const YamlView& v) {
 }
 
 TrialConfig load_trial_file(const std::string& path) { return trial_from_yaml(YamlView::load_file(path)); }
+
+namespace {
+
+std::string list(const std::vector<std::string>& names) {
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
+// A path as written into generated YAML: absolute, so that the text means the same file wherever it is saved.
+std::string file_text(const std::string& path) {
+    return params::CommentedYaml::scalar(std::filesystem::absolute(path).lexically_normal().string());
+}
+
+}  // namespace
+
+std::string trial_to_commented_yaml(const TrialConfig& t) {
+    params::CommentedYaml out;
+    out.comment("", "A trial (docs/experiments.md): every key. `bvc3d run --config FILE` runs it.");
+    const auto presets = world_preset_names();
+    const bool preset_world = std::find(presets.begin(), presets.end(), t.world.source) != presets.end();
+    out.section("", "world");
+    out.line("  ", "source", preset_world ? t.world.source : file_text(t.world.source),
+             "a world preset (" + list(presets) + ") or a world YAML file");
+    if (t.world.source == "cross" || t.world.tilt_deg)
+        out.line("  ", "tilt_deg", format_number(t.world.tilt_deg.value_or(0.0)),
+                 "cross only: degrees the central walls lean");
+    if (preset_world) out.line("  ", "lean", params::CommentedYaml::scalar(t.world.lean), "the corner they lean toward");
+    if (const std::string preset = preset_name_of(t.model); !preset.empty()) {
+        out.line("", "model", preset,
+                 "a preset (" + list(model_preset_names()) + "), a model YAML file or a mapping (bvc3d config --model NAME)");
+    } else {
+        out.section("", "model", "a model mapping (docs/model.md#custom-models-yaml)");
+        write_model(out, t.model, "  ");
+    }
+    out.line("", "seed", std::to_string(t.seed), "seeds the walk, the weights and the sensor noise");
+    out.section("", "protocol");
+    out.fields(Protocol::table(), t.protocol, "  ");
+    t.agent->write_yaml(out);
+    out.section("", "analysis");
+    out.fields(analysis::AnalysisParams::table(), t.analysis, "  ");
+    out.line("  ", "extent", t.arena_extent ? "arena" : "data",
+             "rate-map grid over the trajectory's bounds (data) or the walkable region's (arena)");
+    return out.str();
+}
 
 }  // namespace bvc3d::config

@@ -15,6 +15,11 @@ namespace bvc3d::config {
 TrialConfig trial_from_yaml(const YamlView& v);
 TrialConfig load_trial_file(const std::string& path);
 
+// What `bvc3d config` prints: the trial as YAML with every key and its description, which
+// trial_from_yaml reads back to the same trial (equal canonical text; the condition label aside).
+// The model is named when it is a preset exactly, else written out; files are absolute paths.
+std::string trial_to_commented_yaml(const TrialConfig& t);
+
 // The trial keys trial_from_yaml accepts at the top level.
 std::vector<std::string> trial_keys();
 

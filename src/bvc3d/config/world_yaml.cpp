@@ -284,6 +284,25 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
     return s;
 }
 
+std::string builtin_sensor_name(const LidarSpec& s) {
+    const auto& table = LidarSpec::table();
+    const std::string text = params::yaml_lines(table, s, "");
+    for (const auto& [name, spec] : {std::pair{"horizontal", LidarSpec::horizontal()}, {"spherical", LidarSpec::spherical()}})
+        if (text == params::yaml_lines(table, spec, "")) return name;
+    return "";
+}
+
+void write_sensor(params::CommentedYaml& out, const LidarSpec& s, const std::string& indent) {
+    out.fields(LidarSpec::table(), s, indent);
+}
+
+std::string sensor_to_commented_yaml(const LidarSpec& s) {
+    params::CommentedYaml out;
+    out.comment("", "A sensor (docs/worlds.md#sensors): every key. Read by --sensor FILE, or as a model's sensor mapping.");
+    write_sensor(out, s, "");
+    return out.str();
+}
+
 LidarSpec resolve_sensor(const std::string& name) {
     if (name == "horizontal") return LidarSpec::horizontal();
     if (name == "spherical") return LidarSpec::spherical();

@@ -27,4 +27,11 @@ WorldDescription resolve_world(const std::string& name_or_file, std::optional<do
 LidarSpec sensor_from_yaml(const YamlView& v);
 LidarSpec resolve_sensor(const std::string& name_or_file);
 
+// The name of the built-in sensor `s` is exactly ("horizontal", "spherical"), or "".
+std::string builtin_sensor_name(const LidarSpec& s);
+// Every key of a sensor mapping at `indent`, with descriptions; sensor_from_yaml reads it back to `s`.
+void write_sensor(params::CommentedYaml& out, const LidarSpec& s, const std::string& indent);
+// What `bvc3d config --sensor` prints: a sensor file with every key.
+std::string sensor_to_commented_yaml(const LidarSpec& s);
+
 }  // namespace bvc3d::config

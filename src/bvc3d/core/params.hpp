@@ -169,4 +169,31 @@ std::string yaml_lines(const Table<S>& table, const S& s, const std::string& ind
     return out;
 }
 
+// YAML for people to read and edit (what `bvc3d config` prints): `key: value` lines with each key's
+// description as a comment, the comments lined up, long lists wrapped. Values are written as
+// yaml_lines writes them (shortest round-trip numbers; text quoted only where YAML needs it), so the
+// text reads back to the same values.
+class CommentedYaml {
+public:
+    void comment(const std::string& indent, const std::string& text);  // a line of its own: `# text`
+    // `key:` opening a nested mapping.
+    void section(const std::string& indent, const std::string& key, const std::string& doc = "");
+    // `key: value`; `value` is YAML text (see scalar()).
+    void line(const std::string& indent, const std::string& key, const std::string& value, const std::string& doc);
+    template <class S>
+    void fields(const Table<S>& table, const S& s, const std::string& indent) {
+        for (const auto& f : table.fields())
+            line(indent, f.key, f.kind == Kind::text ? scalar(to_text(f.get(s))) : to_text(f.get(s)), f.doc);
+    }
+    // Text as a YAML scalar: as it is when YAML reads it back unchanged, else double-quoted.
+    static std::string scalar(const std::string& text);
+    std::string str() const;
+
+private:
+    struct Entry {
+        std::string text, doc, indent;  // text: the line(s) without the comment
+    };
+    std::vector<Entry> entries_;
+};
+
 }  // namespace bvc3d::params

@@ -248,6 +248,17 @@ std::vector<std::size_t> dims(hid_t loc, const std::string& name) {
     return std::vector<std::size_t>(d.begin(), d.end());
 }
 
+Element element(hid_t loc, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle ds(check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), "no dataset '" + name + "'"), H5Dclose);
+    Handle type(check(H5Dget_type(ds), "type " + name), H5Tclose);
+    switch (H5Tget_class(type)) {
+        case H5T_FLOAT: return H5Tget_size(type) <= 4 ? Element::f32 : Element::f64;
+        case H5T_INTEGER: return Element::integer;
+        default: return Element::other;
+    }
+}
+
 std::vector<double> read_doubles(hid_t loc, const std::string& n) { return read_any<double>(loc, n, H5T_NATIVE_DOUBLE); }
 std::vector<float> read_floats(hid_t loc, const std::string& n) { return read_any<float>(loc, n, H5T_NATIVE_FLOAT); }
 std::vector<std::int64_t> read_ints(hid_t loc, const std::string& n) { return read_any<std::int64_t>(loc, n, H5T_NATIVE_INT64); }

@@ -61,6 +61,9 @@ void write(hid_t loc, const std::string& name, const std::vector<std::int64_t>& 
 void write(hid_t loc, const std::string& name, const std::vector<std::uint8_t>& v, std::vector<std::size_t> dims, bool compress = true);
 
 std::vector<std::size_t> dims(hid_t loc, const std::string& name);
+// What a dataset's elements are, for readers that take any stored type.
+enum class Element { f64, f32, integer, other };
+Element element(hid_t loc, const std::string& name);
 std::vector<double> read_doubles(hid_t loc, const std::string& name);
 std::vector<float> read_floats(hid_t loc, const std::string& name);
 std::vector<std::int64_t> read_ints(hid_t loc, const std::string& name);

@@ -189,6 +189,32 @@ TrialWeights read_trial_weights(const std::filesystem::path& path) {
     return w;
 }
 
+std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, const std::string& dataset) {
+    auto lock = h5::hdf5_lock();
+    const auto f = open_trial(path);
+    // Walk the groups one name at a time: H5Lexists needs every link on the way to exist.
+    std::vector<h5::Handle> groups;
+    hid_t loc = f;
+    std::string rest = dataset;
+    for (auto slash = rest.find('/'); slash != std::string::npos; slash = rest.find('/')) {
+        const std::string group = rest.substr(0, slash);
+        if (group.empty() || !h5::exists(loc, group)) return std::nullopt;
+        groups.push_back(h5::open_group(loc, group));
+        loc = groups.back();
+        rest = rest.substr(slash + 1);
+    }
+    if (rest.empty() || !h5::exists(loc, rest)) return std::nullopt;
+    NamedArray a{dataset, h5::dims(loc, rest), {}, true};
+    switch (h5::element(loc, rest)) {
+        case h5::Element::f64: a.data = h5::read_doubles(loc, rest); break;
+        case h5::Element::f32: a.data = h5::read_floats(loc, rest); break;
+        case h5::Element::integer: a.data = h5::read_ints(loc, rest); break;
+        case h5::Element::other:
+            throw InputError("'" + path.string() + "': dataset '" + dataset + "' holds neither numbers nor integers");
+    }
+    return a;
+}
+
 TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names) {
     auto lock = h5::hdf5_lock();
     const auto f = open_trial(path);

@@ -83,6 +83,11 @@ struct TrialWeights {
     std::size_t n_place = 0, n_bvc = 0;
 };
 TrialWeights read_trial_weights(const std::filesystem::path& path);
+// Any dataset of a trial file by its path inside the file ("samples/heading", "metrics/sai",
+// "weights"), as stored: float64, float32, or int64 for integers. nullopt when the file lacks it;
+// InputError when the file is missing, broken or not a trial file, or the dataset holds neither
+// numbers nor integers. For readers that show a file (`bvc3d view`), not for the analysis.
+std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, const std::string& dataset);
 
 // The named scalar metrics of a file, for summaries; a metric the file lacks (written before it
 // existed) reads as NaN.

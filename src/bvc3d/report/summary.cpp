@@ -1,5 +1,6 @@
 #include "bvc3d/report/summary.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -138,7 +139,11 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
         }
         os << '\n';
     }
-    os << "\nMean over seeds ± sample standard deviation. MI: modality index (DBSCAN clusters per place cell);\n"
+    // With one seed per condition a value is that trial's: no mean, no spread.
+    const bool replicated = std::any_of(rows.begin(), rows.end(), [](const SummaryRow& r) { return r.n_seeds > 1; });
+    os << (replicated ? "\nMean over seeds ± sample standard deviation (one seed: the trial's value)."
+                      : "\nOne trial (seed) per condition: each value is that trial's.")
+       << " MI: modality index (DBSCAN clusters per place cell);\n"
           "MSAI: mean spatial aliasing index; decoding: position error of the cosine-nearest rate-map bin.\n";
     f.commit();
 }

@@ -1,0 +1,369 @@
+#include "view/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bvc3d/analysis/hexbin.hpp"
+#include "bvc3d/bvc/boundary_vector_layer.hpp"
+#include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/trial_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
+#include "bvc3d/recording/pairing.hpp"
+#include "bvc3d/recording/scan_file.hpp"
+#include "bvc3d/sensor/lidar.hpp"
+#include "view/blob.hpp"
+
+namespace bvc3d::view {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json value_json(const params::Value& v) {
+    if (const auto* d = std::get_if<double>(&v)) return number_or_null(*d);
+    if (const auto* i = std::get_if<long long>(&v)) return *i;
+    if (const auto* b = std::get_if<bool>(&v)) return *b;
+    if (const auto* s = std::get_if<std::string>(&v)) return *s;
+    return nullptr;
+}
+
+// A stored array as float32 (or int32 for integers), under `name`.
+BlobArray array_blob(const std::string& name, const NamedArray& a) {
+    if (const auto* d = std::get_if<std::vector<double>>(&a.data)) return f32_array(name, std::span<const double>(*d), a.shape);
+    if (const auto* f = std::get_if<std::vector<float>>(&a.data)) return f32_array(name, std::span<const float>(*f), a.shape);
+    return i32_array(name, std::get<std::vector<std::int64_t>>(a.data), a.shape);
+}
+
+json sensor_json(const LidarSpec& s) {
+    return {{"name", s.name}, {"rows", s.elevations.size()}, {"elevations", s.elevations},
+            {"azimuth_count", s.azimuth_count}, {"height", s.height}, {"max_range", s.max_range}};
+}
+
+json model_json(const ModelSpec& m) {
+    const auto& b = m.bvc;
+    return {{"name", m.name},
+            {"sensor", sensor_json(m.sensor)},
+            {"bvc", {{"elevations", b.elevations}, {"n_layers", b.n_layers()}, {"n_dir", b.n_dir},
+                     {"n_per_axis", b.n_per_axis}, {"max_dist", b.max_dist}, {"n_cells", b.n_cells()}}},
+            {"n_place", m.place.n_place}};
+}
+
+// Returns as world-frame points from the sensor at `origin`.
+void add_point(std::vector<float>& xyz, const Vec3& origin, const LidarReturn& r) {
+    const double c = std::cos(r.elevation);
+    xyz.push_back(static_cast<float>(origin.x() + r.range * c * std::cos(r.azimuth)));
+    xyz.push_back(static_cast<float>(origin.y() + r.range * c * std::sin(r.azimuth)));
+    xyz.push_back(static_cast<float>(origin.z() + r.range * std::sin(r.elevation)));
+}
+
+// Which rows of the drawn sensor feed the model's BVCs: rows of the model's own sensor that its
+// BVC layer's plan casts.
+std::vector<char> kept_rows(const LidarSpec& drawn, const ModelSpec& model) {
+    const auto plan = BoundaryVectorLayer(model.bvc).plan(model.sensor);
+    std::vector<char> kept(drawn.elevations.size(), 0);
+    for (std::size_t r = 0; r < drawn.elevations.size(); ++r)
+        for (std::size_t j = 0; j < model.sensor.elevations.size(); ++j)
+            if (std::abs(drawn.elevations[r] - model.sensor.elevations[j]) < 1e-9 && plan.rows[j]) kept[r] = 1;
+    return kept;
+}
+
+std::size_t nearest_row(const std::vector<double>& elevations, double e) {
+    std::size_t best = 0;
+    for (std::size_t r = 1; r < elevations.size(); ++r)
+        if (std::abs(elevations[r] - e) < std::abs(elevations[best] - e)) best = r;
+    return best;
+}
+
+}  // namespace
+
+std::string world_blob(const WorldDescription& w, const std::string& source, const std::vector<float>& points) {
+    std::vector<float> tri;
+    tri.reserve(w.mesh.size() * 9);
+    Eigen::AlignedBox3d box;
+    for (std::size_t t = 0; t < w.mesh.size(); ++t)
+        for (const auto& v : w.mesh.corners(t)) {
+            box.extend(v);
+            for (int k = 0; k < 3; ++k) tri.push_back(static_cast<float>(v[k]));
+        }
+    for (std::size_t i = 0; i + 2 < points.size(); i += 3) box.extend(Vec3(points[i], points[i + 1], points[i + 2]));
+    json walkable = json::array(), starts = json::array();
+    for (const auto& p : w.walkable.points) walkable.push_back({p.x(), p.y()});
+    for (const auto& p : w.start.points) starts.push_back({p.x(), p.y()});
+    json header = {{"kind", "world"}, {"name", w.name}, {"source", source}, {"triangles", w.mesh.size()},
+                   {"walkable", walkable}, {"start_points", starts}, {"points", points.size() / 3}};
+    if (w.tilt_deg) header["tilt_deg"] = *w.tilt_deg;
+    // Where the page first probes the world: a start point, or the middle of the walkable region.
+    // As text, so that the page asks for exactly this pose (an export holds the reply under it).
+    if (!w.walkable.points.empty() || !w.start.points.empty()) {
+        Vec2 at = w.start.points.empty() ? Vec2(w.walkable.bounds().center()) : w.start.points.front();
+        header["probe"] = {{"x", format_number(at.x())}, {"y", format_number(at.y())}, {"heading", "0"}};
+    }
+    if (!box.isEmpty())
+        header["bounds"] = {{box.min().x(), box.min().y(), box.min().z()}, {box.max().x(), box.max().y(), box.max().z()}};
+    std::vector<BlobArray> arrays{f32_array("triangles", std::span<const float>(tri), {w.mesh.size() * 3, 3})};
+    if (!points.empty()) arrays.push_back(f32_array("points", std::span<const float>(points), {points.size() / 3, 3}));
+    return encode_blob(std::move(header), arrays);
+}
+
+LidarSpec drawn_sensor(const LidarSpec& model_sensor) {
+    if (model_sensor.name != "spherical") return model_sensor;
+    LidarSpec all = LidarSpec::spherical(false);
+    all.height = model_sensor.height;
+    all.max_range = model_sensor.max_range;
+    all.azimuth_offset = model_sensor.azimuth_offset;
+    // Keep the model's own rows if it has some the preset lacks (a custom table named spherical).
+    for (double e : model_sensor.elevations)
+        if (std::none_of(all.elevations.begin(), all.elevations.end(), [&](double a) { return std::abs(a - e) < 1e-9; }))
+            return model_sensor;
+    if (model_sensor.azimuth_count != all.azimuth_count) return model_sensor;
+    return all;
+}
+
+std::shared_ptr<const TrialScene> TrialScene::load(const fs::path& file) {
+    auto s = std::make_shared<TrialScene>();
+    s->data_ = read_trial_samples(file);
+    auto doubles = [&](const char* name) {
+        const auto a = read_trial_array(file, name);
+        if (!a) return std::vector<double>(s->data_.x.size(), 0.0);
+        if (const auto* d = std::get_if<std::vector<double>>(&a->data)) return *d;
+        throw InputError("'" + file.string() + "': " + name + " is not float64");
+    };
+    s->t_ = doubles("samples/t");
+    s->heading_ = doubles("samples/heading");
+    if (s->t_.size() != s->data_.x.size() || s->heading_.size() != s->data_.x.size())
+        throw InputError("'" + file.string() + "': samples/t and samples/heading must have one value per sample");
+    s->resolve_model_and_world(file);
+    s->encode(file);
+    return s;
+}
+
+void TrialScene::resolve_model_and_world(const fs::path& file) {
+    // The configuration as recorded; relative paths in it are tried next to the trial file first.
+    try {
+        const TrialConfig t = config::trial_from_yaml(config::YamlView::load_string(data_.config, file.string()));
+        model_ = t.model;
+        world_source_ = t.world.source;
+        world_ = std::make_shared<World>(t.world.resolve());
+        return;
+    } catch (const InputError& e) {
+        world_problem_ = e.what();
+    }
+    // The whole configuration does not resolve (most often a world file that moved): take the
+    // model and world on their own.
+    try {
+        const auto yaml = config::YamlView::load_string(data_.config, file.string());
+        if (yaml.has("model")) {
+            const auto m = yaml["model"];
+            model_ = m.is_scalar() ? config::resolve_model(m.as_string()) : config::model_from_yaml(m);
+        } else {
+            model_ = config::resolve_model(data_.model);
+        }
+    } catch (const InputError& e) {
+        model_problem_ = e.what();
+    }
+    world_source_ = data_.world_source.empty() ? data_.world : data_.world_source;
+    try {
+        std::optional<double> tilt;
+        if (std::isfinite(data_.tilt_deg) && world_source_ == "cross") tilt = data_.tilt_deg;
+        world_ = std::make_shared<World>(config::resolve_world(world_source_, tilt));
+        world_problem_.clear();
+    } catch (const InputError& e) {
+        world_problem_ = "the trial's world '" + world_source_ + "' cannot be opened: " + e.what();
+    }
+}
+
+void TrialScene::encode(const fs::path& file) {
+    const std::size_t n = data_.x.size();
+    json metrics = json::object();
+    for (const auto& [name, v] : data_.metric_attributes) metrics[name] = value_json(v);
+    json swept = json::object();
+    for (const auto& [k, v] : data_.swept) swept[k] = v;
+    json header = {{"kind", "trial"},
+                   {"name", data_.name},
+                   {"condition", data_.condition},
+                   {"swept", swept},
+                   {"world", data_.world},
+                   {"world_source", world_source_},
+                   {"world_problem", world_problem_},
+                   {"model_name", data_.model},
+                   {"seed", data_.seed},
+                   {"tilt_deg", number_or_null(data_.tilt_deg)},
+                   {"samples", n},
+                   {"n_place", data_.n_place},
+                   {"dims", data_.z.empty() ? 2 : 3},
+                   {"metrics", metrics},
+                   {"model_problem", model_problem_}};
+    if (model_) {
+        header["model"] = model_json(*model_);
+        header["drawn_sensor"] = sensor_json(drawn_sensor(model_->sensor));
+    }
+    if (data_.extent) header["extent"] = *data_.extent;
+    float rate_max = 0;  // the population's color scale
+    for (float r : data_.rates) rate_max = std::max(rate_max, r);
+    header["rate_max"] = rate_max;
+
+    std::vector<BlobArray> arrays{f32_array("x", std::span<const double>(data_.x)),
+                                  f32_array("y", std::span<const double>(data_.y)),
+                                  f32_array("heading", std::span<const double>(heading_)),
+                                  f32_array("t", std::span<const double>(t_))};
+    if (!data_.z.empty()) arrays.push_back(f32_array("z", std::span<const double>(data_.z)));
+    for (const char* name : {"bin_centers", "bin_counts", "rate_maps", "sai", "modality", "spatial_info", "peak_rate"})
+        if (const auto a = read_trial_array(file, std::string("metrics/") + name)) arrays.push_back(array_blob(name, *a));
+
+    // The hexagons' size, for drawing maps as the figures do: the grid the analysis fits.
+    const auto centers = std::find_if(arrays.begin(), arrays.end(), [](const BlobArray& a) { return a.name == "bin_centers"; });
+    if (centers != arrays.end() && centers->shape.size() == 2 && centers->shape[1] == 2 && n > 0) {
+        int gridsize = 50;
+        for (const auto& [name, v] : data_.metric_attributes)
+            if (name == "gridsize" && std::holds_alternative<long long>(v)) gridsize = static_cast<int>(std::get<long long>(v));
+        std::optional<analysis::Extent> extent;
+        if (data_.extent && data_.extent->size() == 4)
+            extent = analysis::Extent{(*data_.extent)[0], (*data_.extent)[1], (*data_.extent)[2], (*data_.extent)[3]};
+        const auto grid = analysis::HexGrid::fit(data_.x, data_.y, gridsize, extent);
+        header["grid"] = {{"kind", "hex"}, {"gridsize", gridsize}, {"sx", grid.sx}, {"sy", grid.sy}};
+    } else if (centers != arrays.end() && centers->shape.size() == 2 && centers->shape[1] == 3) {
+        header["grid"] = {{"kind", "voxel"}};
+    }
+    blob_ = encode_blob(std::move(header), arrays);
+}
+
+Pose TrialScene::pose(std::size_t i) const {
+    return Pose{data_.x[i], data_.y[i], data_.z.empty() ? 0.0 : data_.z[i], heading_[i], 0.0, 0.0};
+}
+
+std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model, const Pose& p, json& header) {
+    const LidarSpec drawn = drawn_sensor(model.sensor);
+    const auto rows = kept_rows(drawn, model);
+    const Scan all = Lidar(drawn).scan(world, p);
+    const Vec3 origin = p.position() + p.rotation() * Vec3(0, 0, drawn.height);
+    std::vector<float> xyz, range;
+    std::vector<std::uint8_t> kept;
+    xyz.reserve(all.size() * 3);
+    for (const auto& r : all) {
+        add_point(xyz, origin, r);
+        range.push_back(static_cast<float>(r.range));
+        kept.push_back(static_cast<std::uint8_t>(rows[nearest_row(drawn.elevations, r.elevation)]));
+    }
+    // The BVC rates from the model's own scanner, as the model computed them (without noise).
+    const Scan seen = Lidar(model.sensor).scan(world, p);
+    const BoundaryVectorLayer layer(model.bvc);
+    std::vector<double> rates(layer.n_cells());
+    layer.rates(seen, rates);
+    header["returns"] = all.size();
+    header["model_returns"] = seen.size();
+    header["sensor_origin"] = {origin.x(), origin.y(), origin.z()};
+    return {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),
+            f32_array("range", std::span<const float>(range)), u8_array("kept", kept),
+            f32_array("bvc", std::span<const double>(rates))};
+}
+
+std::string probe_blob(const World& world, const ModelSpec& model, const Pose& p) {
+    json header = {{"kind", "probe"}, {"x", p.x}, {"y", p.y}, {"z", p.z}, {"heading", p.heading},
+                   {"model", model_json(model)}, {"drawn_sensor", sensor_json(drawn_sensor(model.sensor))}};
+    auto arrays = sensed_arrays(world, model, p, header);
+    return encode_blob(std::move(header), arrays);
+}
+
+std::string TrialScene::step_blob(std::size_t i) const {
+    if (i >= samples()) throw InputError("sample " + std::to_string(i) + " is past the trial's " + std::to_string(samples()));
+    const Pose p = pose(i);
+    json header = {{"kind", "step"}, {"sample", i}, {"t", t_[i]}, {"x", p.x}, {"y", p.y}, {"z", p.z}, {"heading", p.heading}};
+    std::vector<BlobArray> arrays;
+    if (world_ && model_) {
+        arrays = sensed_arrays(*world_, *model_, p, header);
+    } else {
+        const std::vector<float> none;
+        arrays = {f32_array("points", std::span<const float>(none), {0, 3}), f32_array("range", std::span<const float>(none)),
+                  u8_array("kept", {}), f32_array("bvc", std::span<const float>(none))};
+    }
+    arrays.push_back(f32_array("place", std::span<const float>(data_.rates.data() + i * data_.n_place, data_.n_place)));
+    return encode_blob(std::move(header), arrays);
+}
+
+// ---- recordings ----
+
+RecordingScene::RecordingScene(const fs::path& scans, const fs::path& poses, ModelSpec model) : model_(std::move(model)) {
+    scans_ = recording::list_scans(scans);
+    const auto all_poses = recording::read_poses(poses);
+    const auto pairing = recording::pair_scans_with_poses(recording::scan_times(scans_), all_poses);
+    for (auto k : pairing.pose_of_scan) poses_.push_back(all_poses[k]);
+    std::vector<float> position, rotation;
+    json names = json::array(), times = json::array();
+    for (std::size_t i = 0; i < scans_.size(); ++i) {
+        const auto& T = poses_[i].world_from_sensor;
+        for (int k = 0; k < 3; ++k) position.push_back(static_cast<float>(T.translation()[k]));
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) rotation.push_back(static_cast<float>(T.linear()(r, c)));
+        names.push_back(scans_[i].path.filename().string());
+        times.push_back(poses_[i].time ? json(*poses_[i].time) : json(nullptr));
+    }
+    json header = {{"kind", "recording"}, {"scans", scans_.size()}, {"names", names}, {"times", times},
+                   {"model", model_json(model_)}, {"paired_by_time", pairing.by_time}};
+    blob_ = encode_blob(std::move(header), {f32_array("position", std::span<const float>(position), {scans_.size(), 3}),
+                                            f32_array("rotation", std::span<const float>(rotation), {scans_.size(), 9})});
+}
+
+std::string RecordingScene::map_blob() const {
+    // At most 60 scans and 250 000 points: enough to see the place, quick to read and draw.
+    const std::size_t every = std::max<std::size_t>(1, (scans_.size() + 59) / 60);
+    const std::size_t used = (scans_.size() + every - 1) / every;
+    const std::size_t per_scan = 250000 / std::max<std::size_t>(used, 1);
+    std::vector<float> points;
+    for (std::size_t i = 0; i < scans_.size(); i += every) {
+        const auto cloud = recording::read_scan(scans_[i].path);
+        const std::size_t stride = std::max<std::size_t>(1, (cloud.size() + per_scan - 1) / per_scan);
+        const auto& T = poses_[i].world_from_sensor;
+        for (std::size_t p = 0; p < cloud.size(); p += stride) {
+            const Vec3 w = T * Vec3(cloud.xyz[3 * p], cloud.xyz[3 * p + 1], cloud.xyz[3 * p + 2]);
+            for (int k = 0; k < 3; ++k) points.push_back(static_cast<float>(w[k]));
+        }
+    }
+    WorldDescription empty;
+    empty.name = "recording";
+    return world_blob(empty, "recording", points);
+}
+
+std::string RecordingScene::scan_blob(std::size_t i) const {
+    if (i >= scans_.size()) throw InputError("scan " + std::to_string(i) + " is past the recording's " + std::to_string(scans_.size()));
+    const auto cloud = recording::read_scan(scans_[i].path);
+    const auto& T = poses_[i].world_from_sensor;
+    std::vector<float> xyz, range;
+    std::vector<std::uint8_t> kept;
+    Scan returns;
+    const auto& psi = model_.bvc.elevations;
+    const double window = 4 * model_.bvc.sigma_phi;
+    for (std::size_t p = 0; p < cloud.size(); ++p) {
+        const Vec3 local(cloud.xyz[3 * p], cloud.xyz[3 * p + 1], cloud.xyz[3 * p + 2]);
+        const Vec3 v = T.linear() * local;  // world-aligned, from the sensor
+        const double r = v.norm();
+        if (!(r > 0)) continue;
+        const LidarReturn ret{r, std::atan2(v.y(), v.x()), std::asin(std::clamp(v.z() / r, -1.0, 1.0))};
+        returns.push_back(ret);
+        const Vec3 w = T * local;
+        for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(w[k]));
+        range.push_back(static_cast<float>(r));
+        const bool near_layer = psi.empty() || std::any_of(psi.begin(), psi.end(), [&](double e) {
+            return std::abs(ret.elevation - e) <= window;
+        });
+        kept.push_back(near_layer ? 1 : 0);
+    }
+    const BoundaryVectorLayer layer(model_.bvc);
+    std::vector<double> rates(layer.n_cells());
+    layer.rates(returns, rates);
+    const std::vector<float> bvc(rates.begin(), rates.end());
+    const Vec3 origin = T.translation();
+    json header = {{"kind", "scan"}, {"scan", i}, {"name", scans_[i].path.filename().string()},
+                   {"returns", returns.size()}, {"sensor_origin", {origin.x(), origin.y(), origin.z()}},
+                   {"dropped_nonfinite", cloud.dropped_nonfinite}};
+    if (poses_[i].time) header["t"] = *poses_[i].time;
+    return encode_blob(std::move(header), {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),
+                                           f32_array("range", std::span<const float>(range)), u8_array("kept", kept),
+                                           f32_array("bvc", std::span<const float>(bvc))});
+}
+
+}  // namespace bvc3d::view
