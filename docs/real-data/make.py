@@ -225,6 +225,7 @@ def scan_to_map(rec, work):
     bvc3d("localize", "--templates", work / "templates_{model}.h5", "--queries", rec, "--query-poses",
           rec / "poses.csv", "--model", ",".join(MODELS), "--out", out)
     copy_table(out / "localization.csv", "scan-to-map.csv")
+    copy_table(out / "queries.csv", "scan-to-map-queries.csv")  # each query's decoded place: the failures
     shutil.copyfile(out / "localization.png", FIGURES / "real-scan-to-map.png")
     aliasing_figure(rec, work, out)
 
