@@ -14,6 +14,7 @@
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/memory.hpp"
 
 namespace bvc3d::cli {
 
@@ -26,11 +27,40 @@ double parse_number(const std::string& s, const std::string& what) {
     return v;
 }
 
+std::string printable(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x80) {
+            out += (c < 0x20 && c != '\n' && c != '\t') || c == 0x7f ? '?' : static_cast<char>(c);
+            ++i;
+            continue;
+        }
+        // A well-formed UTF-8 sequence passes whole; anything else is one '?' per byte.
+        const int len = c >= 0xf0 && c < 0xf5 ? 4 : c >= 0xe0 ? 3 : c >= 0xc2 && c < 0xe0 ? 2 : 0;
+        bool ok = len > 0 && i + len <= text.size();
+        for (int k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        if (ok) {
+            out.append(text.substr(i, len));
+            i += len;
+        } else {
+            out += '?';
+            ++i;
+        }
+    }
+    return out;
+}
+
 const CLI::Validator seed_check(
     [](std::string& s) -> std::string {
-        return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos ? "" : "a seed is a whole number >= 0";
+        std::uint64_t v = 0;
+        const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+        return !s.empty() && r.ec == std::errc() && r.ptr == s.data() + s.size()
+                   ? ""
+                   : "a seed is a whole number from 0 to 18446744073709551615 (2^64 - 1), got '" + s + "'";
     },
-    "SEED>=0");
+    "SEED");
 
 const CLI::Validator non_negative_check(
     [](std::string& s) -> std::string {
@@ -98,6 +128,58 @@ int run_python_module(const std::string& module, const std::vector<std::string>&
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const char* const extent_help =
+    "Rate-map grid: 'data' (each trajectory's own bounds, the default), 'arena' (the walkable region's) or "
+    "XMIN,XMAX,YMIN,YMAX in meters";
+
+ExtentOption parse_extent(const std::string& text) {
+    ExtentOption e;
+    if (text == "data") return e;
+    if (text == "arena") {
+        e.kind = ExtentOption::Kind::arena;
+        return e;
+    }
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    for (std::size_t i = 0; i <= text.size(); ++i)
+        if (i == text.size() || text[i] == ',') {
+            parts.push_back(text.substr(start, i - start));
+            start = i + 1;
+        }
+    if (parts.size() != 4) throw InputError("--extent expects data, arena or XMIN,XMAX,YMIN,YMAX, got '" + text + "'");
+    e.kind = ExtentOption::Kind::bounds;
+    e.bounds = analysis::Extent{parse_number(parts[0], "--extent: XMIN"), parse_number(parts[1], "--extent: XMAX"),
+                                parse_number(parts[2], "--extent: YMIN"), parse_number(parts[3], "--extent: YMAX")};
+    try {
+        e.bounds.validate();
+    } catch (const InputError& err) {
+        throw InputError(std::string("--extent: ") + err.what());
+    }
+    return e;
+}
+
+void apply_extent(const ExtentOption& e, TrialConfig& t) {
+    t.arena_extent = e.kind == ExtentOption::Kind::arena;
+    t.analysis.extent.reset();
+    if (e.kind == ExtentOption::Kind::bounds) t.analysis.extent = e.bounds;
+}
+
+int check_jobs(int jobs) {
+    if (jobs < 0) throw InputError("--jobs must be >= 0 (0: one per core), got " + std::to_string(jobs));
+    if (jobs > max_jobs) throw InputError("--jobs " + std::to_string(jobs) + " is more than the limit of " + std::to_string(max_jobs));
+    return jobs;
+}
+
+const char* const no_memory_check_help =
+    "Run even when the estimated memory exceeds what the machine has available";
+
+void check_run_memory(const std::vector<TrialConfig>& trials, int jobs, bool skip) {
+    if (skip) return;
+    const std::string what = trials.size() == 1 ? "this trial" : "this run (" + std::to_string(trials.size()) + " trials)";
+    check_memory(estimate_memory(trials, jobs), what,
+                 "shorten sample_hours, use fewer --jobs or smaller models, or pass --no-memory-check to try anyway");
 }
 
 }  // namespace bvc3d::cli

@@ -2,9 +2,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -13,7 +18,9 @@
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
+#include "bvc3d/config/sweep_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/output_lock.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
@@ -38,6 +45,13 @@ std::vector<std::string> split(const std::string& s) {
         if (!item.empty()) out.push_back(item);
     return out;
 }
+
+// How the report child process ended: its exit status (-1 if it could not run or died by a
+// signal) and the last line it printed on standard error.
+struct ReportRun {
+    int status = -1;
+    std::string error_text, last_error_line;  // all it wrote to standard error, and its last line
+};
 
 // Text as one shell word: as it is when safe, else single-quoted.
 std::string shell_word(const std::string& s) {
@@ -70,22 +84,103 @@ ReportCommand report_command() {
     return c;
 }
 
-// Runs the report module as a child process (no shell); returns its exit status.
-int run_report(const ReportCommand& command, const std::filesystem::path& dir) {
+// Runs the report module as a child process (no shell). Its standard error is kept, to say why it
+// failed (report_failure); the caller decides what of it to show.
+ReportRun run_report(const ReportCommand& command, const std::filesystem::path& dir) {
     std::fflush(stdout);  // our lines first, then the report's
+    std::fflush(stderr);
+    int pipe_fds[2];
+    if (::pipe(pipe_fds) != 0) return {};
     const pid_t pid = ::fork();
-    if (pid < 0) return -1;
+    if (pid < 0) {
+        ::close(pipe_fds[0]);
+        ::close(pipe_fds[1]);
+        return {};
+    }
     if (pid == 0) {
+        ::close(pipe_fds[0]);
+        ::dup2(pipe_fds[1], STDERR_FILENO);
+        ::close(pipe_fds[1]);
         ::setenv("PYTHONPATH", command.pythonpath.c_str(), 1);
         ::execl(command.python.c_str(), command.python.c_str(), "-m", "bvc3d.report", dir.c_str(),
                 static_cast<char*>(nullptr));
         std::perror(("bvc3d: cannot run " + command.python).c_str());
         ::_exit(127);
     }
+    ::close(pipe_fds[1]);
+    ReportRun run;
+    std::string& text = run.error_text;
+    char buf[4096];
+    for (;;) {
+        const ssize_t n = ::read(pipe_fds[0], buf, sizeof buf);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        text.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(pipe_fds[0]);
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::string tail = text;
+    while (!tail.empty() && (tail.back() == '\n' || tail.back() == '\r')) tail.pop_back();
+    const auto nl = tail.rfind('\n');
+    run.last_error_line = nl == std::string::npos ? tail : tail.substr(nl + 1);
+    return run;
+}
+
+// True if a PNG file is complete (ends with its IEND chunk).
+bool png_complete(const std::filesystem::path& file) {
+    static const char iend[] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xae', '\x42', '\x60', '\x82'};
+    std::ifstream in(file, std::ios::binary | std::ios::ate);
+    if (!in || in.tellg() < 12) return false;
+    in.seekg(-12, std::ios::end);
+    char tail[12];
+    return static_cast<bool>(in.read(tail, 12)) && std::equal(tail, tail + 12, iend);
+}
+
+// After a failed report: nothing half-written stays. Temporary files, and figures that do not end
+// where a PNG ends, are removed (and returned); complete figures stay.
+std::vector<std::filesystem::path> remove_partial_report(const std::filesystem::path& dir) {
+    std::vector<std::filesystem::path> removed;
+    std::error_code ec;
+    for (const auto& folder : {dir, dir / "figures"}) {
+        if (!std::filesystem::is_directory(folder, ec)) continue;
+        for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
+            const auto name = e.path().filename().string();
+            // The report's own temporaries ("report.md.tmp") and ours ("x.csv.tmp<pid>-<n>").
+            const auto at = name.rfind(".tmp");
+            const bool temporary = at != std::string::npos &&
+                                   name.find_first_not_of("0123456789-", at + 4) == std::string::npos;
+            const bool broken_png = e.path().extension() == ".png" && !png_complete(e.path());
+            if (e.is_regular_file(ec) && (temporary || broken_png) && std::filesystem::remove(e.path(), ec))
+                removed.push_back(e.path());
+        }
+    }
+    return removed;
+}
+
+// Why a report failed, from its last line: Python's "OSError: [Errno 28] No space left on device"
+// becomes "cannot write 'DIR/figures/msai.png': No space left on device" (the file from the error,
+// or the half-written figure that was removed). Empty `os_error` for any other failure.
+std::string report_failure(const ReportRun& run, const std::vector<std::filesystem::path>& removed, bool& os_error) {
+    const std::string& line = run.last_error_line;
+    const auto errno_at = line.find("[Errno ");
+    const auto close = errno_at == std::string::npos ? std::string::npos : line.find("] ", errno_at);
+    os_error = close != std::string::npos;
+    if (os_error) {
+        std::string reason = line.substr(close + 2), file;
+        const auto quote = reason.find(": '");
+        if (quote != std::string::npos && reason.back() == '\'') {
+            file = reason.substr(quote + 3, reason.size() - quote - 4);
+            reason.resize(quote);
+        } else if (!removed.empty()) {
+            file = removed.front().string();
+        }
+        return file.empty() ? "writing the figures failed: " + reason : "cannot write '" + file + "': " + reason;
+    }
+    if (run.status < 0) return "the report process could not run or was killed";
+    return line.empty() ? "the report exited with status " + std::to_string(run.status) : printable(line);
 }
 
 }  // namespace
@@ -109,17 +204,20 @@ void exit_interrupted() {
     std::exit(130);
 }
 
+ProgressStyle progress_style() { return ::isatty(STDERR_FILENO) ? ProgressStyle::terminal : ProgressStyle::lines; }
+
 ExperimentOutcome run_local_experiment(const std::vector<TrialConfig>& trials, const std::filesystem::path& out,
-                                       int jobs, double checkpoint_minutes, std::function<void(const std::string&)> on_done) {
-    if (jobs < 0) throw InputError("--jobs must be >= 0");
-    if (checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+                                       const LocalRun& how) {
+    check_jobs(how.jobs);
+    if (how.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+    check_run_memory(trials, how.jobs, how.no_memory_check);
     ExperimentOptions opts;
     opts.out_dir = out;
-    opts.jobs = jobs;
-    opts.progress = ::isatty(STDERR_FILENO);
-    opts.checkpoint_minutes = checkpoint_minutes;
+    opts.jobs = how.jobs;
+    opts.progress = progress_style();
+    opts.checkpoint_minutes = how.checkpoint_minutes;
     opts.stop = &stop_flag();
-    opts.on_trial_done = std::move(on_done);
+    opts.on_trial_done = how.on_done;
     InterruptGuard guard;
     try {
         return run_experiment(trials, opts);
@@ -137,17 +235,28 @@ void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const
     std::printf("\n");
 }
 
-void summarize(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report) {
+void summarize(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report,
+               bool allow_mixed) {
     const auto trials = read_summaries(files);
+    if (const auto problem = mixing_problem(trials, files); !problem.empty() && !allow_mixed)
+        throw InputError(problem + "; one table would mix them (summarize them apart, or pass --allow-mixed)");
     const auto rows = summarize(trials);
     write_trials_csv(out / "trials.csv", trials);
     write_summary_csv(out / "summary.csv", rows);
     write_summary_markdown(out / "summary.md", rows);
     if (!report) return;
     const ReportCommand command = report_command();
-    if (run_report(command, out) != 0)
-        throw InputError("the report (figures) failed; the trial files and summary are in '" + out.string() +
-                         "'; rerun it with:\n  " + command.shell_line(out));
+    const ReportRun run = run_report(command, out);
+    if (run.status == 0) {
+        std::fputs(run.error_text.c_str(), stderr);  // the report's own warnings
+        return;
+    }
+    const auto removed = remove_partial_report(out);
+    bool os_error = false;
+    const std::string why = report_failure(run, removed, os_error);
+    if (!os_error) std::fputs(run.error_text.c_str(), stderr);  // a bug's traceback is worth showing
+    throw InputError("the report (figures) failed: " + why + "; the trial files and summary are in '" + out.string() +
+                     "'; rerun it with:\n  " + command.shell_line(out));
 }
 
 namespace {
@@ -156,7 +265,7 @@ struct RunOptions {
     std::string config, world, lean, model, protocol, extent, out, trajectory;
     std::optional<double> tilt, explore_hours, sample_hours, hours;
     std::optional<std::uint64_t> seed;
-    bool record_bvc = false;
+    bool record_bvc = false, no_memory_check = false;
     double checkpoint_minutes = 10;
 };
 
@@ -170,23 +279,23 @@ TrialConfig run_config(const RunOptions& o) {
     if (!o.trajectory.empty()) t.agent = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory));
     if (o.seed) t.seed = *o.seed;
     if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
-    if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
+    const auto hours = [](const char* flag, double h) {
+        if (!(h > 0) || !std::isfinite(h)) throw InputError(std::string(flag) + " must be a positive number of hours");
+        return h;
+    };
+    if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = hours("--hours", *o.hours);
     if (o.explore_hours) t.protocol.explore_hours = *o.explore_hours;
     if (o.sample_hours) t.protocol.sample_hours = *o.sample_hours;
     if (o.record_bvc) t.protocol.record_bvc = true;
-    if (!o.extent.empty()) {
-        if (o.extent != "data" && o.extent != "arena") throw InputError("--extent must be 'data' or 'arena'");
-        t.arena_extent = o.extent == "arena";
-    }
+    if (!o.extent.empty()) apply_extent(parse_extent(o.extent), t);
     if (o.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-    t.validate();
-    t.world.resolve();  // fail early on bad worlds
+    t.check_runnable();  // fail early on bad worlds, start points and robots
     return t;
 }
 
-// Runs one trial into `out` through the trial pipeline, with a progress line on a terminal.
+// Runs one trial into `out` through the trial pipeline, with progress on standard error.
 void run_one(const TrialConfig& t, const std::filesystem::path& out, double checkpoint_minutes) {
-    const bool tty = ::isatty(STDERR_FILENO);
+    const ProgressStyle style = progress_style();
     const double total = t.protocol.seconds();
     InterruptGuard guard;
     RunControl control;
@@ -194,12 +303,18 @@ void run_one(const TrialConfig& t, const std::filesystem::path& out, double chec
     control.checkpoint = out.string() + ".ckpt";
     control.checkpoint_minutes = checkpoint_minutes;
     const auto start = std::chrono::steady_clock::now();
-    if (tty)
-        control.progress = [&](double s, std::int64_t) {
-            const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            std::fprintf(stderr, "\r  %.2f/%.2f simulated hours  ~%.0f s left   ", s / 3600, total / 3600,
-                         s > 0 ? wall * (total - s) / s : 0.0);
-        };
+    int printed_tenth = 0;
+    control.progress = [&](double s, std::int64_t) {
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double left = s > 0 ? wall * (total - s) / s : 0.0;
+        if (style == ProgressStyle::terminal) {
+            std::fprintf(stderr, "\r  %.2f/%.2f simulated hours  ~%.0f s left   ", s / 3600, total / 3600, left);
+        } else if (const int tenth = static_cast<int>(10 * s / total); tenth > printed_tenth && tenth < 10) {
+            printed_tenth = tenth;  // a line per tenth of the trial: logs show where it is
+            std::fprintf(stderr, "bvc3d: %.2f/%.2f simulated hours (%d%%), ~%.0f s left\n", s / 3600, total / 3600,
+                         10 * tenth, left);
+        }
+    };
     GroupOutcome done;
     try {
         done = run_analyze_write({t}, {out}, control);
@@ -207,7 +322,7 @@ void run_one(const TrialConfig& t, const std::filesystem::path& out, double chec
         exit_interrupted();
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (tty) std::fprintf(stderr, "\n");
+    if (style == ProgressStyle::terminal) std::fprintf(stderr, "\n");
     const auto& r = done.result;
     std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), r.t.size(),
                 (r.stats.explore_steps + r.stats.sample_steps) / wall);
@@ -224,49 +339,59 @@ void add_run(CLI::App& app) {
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
     cmd->add_option("--trajectory", o->trajectory,
                     "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
-    cmd->add_option("--seed", o->seed, "Random seed (default 0)")->check(seed_check);
+    cmd->add_option("--seed", o->seed, "Random seed, 0 .. 2^64 - 1 (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
     cmd->add_option("--sample-hours", o->sample_hours, "Simulated hours of sampling (recorded)");
     cmd->add_option("--hours", o->hours, "Shorten both phases to this many simulated hours");
     cmd->add_flag("--record-bvc", o->record_bvc, "Also record the BVC rates");
-    cmd->add_option("--extent", o->extent, "Rate-map grid over the 'data' (default) or the 'arena'");
+    cmd->add_option("--extent", o->extent, extent_help);
     cmd->add_option("--out", o->out, "Trial file to write (default results/<trial name>.h5)");
     cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
                     "Checkpoint every this many simulated minutes (0: only on Ctrl-C)")
         ->capture_default_str();
+    cmd->add_flag("--no-memory-check", o->no_memory_check, no_memory_check_help);
     cmd->footer("Ctrl-C checkpoints and stops; running the same command again resumes and gives the same file.");
     cmd->callback([o] {
         const TrialConfig t = run_config(*o);
         const std::filesystem::path out = o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
                                                          : std::filesystem::path(o->out);
+        require_not_directory(out, "--out");
         ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
+        const OutputLock lock(file_lock_path(out), "trial file '" + out.string() + "'");
         if (trial_file_complete(out, t)) {
             std::cerr << "bvc3d: " << out.string() << " is complete with this configuration; nothing to do\n";
             return;
         }
+        check_run_memory({t}, 1, o->no_memory_check);
         run_one(t, out, o->checkpoint_minutes);
     });
 }
 
 struct PaperOptions {
-    std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol;
+    std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol, extent;
     int seeds = 1, jobs = 0;
     std::optional<double> hours;
     double checkpoint_minutes = 0;
-    bool no_report = false, arena_extent = false;
+    bool no_report = false, no_memory_check = false;
 };
 
 // Models × tilts × seeds, seeds slowest.
 std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
-    if (o.seeds < 1) throw InputError("--seeds must be >= 1");
-    if (o.hours && !(*o.hours > 0)) throw InputError("--hours must be a positive number of hours");
     std::vector<ModelSpec> models;
     for (const auto& m : split(o.models)) models.push_back(config::resolve_model(m));
     if (models.empty()) throw InputError("--models lists no model");
     std::vector<double> tilts;
     for (const auto& t : split(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
+    const double n_trials = static_cast<double>(o.seeds) * static_cast<double>(models.size()) * static_cast<double>(tilts.size());
+    if (o.seeds < 1) throw InputError("--seeds must be >= 1, got " + std::to_string(o.seeds));
+    if (n_trials > config::max_trials)
+        throw InputError("--seeds " + std::to_string(o.seeds) + " × " + std::to_string(models.size()) + " models × " +
+                         std::to_string(tilts.size()) + " tilts = " + num(n_trials) + " trials; the limit is " +
+                         std::to_string(static_cast<long long>(config::max_trials)));
+    if (o.hours && (!(*o.hours > 0) || !std::isfinite(*o.hours))) throw InputError("--hours must be a positive number of hours");
+    const ExtentOption extent = parse_extent(o.extent.empty() ? "data" : o.extent);
     std::vector<TrialConfig> trials;
     for (int seed = 0; seed < o.seeds; ++seed)
         for (double tilt : tilts)
@@ -277,7 +402,7 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
                 t.seed = static_cast<std::uint64_t>(seed);
                 if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
                 if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
-                t.arena_extent = o.arena_extent;
+                apply_extent(extent, t);
                 trials.push_back(t);
             }
     return trials;
@@ -289,21 +414,28 @@ void add_paper(CLI::App& app) {
     cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
     cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
     cmd->add_option("--hours", o->hours, "Shorten both phases to H simulated hours (default: the paper's 4 + 4)");
-    cmd->add_option("--jobs", o->jobs, "Trials in parallel (default: every core)");
+    cmd->add_option("--jobs", o->jobs, "Trials in parallel; 0 (the default): one per core");
     cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
     cmd->add_option("--tilts", o->tilts, "Comma-separated tilts of the cross arena, degrees")->capture_default_str();
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
-    cmd->add_flag("--arena-extent", o->arena_extent, "Bin rate maps over the arena instead of each trajectory");
+    cmd->add_option("--extent", o->extent, extent_help);
     cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
                     "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
     cmd->add_flag("--no-report", o->no_report, "Skip the figures (trial files and summary only)");
+    cmd->add_flag("--no-memory-check", o->no_memory_check, no_memory_check_help);
     cmd->footer(
         "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and the figures and report.md (the\n"
         "Python module bvc3d.report, run with " BVC3D_PYTHON " or $BVC3D_PYTHON). Completed trials are skipped on\n"
         "a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
+        check_jobs(o->jobs);
+        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
         const auto trials = paper_trials(*o);
-        const ExperimentOutcome outcome = run_local_experiment(trials, o->out, o->jobs, o->checkpoint_minutes);
+        check_runnable(trials);  // before anything is written
+        ensure_writable_directory(o->out);
+        const OutputLock lock(folder_lock_path(o->out), "output folder '" + o->out + "'");
+        const ExperimentOutcome outcome =
+            run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, o->no_memory_check, {}});
         print_outcome(trials.size(), o->out, outcome);
         summarize(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
@@ -325,7 +457,7 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
     cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
     cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
-    cmd->add_option("--extent", o->extent, "Grid extent XMIN,XMAX,YMIN,YMAX, or 'data' for the trajectory's own");
+    cmd->add_option("--extent", o->extent, extent_help);
     cmd->add_option("--decoding-templates", o->templates,
                     "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
@@ -333,33 +465,44 @@ void add_analyze(CLI::App& app) {
                 "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20, d-th 2,\n"
                 "decoding templates rate_maps; docs/analysis.md).");
     cmd->callback([o] {
-        std::optional<analysis::Extent> extent;
-        if (!o->extent.empty() && o->extent != "data") {
-            const auto parts = split(o->extent);
-            if (parts.size() != 4) throw InputError("--extent expects XMIN,XMAX,YMIN,YMAX or 'data'");
-            extent = analysis::Extent{parse_number(parts[0], "--extent: a bound"), parse_number(parts[1], "--extent: a bound"),
-                                      parse_number(parts[2], "--extent: a bound"), parse_number(parts[3], "--extent: a bound")};
-        }
+        const bool new_extent = !o->extent.empty();
+        const ExtentOption extent = parse_extent(new_extent ? o->extent : "data");
+        if (!o->cells.empty()) require_not_directory(o->cells, "--cells");
         std::vector<TrialFileData> trials;
-        for (const auto& f : o->files) trials.push_back(read_trial_samples(f));  // all readable before any output
+        std::vector<analysis::AnalysisParams> params;
+        for (const auto& f : o->files) {  // all readable and their parameters valid before any output
+            trials.push_back(read_trial_samples(f));
+            analysis::AnalysisParams p = stored_analysis_params(trials.back(), f);
+            const auto& table = analysis::AnalysisParams::table();
+            const auto set = [&](const char* key, const params::Value& v) {
+                try {
+                    table.set(p, *table.find(key), v);
+                } catch (const params::ParamError& e) {
+                    throw InputError("--" + std::string(key) + ": " + e.reason());
+                }
+            };
+            if (o->gridsize) set("gridsize", static_cast<long long>(*o->gridsize));
+            if (o->quantile) set("quantile", *o->quantile);
+            if (o->eps) set("eps", *o->eps);
+            if (o->min_samples) set("min_samples", static_cast<long long>(*o->min_samples));
+            if (o->d_th) set("d_th", *o->d_th);
+            if (!o->templates.empty()) p.decoding_templates = analysis::parse_decoding_templates(o->templates);
+            if (new_extent) {
+                p.extent.reset();
+                if (extent.kind == ExtentOption::Kind::bounds) p.extent = extent.bounds;
+                if (extent.kind == ExtentOption::Kind::arena) p.extent = arena_extent(trials.back(), f);
+            }
+            p.validate();
+            params.push_back(p);
+        }
         std::printf("%-40s", "trial");
         for (const auto& n : analysis::metric_names()) std::printf(" %15s", n.c_str());
         std::printf("\n");
         for (std::size_t i = 0; i < trials.size(); ++i) {
             const auto& d = trials[i];
-            analysis::AnalysisParams params = stored_analysis_params(d);
-            if (o->gridsize) params.gridsize = *o->gridsize;
-            if (o->quantile) params.quantile = *o->quantile;
-            if (o->eps) params.dbscan.eps = *o->eps;
-            if (o->min_samples) params.dbscan.min_samples = *o->min_samples;
-            if (o->d_th) params.d_th = *o->d_th;
-            if (!o->templates.empty()) params.decoding_templates = analysis::parse_decoding_templates(o->templates);
-            if (o->extent == "data") params.extent.reset();
-            if (extent) params.extent = extent;
-            params.validate();
             const Eigen::Map<const analysis::RowMatrixXf> rates(d.rates.data(), static_cast<Eigen::Index>(d.x.size()),
                                                                 static_cast<Eigen::Index>(d.n_place));
-            const auto m = analysis::analyze_trial<float>(d.x, d.y, rates, params);
+            const auto m = analysis::analyze_trial<float>(d.x, d.y, rates, params[i]);
             std::printf("%-40s", d.name.c_str());
             for (const auto& [name, v] : analysis::scalar_metrics(m)) std::printf(" %15.6g", v);
             std::printf("\n");
@@ -378,20 +521,39 @@ void add_analyze(CLI::App& app) {
 
 void add_summarize(CLI::App& app) {
     auto* cmd = app.add_subcommand("summarize", "Write trials.csv, summary.csv/.md and the figures for a folder of trial files");
-    auto dir = std::make_shared<std::string>();
-    auto no_report = std::make_shared<bool>(false);
-    cmd->add_option("folder", *dir, "Folder of trial files")->required();
-    cmd->add_flag("--no-report", *no_report, "Skip the figures");
-    cmd->callback([dir, no_report] {
-        std::vector<std::filesystem::path> files;
+    struct Options {
+        std::string dir;
+        bool no_report = false, skip_unreadable = false, allow_mixed = false;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("folder", o->dir, "Folder of trial files")->required();
+    cmd->add_flag("--no-report", o->no_report, "Skip the figures");
+    cmd->add_flag("--skip-unreadable", o->skip_unreadable,
+                  "Leave out .h5 files that are not readable trial files (each named on standard error) instead of stopping");
+    cmd->add_flag("--allow-mixed", o->allow_mixed,
+                  "Put trials of different protocols, durations or analysis parameters into one table");
+    cmd->callback([o] {
         std::error_code ec;
-        if (!std::filesystem::is_directory(*dir, ec)) throw InputError("'" + *dir + "' is not a folder");
-        for (const auto& e : std::filesystem::directory_iterator(*dir))
-            if (e.path().extension() == ".h5" && read_trial_stamp(e.path())) files.push_back(e.path());
-        if (files.empty()) throw InputError("'" + *dir + "' holds no complete trial files");
-        std::sort(files.begin(), files.end());
-        summarize(*dir, files, !*no_report);
-        std::printf("%zu trials summarized in %s/summary.md\n", files.size(), dir->c_str());
+        if (!std::filesystem::is_directory(o->dir, ec))
+            throw InputError("'" + o->dir + "' is not a folder" + (std::filesystem::exists(o->dir, ec) ? "" : " (it does not exist)"));
+        const OutputLock lock(folder_lock_path(o->dir), "output folder '" + o->dir + "'");
+        std::vector<std::filesystem::path> candidates, files;
+        for (const auto& e : std::filesystem::directory_iterator(o->dir))
+            if (e.path().extension() == ".h5") candidates.push_back(e.path());
+        std::sort(candidates.begin(), candidates.end());
+        for (const auto& f : candidates) {
+            try {
+                read_summary(f);
+                files.push_back(f);
+            } catch (const InputError& e) {
+                if (!o->skip_unreadable)
+                    throw InputError(std::string(e.what()) + " (remove it, or pass --skip-unreadable to leave it out)");
+                std::fprintf(stderr, "bvc3d: warning: skipping %s\n", printable(e.what()).c_str());
+            }
+        }
+        if (files.empty()) throw InputError("'" + o->dir + "' holds no readable trial files (*.h5)");
+        summarize(o->dir, files, !o->no_report, o->allow_mixed);
+        std::printf("%zu trials summarized in %s/summary.md\n", files.size(), o->dir.c_str());
     });
 }
 

@@ -51,6 +51,7 @@ void add_bvc(CLI::App& app) {
         "One line per (layer, direction): the largest rate, the preferred distance where it peaks, and the\n"
         "rates over preferred distance 0..max_dist as a bar (a full block is the step's maximum, 0.5).");
     cmd->callback([o] {
+        if (!o->csv.empty()) require_not_directory(o->csv, "--csv");
         const ModelSpec model = config::resolve_model(o->model);
         const World world(config::resolve_world(o->world, o->tilt, o->lean));
         const Pose pose = parse_pose(o->pose);

@@ -1,10 +1,14 @@
 // bvc3d scan / bvc3d walk: the simulator stage on its own.
+#include <cerrno>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <optional>
 
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/memory.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "cli_common.hpp"
 
@@ -33,6 +37,8 @@ void emit(const std::string& out, const std::string& header, WriteRows&& write_r
     if (out.empty() || out == "-") {
         std::cout << header << "\n";
         write_rows(std::cout);
+        std::cout.flush();
+        if (!std::cout) throw InputError(std::string("cannot write to standard output: ") + std::strerror(errno ? errno : EIO));
         return;
     }
     AtomicFile file(out);
@@ -58,6 +64,7 @@ void add_scan(CLI::App& app) {
         const World w = world->make();
         const Lidar lidar(config::resolve_sensor(*sensor));
         const Pose p = parse_pose(*pose);
+        if (!out->empty() && *out != "-") require_not_directory(*out, "--out");
         warn_if_blocked(w, p);
         const Scan scan = lidar.scan(w, p);
         emit(*out, "range,azimuth,elevation", [&](std::ostream& os) {
@@ -72,14 +79,23 @@ void add_walk(CLI::App& app) {
     auto hours = std::make_shared<double>(1.0);
     auto seed = std::make_shared<std::uint64_t>(0);
     auto out = std::make_shared<std::string>();
+    auto no_memory_check = std::make_shared<bool>(false);
     world->add_to(*cmd);
     cmd->add_option("--hours", *hours, "Simulated hours to walk")->capture_default_str()->check(non_negative_check);
-    cmd->add_option("--seed", *seed, "Random seed")->capture_default_str()->check(seed_check);
+    cmd->add_option("--seed", *seed, "Random seed, 0 .. 2^64 - 1")->capture_default_str()->check(seed_check);
     cmd->add_option("--out", *out, "CSV file to write (default: standard output)");
+    cmd->add_flag("--no-memory-check", *no_memory_check, no_memory_check_help);
     cmd->footer(
         "One row per model step: t in simulated seconds, position in meters, heading in radians,\n"
         "bumped = 1 when the step ended against an obstacle.");
     cmd->callback([=] {
+        if (*hours > max_agent_hours)
+            throw InputError("--hours " + num(*hours) + " is more than the limit of " + num(max_agent_hours) +
+                             " simulated hours");
+        if (!*no_memory_check)  // the steps are held in memory, one ModelStep each
+            check_memory(*hours * 3600.0 / RobotParams{}.model_dt * sizeof(ModelStep), "walk --hours " + num(*hours),
+                         "walk fewer hours, or pass --no-memory-check to try anyway");
+        if (!out->empty() && *out != "-") require_not_directory(*out, "--out");
         const World w = world->make();
         const auto steps = random_walk(w, *hours, *seed);
         emit(*out, "t,x,y,heading,bumped", [&](std::ostream& os) {

@@ -1,6 +1,7 @@
 // bvc3d sweep: a grid of conditions × seeds, on local threads or over MPI ranks (mpirun).
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -8,10 +9,13 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <sstream>
 
 #include "bvc3d/config/sweep_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/output_lock.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"
 #include "cli_common.hpp"
@@ -31,9 +35,11 @@ bool launched_by_mpi() {
 }
 
 void copy_sweep_file(const std::string& from, const std::filesystem::path& dir) {
-    std::ifstream in(from);
+    std::ifstream in(from, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
     AtomicFile out(dir / "sweep.yaml");
-    out.stream() << in.rdbuf();
+    out.write(text.str());
     out.commit();
 }
 
@@ -42,19 +48,19 @@ struct SweepOptions {
     std::optional<double> hours;
     int jobs = 0;
     double checkpoint_minutes = 0;
-    bool no_report = false, dry_run = false, verbose = false;
+    bool no_report = false, dry_run = false, verbose = false, no_memory_check = false;
 };
 
 // The sweep's trials with the command line's overrides, checked before anything runs (and before MPI starts).
 config::Sweep checked_sweep(const SweepOptions& o) {
     auto sweep = config::load_sweep_file(o.file);
     if (o.hours) {
-        if (!(*o.hours > 0)) throw InputError("--hours must be a positive number of hours");
+        if (!(*o.hours > 0) || !std::isfinite(*o.hours)) throw InputError("--hours must be a positive number of hours");
         for (auto& t : sweep.trials) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
     }
-    if (o.jobs < 0) throw InputError("--jobs must be >= 0");
+    check_jobs(o.jobs);
     if (o.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-    for (const auto& t : sweep.trials) t.world.resolve();
+    check_runnable(sweep.trials);
     return sweep;
 }
 
@@ -73,6 +79,7 @@ std::function<void(const std::string&)> trial_printer(bool verbose, const int& r
 // Under mpirun: rank 0 deals groups of trials to the ranks. Returns false on ranks other than 0.
 bool run_over_mpi(const config::Sweep& sweep, const SweepOptions& o, const std::filesystem::path& out,
                   ExperimentOutcome& outcome) {
+    check_run_memory(sweep.trials, o.jobs == 0 ? 1 : o.jobs, o.no_memory_check);  // per rank
     int provided = 0;
     MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
     if (provided < MPI_THREAD_SERIALIZED) {
@@ -87,10 +94,14 @@ bool run_over_mpi(const config::Sweep& sweep, const SweepOptions& o, const std::
     opts.jobs = o.jobs == 0 ? 1 : o.jobs;
     opts.checkpoint_minutes = o.checkpoint_minutes;
     opts.stop = &stop_flag();
-    opts.progress = ::isatty(STDERR_FILENO);
+    opts.progress = progress_style();
     opts.on_trial_done = trial_printer(o.verbose, rank);
-    if (coord.is_root()) copy_sweep_file(o.file, out);
+    std::optional<OutputLock> lock;
     try {
+        if (coord.is_root()) {
+            lock.emplace(folder_lock_path(out), "output folder '" + out.string() + "'");
+            copy_sweep_file(o.file, out);
+        }
         outcome = run_experiment(sweep.trials, opts, &coord);
     } catch (const Interrupted&) {
         MPI_Finalize();
@@ -112,11 +123,12 @@ void add_sweep_command(CLI::App& app) {
     cmd->add_option("sweep", o->file, "Sweep YAML file (docs/sweeps.md)")->required();
     cmd->add_option("--out", o->out, "Output folder (default results/<sweep name>)");
     cmd->add_option("--hours", o->hours, "Shorten both phases of every trial to H simulated hours");
-    cmd->add_option("--jobs", o->jobs, "Threads (per rank under MPI; default: every core, or 1 per rank under MPI)");
+    cmd->add_option("--jobs", o->jobs, "Threads (per rank under MPI); 0 (the default): one per core, or 1 per rank under MPI");
     cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes, "Checkpoint running trials every M simulated minutes");
     cmd->add_flag("--no-report", o->no_report, "Skip the figures");
     cmd->add_flag("--dry-run", o->dry_run, "List the trials and exit");
     cmd->add_flag("--verbose", o->verbose, "Print a line for every finished trial (with its MPI rank)");
+    cmd->add_flag("--no-memory-check", o->no_memory_check, no_memory_check_help);
     cmd->footer(
         "Under `mpirun -np N bvc3d sweep FILE`, rank 0 deals trials to the ranks as they become free; the output\n"
         "folder must be shared by all ranks. Completed trials are skipped on a rerun. See docs/cluster.md.");
@@ -134,6 +146,10 @@ void add_sweep_command(CLI::App& app) {
 #ifdef BVC3D_HAVE_MPI
         if (launched_by_mpi()) {
             if (!run_over_mpi(sweep, *o, out, outcome)) return;
+            print_outcome(sweep.trials.size(), out, outcome);  // rank 0; the ranks have finished
+            summarize(out, outcome.files, !o->no_report);
+            std::printf("summary: %s/summary.md\n", out.c_str());
+            return;
         } else
 #else
         if (launched_by_mpi())
@@ -141,13 +157,16 @@ void add_sweep_command(CLI::App& app) {
                              "rebuild with MPI (libopenmpi-dev) or run `bvc3d sweep` without mpirun");
 #endif
         {
+            const OutputLock lock(folder_lock_path(out), "output folder '" + out.string() + "'");
             copy_sweep_file(o->file, out);
             static const int rank = 0;
-            outcome = run_local_experiment(sweep.trials, out, o->jobs, o->checkpoint_minutes, trial_printer(o->verbose, rank));
+            outcome = run_local_experiment(sweep.trials, out,
+                                           LocalRun{o->jobs, o->checkpoint_minutes, o->no_memory_check,
+                                                    trial_printer(o->verbose, rank)});
+            print_outcome(sweep.trials.size(), out, outcome);
+            summarize(out, outcome.files, !o->no_report);
+            std::printf("summary: %s/summary.md\n", out.c_str());
         }
-        print_outcome(sweep.trials.size(), out, outcome);
-        summarize(out, outcome.files, !o->no_report);
-        std::printf("summary: %s/summary.md\n", out.c_str());
     });
 }
 

@@ -86,11 +86,10 @@ void bind_sample_functions(pyb::module_& a) {
             const auto v = matrix<T>(values, "values");
             an::HexBins bins;
             an::RowMatrixXd means;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 bins = an::hexbin(xs, ys, gridsize, extent_of(extent));
                 means = an::bin_means<T>(bins, v);
-            }
+            });
             return pyb::make_tuple(numpy_of(bins.centers), numpy_of(means), numpy_of(bins.counts));
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("values"), pyb::arg("gridsize"), pyb::arg("extent"));
@@ -101,10 +100,9 @@ void bind_sample_functions(pyb::module_& a) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
             an::RateMaps m;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 m = an::rate_maps<T>(xs, ys, r, {gridsize, quantile, extent_of(extent)});
-            }
+            });
             return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean), numpy_of(m.bins.counts));
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
@@ -117,10 +115,9 @@ void bind_sample_functions(pyb::module_& a) {
             const auto r = matrix<T>(rates, "rates");
             const an::DecodingParams params{gridsize, quantile, extent_of(extent), an::parse_decoding_templates(templates)};
             an::DecodingResult d;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 d = an::decoding_error<T>(xs, ys, r, params);
-            }
+            });
             return decoding_dict(d);
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("extent"),
@@ -132,10 +129,9 @@ void bind_sample_functions(pyb::module_& a) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
             an::CellStats s;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 s = an::cell_stats(an::rate_maps<T>(xs, ys, r, {gridsize, quantile, extent_of(extent)}));
-            }
+            });
             return stats_dict(s);
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
@@ -149,10 +145,9 @@ void bind_sample_functions(pyb::module_& a) {
             const an::AnalysisParams params{gridsize, quantile, {eps, min_samples}, d_th, extent_of(extent),
                                             an::parse_decoding_templates(decoding_templates)};
             an::TrialMetrics m;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 m = an::analyze_trial<T>(xs, ys, r, params);
-            }
+            });
             pyb::dict d;
             d["centers"] = numpy_of(m.maps.bins.centers);
             d["counts"] = numpy_of(m.maps.bins.counts);
@@ -183,8 +178,7 @@ void bind_analysis(pyb::module_& m) {
         "dbscan_cluster_count",
         [](const ArrayD& points, double eps, int min_samples) {
             const auto p = centers_of(points);
-            pyb::gil_scoped_release release;
-            return an::dbscan_cluster_count(p, {eps, min_samples});
+            return interruptible([&](const std::atomic<bool>&) { return an::dbscan_cluster_count(p, {eps, min_samples}); });
         },
         pyb::arg("points"), pyb::arg("eps"), pyb::arg("min_samples"));
     a.def(
@@ -192,10 +186,9 @@ void bind_analysis(pyb::module_& m) {
         [](const ArrayD& points, double eps) {
             const auto p = centers_of(points);
             an::Neighborhoods nb;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 nb = an::sklearn_radius_neighbors(p, eps);
-            }
+            });
             return pyb::make_tuple(numpy_of(nb.offsets), numpy_of(nb.indices));
         },
         pyb::arg("points"), pyb::arg("eps"));
@@ -205,10 +198,9 @@ void bind_analysis(pyb::module_& m) {
             const auto c = centers_of(centers);
             const auto mp = matrix<double>(maps, "maps");
             std::vector<int> mi;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 mi = an::modality(c, mp, {eps, min_samples});
-            }
+            });
             return numpy_of(mi);
         },
         pyb::arg("centers"), pyb::arg("maps"), pyb::arg("eps"), pyb::arg("min_samples"));
@@ -232,10 +224,9 @@ void bind_analysis(pyb::module_& m) {
             const auto c = centers_of(centers);
             const auto mp = matrix<double>(maps, "maps");
             an::AliasingResult r;
-            {
-                pyb::gil_scoped_release release;
+            interruptible([&](const std::atomic<bool>&) {
                 r = an::spatial_aliasing(c, mp, d_th);
-            }
+            });
             return pyb::make_tuple(to_numpy(r.sai.data(), {r.sai.size()}), r.msai);
         },
         pyb::arg("centers"), pyb::arg("maps"), pyb::arg("d_th"));

@@ -19,7 +19,9 @@ std::shared_ptr<const AgentSpec> trajectory_of(const pyb::object& obj) {
     const auto d = obj.cast<pyb::dict>();
     auto column = [&](const char* key) {
         if (!d.contains(key)) return std::vector<double>{};
-        return pyb::cast<std::vector<double>>(pyb::module_::import("numpy").attr("asarray")(d[key], "float64").attr("ravel")());
+        const auto a = real_array(d[key], std::string("trajectory['") + key + "']");
+        if (a.ndim() > 1) throw InputError(std::string("trajectory['") + key + "'] must be 1-D");
+        return std::vector<double>(a.data(), a.data() + a.size());
     };
     for (const char* key : {"t", "x", "y", "heading"})
         if (!d.contains(key)) throw InputError(std::string("trajectory: the dict lacks '") + key + "'");
@@ -29,11 +31,11 @@ std::shared_ptr<const AgentSpec> trajectory_of(const pyb::object& obj) {
 }
 
 TrialConfig trial_of(const std::string& model, const std::string& world, std::optional<double> tilt_deg,
-                     std::uint64_t seed, const pyb::kwargs& kwargs) {
+                     const pyb::object& seed, const pyb::kwargs& kwargs) {
     TrialConfig t;
     t.model = config::resolve_model(model);
     t.world = WorldSpec{world, tilt_deg, t.world.lean};
-    t.seed = seed;
+    t.seed = seed_of(seed, "seed");
     if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) t.agent = trajectory_of(kwargs["trajectory"]);
     apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol"});
     if (kwargs.contains("protocol")) t.protocol.kind = parse_protocol(pyb::str(kwargs["protocol"]));  // = kind
@@ -66,14 +68,14 @@ pyb::dict outcome_to_dict(const TrialConfig& t, const GroupOutcome& done) {
 void bind_experiment(pyb::module_& m) {
     m.def(
         "run_trial",
-        [](const std::string& model, const std::string& world, std::optional<double> tilt_deg, std::uint64_t seed,
+        [](const std::string& model, const std::string& world, std::optional<double> tilt_deg, const pyb::object& seed,
            const pyb::kwargs& kwargs) {
             const TrialConfig t = trial_of(model, world, tilt_deg, seed, kwargs);
-            GroupOutcome done;
-            {
-                pyb::gil_scoped_release release;
-                done = run_and_analyze({t});
-            }
+            const GroupOutcome done = interruptible([&](const std::atomic<bool>& stop) {
+                RunControl control;
+                control.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
+                return run_and_analyze({t}, control);
+            });
             return outcome_to_dict(t, done);
         },
         pyb::arg("model") = TrialConfig{}.model.name, pyb::arg("world") = WorldSpec{}.source,

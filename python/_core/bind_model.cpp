@@ -16,7 +16,8 @@ std::span<const LidarReturn> returns_view(const ArrayD& a) {
     return {reinterpret_cast<const LidarReturn*>(a.data()), static_cast<std::size_t>(a.shape(0))};
 }
 
-pyb::array_t<double> compute(const BoundaryVectorLayer& layer, const ArrayD& returns, bool normalized) {
+pyb::array_t<double> compute(const BoundaryVectorLayer& layer, const pyb::handle& obj, bool normalized) {
+    const ArrayD returns = real_array(obj, "returns");
     const auto view = returns_view(returns);
     std::vector<double> out(layer.n_cells());
     {
@@ -60,9 +61,9 @@ Keyword arguments and their defaults (the `3d-0.2` model's layer):
         .def_static(
             "preset", [](const std::string& name) { return BoundaryVectorLayer(config::resolve_model(name).bvc); },
             pyb::arg("name"), "The BVC layer of a model preset (2d, 3d-0.1, 3d-0.2, 3d-3l, 2d-8beam) or model YAML")
-        .def("rates", [](const BoundaryVectorLayer& l, const ArrayD& r) { return compute(l, r, true); },
+        .def("rates", [](const BoundaryVectorLayer& l, const pyb::object& r) { return compute(l, r, true); },
              pyb::arg("returns"), "Normalized rates (n_cells,) for an (N, 3) array of returns")
-        .def("raw", [](const BoundaryVectorLayer& l, const ArrayD& r) { return compute(l, r, false); },
+        .def("raw", [](const BoundaryVectorLayer& l, const pyb::object& r) { return compute(l, r, false); },
              pyb::arg("returns"), "Unnormalized sums (n_cells,)")
         .def_property_readonly("n_cells", &BoundaryVectorLayer::n_cells)
         .def_property_readonly("preferred", &preferred, "dict of arrays: each cell's preferred elevation, azimuth and distance");
@@ -76,15 +77,16 @@ void bind_network(pyb::module_& m) {
 Place cells driven by BVCs, with Oja learning (docs/model-reference.md#place-cell-network).
 PlaceCellNetwork(n_bvc, seed=0, **params); params and their defaults:
 )doc" + describe(PlaceParams::table(), PlaceParams{})).c_str());
-    cls.def(pyb::init([](int n_bvc, std::uint64_t seed, const pyb::kwargs& kwargs) {
+    cls.def(pyb::init([](int n_bvc, const pyb::object& seed, const pyb::kwargs& kwargs) {
                 PlaceParams p;
                 apply_kwargs(p, PlaceParams::table(), kwargs);
-                return PlaceCellNetwork(n_bvc, p, seed);
+                return PlaceCellNetwork(n_bvc, p, seed_of(seed, "seed"));
             }),
             pyb::arg("n_bvc"), pyb::arg("seed") = 0)
         .def(
             "step",
-            [](PlaceCellNetwork& net, const ArrayD& bvc_rates, bool learn) {
+            [](PlaceCellNetwork& net, const pyb::object& obj, bool learn) {
+                const ArrayD bvc_rates = real_array(obj, "bvc_rates");
                 if (bvc_rates.ndim() != 1) throw InputError("bvc_rates must be a 1-D array");
                 const std::span<const double> in(bvc_rates.data(), static_cast<std::size_t>(bvc_rates.shape(0)));
                 const auto out = net.step(in, learn);
@@ -97,7 +99,8 @@ PlaceCellNetwork(n_bvc, seed=0, **params); params and their defaults:
                 const auto w = net.weights();
                 return to_numpy(w.data(), {net.n_place(), net.n_bvc()});
             },
-            [](PlaceCellNetwork& net, const pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast>& w) {
+            [](PlaceCellNetwork& net, const pyb::object& obj) {
+                const auto w = real_array_f32(obj, "weights");
                 if (w.ndim() != 2 || w.shape(0) != net.n_place() || w.shape(1) != net.n_bvc())
                     throw InputError("weights must have shape (" + std::to_string(net.n_place()) + ", " +
                                      std::to_string(net.n_bvc()) + ")");

@@ -109,13 +109,14 @@ void bind_world(pyb::module_& m) {
                                "(K, 2) polygon the robot's body stays inside")
         .def(
             "scan",
-            [](const World& w, const pyb::object& sensor, double x, double y, double heading, std::uint64_t noise_seed,
-               std::uint64_t scan_index, double z, double pitch, double roll) {
+            [](const World& w, const pyb::object& sensor, double x, double y, double heading, const pyb::object& noise_seed,
+               const pyb::object& scan_index, double z, double pitch, double roll) {
                 const Lidar lidar(sensor_of(sensor));
+                const NoiseKey key{seed_of(noise_seed, "noise_seed"), seed_of(scan_index, "scan_index")};
                 Scan s;
                 {
                     pyb::gil_scoped_release release;
-                    lidar.scan(w, Pose{x, y, z, heading, pitch, roll}, s, NoiseKey{noise_seed, scan_index});
+                    lidar.scan(w, Pose{x, y, z, heading, pitch, roll}, s, key);
                 }
                 return scan_to_numpy(s);
             },
@@ -134,14 +135,11 @@ void bind_simulator(pyb::module_& m) {
     bind_world(m);
     m.def(
         "random_walk",
-        [](const World& w, double hours, std::uint64_t seed, const pyb::kwargs& kwargs) {
+        [](const World& w, double hours, const pyb::object& seed, const pyb::kwargs& kwargs) {
+            const std::uint64_t s = seed_of(seed, "seed");
             RobotParams robot;
             apply_kwargs(robot, RobotParams::table(), kwargs);
-            std::vector<ModelStep> steps;
-            {
-                pyb::gil_scoped_release release;
-                steps = random_walk(w, hours, seed, robot);
-            }
+            const auto steps = interruptible([&](const std::atomic<bool>&) { return random_walk(w, hours, s, robot); });
             return steps_to_dict(steps);
         },
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),

@@ -7,10 +7,19 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cstring>
+#include <exception>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
+#include <type_traits>
 #include <vector>
 
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/params.hpp"
 
@@ -27,6 +36,62 @@ pyb::array_t<T> to_numpy(const T* data, std::vector<pyb::ssize_t> shape) {
     for (auto s : shape) n *= static_cast<std::size_t>(s);
     if (n) std::memcpy(a.mutable_data(), data, n * sizeof(T));
     return a;
+}
+
+// An array of real numbers as float64, C order. Integers and floats convert; complex, object, text
+// and boolean arrays are refused (a cast would drop imaginary parts or invent numbers).
+ArrayD real_array(const pyb::handle& obj, const std::string& name);
+// The same as float32 (the dtype of weights and rates), with the same refusals.
+pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(const pyb::handle& obj, const std::string& name);
+
+// A seed: a Python integer 0 .. 2^64 - 1 (InputError naming `name` otherwise; no bools, no floats).
+std::uint64_t seed_of(const pyb::handle& obj, const std::string& name);
+
+// Runs `work(stop)` on a worker thread with the GIL released, and wakes every 100 ms to let Python
+// run its signal handlers: Ctrl-C (KeyboardInterrupt) sets `stop` — which the work's loops poll,
+// directly or through poll_cancel() — waits for the work to end (a fraction of a second) and
+// raises the KeyboardInterrupt. Exceptions of the work are rethrown in the caller.
+template <class F>
+auto interruptible(F&& work) {
+    using R = std::invoke_result_t<F&, const std::atomic<bool>&>;
+    std::atomic<bool> stop{false};
+    std::mutex m;
+    std::condition_variable cv;
+    bool done = false;
+    std::exception_ptr error;
+    std::conditional_t<std::is_void_v<R>, bool, std::optional<R>> result{};
+    bool interrupted = false;
+    {
+        pyb::gil_scoped_release release;
+        std::thread worker([&] {
+            try {
+                const CancelScope scope(&stop);
+                if constexpr (std::is_void_v<R>) work(stop);
+                else result.emplace(work(stop));
+            } catch (...) {
+                error = std::current_exception();
+            }
+            std::lock_guard lock(m);
+            done = true;
+            cv.notify_one();
+        });
+        std::unique_lock lock(m);
+        while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
+            if (interrupted) continue;
+            lock.unlock();
+            {
+                pyb::gil_scoped_acquire gil;
+                if (PyErr_CheckSignals() != 0) interrupted = true;  // the exception stays set
+            }
+            if (interrupted) stop = true;
+            lock.lock();
+        }
+        lock.unlock();
+        worker.join();
+    }
+    if (interrupted) throw pyb::error_already_set();
+    if (error) std::rethrow_exception(error);
+    if constexpr (!std::is_void_v<R>) return std::move(*result);
 }
 
 // A Python value as a table field's value (InputError naming the key if it has the wrong type).

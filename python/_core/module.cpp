@@ -2,6 +2,8 @@
 // calls the C++ API; everything user-facing is re-exported by bvc3d/__init__.py.
 #include "bindings.hpp"
 
+#include <limits>
+
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::py {
@@ -14,6 +16,11 @@ params::Value to_value(const pyb::handle& obj, params::Kind kind, const std::str
             if (pyb::isinstance<pyb::bool_>(obj) || !(pyb::isinstance<pyb::float_>(obj) || pyb::isinstance<pyb::int_>(obj) ||
                                                       pyb::hasattr(obj, "__float__")))
                 throw wrong("a number");
+            // numpy scalars: real kinds only (a complex one would lose its imaginary part).
+            if (PyComplex_Check(obj.ptr()) ||
+                (pyb::hasattr(obj, "dtype") && std::string("iuf").find(pyb::str(obj.attr("dtype").attr("kind")).cast<std::string>()) ==
+                                                   std::string::npos))
+                throw wrong("a real number");
             return obj.cast<double>();
         case Kind::integer: {
             if (pyb::isinstance<pyb::bool_>(obj) || !pyb::hasattr(obj, "__index__")) throw wrong("an integer");
@@ -30,13 +37,45 @@ params::Value to_value(const pyb::handle& obj, params::Kind kind, const std::str
             if (obj.is_none()) return std::vector<double>{};
             if (pyb::isinstance<pyb::str>(obj)) throw wrong("a list of numbers");
             try {
-                return obj.cast<std::vector<double>>();
-            } catch (const pyb::cast_error&) {
+                const auto a = real_array(obj, "'" + key + "'");
+                if (a.ndim() > 1) throw wrong("a list of numbers (1-D)");
+                return std::vector<double>(a.data(), a.data() + a.size());
+            } catch (const pyb::error_already_set&) {
                 throw wrong("a list of numbers");
             }
         }
     }
     throw wrong("a supported value");
+}
+
+namespace {
+template <class T>
+pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast> real_array_as(const pyb::handle& obj, const std::string& name) {
+    pyb::array a;
+    try {
+        a = pyb::array::ensure(obj);
+    } catch (const pyb::error_already_set&) {
+    }
+    if (!a) throw InputError(name + " must be an array of numbers");
+    const char kind = a.dtype().kind();
+    if (kind != 'i' && kind != 'u' && kind != 'f')
+        throw InputError(name + " must hold real numbers, got dtype " + pyb::str(a.dtype()).cast<std::string>());
+    return pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast>::ensure(a);
+}
+}  // namespace
+
+ArrayD real_array(const pyb::handle& obj, const std::string& name) { return real_array_as<double>(obj, name); }
+pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(const pyb::handle& obj, const std::string& name) {
+    return real_array_as<float>(obj, name);
+}
+
+std::uint64_t seed_of(const pyb::handle& obj, const std::string& name) {
+    const std::string range = " must be a whole number from 0 to 18446744073709551615 (2**64 - 1)";
+    if (pyb::isinstance<pyb::bool_>(obj) || !pyb::hasattr(obj, "__index__")) throw InputError(name + range);
+    const pyb::int_ value(pyb::reinterpret_borrow<pyb::object>(obj).attr("__index__")());
+    if (value < pyb::int_(0) || value > pyb::int_(std::numeric_limits<std::uint64_t>::max()))
+        throw InputError(name + range + ", got " + std::string(pyb::repr(value)));
+    return value.cast<std::uint64_t>();
 }
 
 pyb::object from_value(const params::Value& v) {
@@ -48,7 +87,21 @@ pyb::object from_value(const params::Value& v) {
 PYBIND11_MODULE(_core, m) {
     m.doc() = "bvc3d compiled core (use the `bvc3d` package)";
     m.attr("__version__") = BVC3D_VERSION;  // the project's version, from CMakeLists.txt
-    pybind11::register_exception<bvc3d::InputError>(m, "InputError", PyExc_ValueError);
+    static auto& input_error = pybind11::register_exception<bvc3d::InputError>(m, "InputError", PyExc_ValueError);
+    // Messages may quote bytes of a file that are not UTF-8 (a Latin-1 or binary YAML): decode them
+    // leniently, so that the message always arrives (pybind's own translation would lose it).
+    pybind11::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const bvc3d::InputError& e) {
+            const char* what = e.what();
+            PyObject* text = PyUnicode_DecodeUTF8(what, static_cast<Py_ssize_t>(std::strlen(what)), "backslashreplace");
+            PyErr_SetObject(input_error.ptr(), text);
+            Py_XDECREF(text);
+        } catch (const bvc3d::Interrupted&) {
+            PyErr_SetNone(PyExc_KeyboardInterrupt);
+        }
+    });
     bvc3d::py::bind_simulator(m);
     bvc3d::py::bind_model(m);
     bvc3d::py::bind_experiment(m);

@@ -11,7 +11,8 @@ Conventions (docs/analysis.md has the details):
 * The modality index is scikit-learn 1.2.1's ``DBSCAN(eps, min_samples).fit(points)`` cluster
   count, reproduced down to points at exactly ``eps``.
 * Every function raises ValueError on bad input (mismatched lengths, non-finite coordinates or
-  values, gridsize < 2, quantile outside [0, 1], eps <= 0, ...).
+  values, gridsize < 2, quantile outside [0, 1], eps <= 0, complex, boolean or object arrays, ...).
+* Ctrl-C interrupts a long call within a fraction of a second (KeyboardInterrupt).
 """
 import numbers
 
@@ -32,9 +33,19 @@ __all__ = [
 ]
 
 
+def _real(values, name):
+    """values as a numpy array of real numbers: integer or floating dtypes only. Complex, boolean,
+    object and text arrays are refused, not cast (a cast would drop imaginary parts or invent
+    numbers)."""
+    a = np.asarray(values)
+    if a.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must hold real numbers (integer or floating point), got dtype {a.dtype}")
+    return a
+
+
 def _positions(x, y):
-    x = np.ascontiguousarray(x, dtype=np.float64)
-    y = np.ascontiguousarray(y, dtype=np.float64)
+    x = np.ascontiguousarray(_real(x, "x"), dtype=np.float64)
+    y = np.ascontiguousarray(_real(y, "y"), dtype=np.float64)
     if x.ndim != 1 or y.ndim != 1:
         raise ValueError(f"x and y must be 1-D arrays, got shapes {x.shape} and {y.shape}")
     if x.shape != y.shape:
@@ -44,7 +55,7 @@ def _positions(x, y):
 
 def _samples(values, n, name):
     """(n,) or (n, C) float32/float64 C-contiguous; returns (array 2-D, was_1d)."""
-    v = np.asarray(values)
+    v = _real(values, name)
     v = np.ascontiguousarray(v, dtype=np.float32 if v.dtype == np.float32 else np.float64)
     if v.ndim not in (1, 2):
         raise ValueError(f"{name} must be (n,) or (n, n_cells), got shape {v.shape}")
@@ -64,21 +75,28 @@ def _gridsize(gridsize):
 def _extent(extent):
     if extent is None:
         return None
-    e = np.asarray(extent, dtype=np.float64).ravel()
+    e = np.asarray(_real(extent, "extent"), dtype=np.float64).ravel()
     if e.shape != (4,):
         raise ValueError(f"extent must be (xmin, xmax, ymin, ymax), got {extent!r}")
     return tuple(float(v) for v in e)
 
 
+def _number(v, name):
+    """A real scalar (int or float, numpy's too); complex, bool and text are refused."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (numbers.Real, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a real number, got {v!r}")
+    return float(v)
+
+
 def _quantile(q):
-    q = float(q)
+    q = _number(q, "quantile")
     if not 0.0 <= q <= 1.0:
         raise ValueError(f"quantile must lie in [0, 1], got {q}")
     return q
 
 
 def _dbscan_params(eps, min_samples):
-    eps = float(eps)
+    eps = _number(eps, "eps")
     if not eps > 0 or not np.isfinite(eps):
         raise ValueError(f"eps must be a positive number, got {eps}")
     if isinstance(min_samples, bool) or not isinstance(min_samples, numbers.Integral) or min_samples < 1:
@@ -87,7 +105,7 @@ def _dbscan_params(eps, min_samples):
 
 
 def _d_th(d_th):
-    d_th = float(d_th)
+    d_th = _number(d_th, "d_th")
     if not d_th >= 0 or not np.isfinite(d_th):
         raise ValueError(f"d_th must be a finite distance >= 0, got {d_th}")
     return d_th
@@ -103,10 +121,10 @@ def _templates(templates, name="templates"):
 
 
 def _centers_maps(centers, maps):
-    c = np.ascontiguousarray(centers, dtype=np.float64)
+    c = np.ascontiguousarray(_real(centers, "centers"), dtype=np.float64)
     if c.ndim != 2 or c.shape[1] not in (2, 3):
         raise ValueError(f"centers must be an (N, 2) or (N, 3) array, got shape {c.shape}")
-    m = np.ascontiguousarray(maps, dtype=np.float64)
+    m = np.ascontiguousarray(_real(maps, "maps"), dtype=np.float64)
     was_1d = m.ndim == 1
     if was_1d:
         m = m.reshape(-1, 1)
@@ -153,7 +171,7 @@ def dbscan_cluster_count(points, eps=1.0, min_samples=20):
     """Number of clusters ``sklearn.cluster.DBSCAN(eps, min_samples).fit(points)`` finds
     (labels >= 0), for (N, 2) or (N, 3) points; identical to scikit-learn 1.2.1 for any input,
     including points at exactly ``eps`` from each other. 0 for no points."""
-    p = np.ascontiguousarray(points, dtype=np.float64)
+    p = np.ascontiguousarray(_real(points, "points"), dtype=np.float64)
     if p.ndim != 2 or p.shape[1] not in (2, 3):
         raise ValueError(f"points must be an (N, 2) or (N, 3) array, got shape {p.shape}")
     eps, min_samples = _dbscan_params(eps, min_samples)

@@ -246,8 +246,16 @@ def bars_figure(folder, metric):
 
 
 def save(fig, out):
-    fig.savefig(out, dpi=DPI)
-    plt.close(fig)
+    """Writes a figure; a failed write names its file (Pillow removes what it wrote and raises an
+    OSError without a file name)."""
+    try:
+        fig.savefig(out, dpi=DPI)
+    except OSError as e:
+        if e.errno is None or e.filename:
+            raise
+        raise OSError(e.errno, e.strerror, str(out)) from e
+    finally:
+        plt.close(fig)
 
 
 def fig_bars(folder, metric, out):

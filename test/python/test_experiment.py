@@ -176,8 +176,8 @@ def test_single_trial_checkpoint_resume_is_identical(tmp_path):
     (["paper", "--tilts", "0,abc"], "'abc' is not a finite number"),
     (["paper", "--tilts", "75"], "pass through the outer walls"),
     (["run", "--world", "atlantis"], "neither a preset"),
-    (["run", "--sample-hours", "0"], "sample_hours must be > 0"),
-    (["run", "--explore-hours", "-2"], "explore_hours must be >= 0"),
+    (["run", "--sample-hours", "0"], "sample_hours must be in (0, 10000]"),
+    (["run", "--explore-hours", "-2"], "explore_hours must be in [0, 10000]"),
     (["run", "--protocol", "forever"], "protocol 'forever'"),
     (["analyze", "/nonexistent.h5"], "does not exist"),
 ])

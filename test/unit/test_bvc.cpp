@@ -1,6 +1,7 @@
 // Boundary vector cells (docs/model-reference.md#boundary-vector-cells) against the literal equations.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -119,6 +120,35 @@ TEST(BoundaryVectorLayer, PrunedScanningGivesTheSameRates) {
                 EXPECT_NEAR(a[i], ref[i], 0.5e-6);
                 EXPECT_NEAR(b[i], ref[i], 0.5e-6);
             }
+        }
+    }
+}
+
+// The azimuth memo and the one-call kernel are for speed only: a layer that has seen a walk's scans
+// (its memo filled, switched off and on) gives each scan exactly the bits a fresh layer gives.
+TEST(BoundaryVectorLayer, RatesDoNotDependOnWhatTheLayerSawBefore) {
+    const World world = World::cross({.tilt_deg = 30});
+    const auto walk = random_walk(world, 0.02, 5);
+    for (const char* name : {"2d", "3d-3l"}) {
+        const ModelSpec m = model_preset(name);
+        const BoundaryVectorLayer used(m.bvc);
+        const Lidar lidar(m.sensor);
+        const auto plan = used.plan(m.sensor);
+        std::vector<double> a(used.n_cells()), b(used.n_cells());
+        Scan scan, shuffled;
+        std::mt19937_64 gen(1);
+        for (std::size_t i = 0; i < walk.size(); i += 3) {
+            lidar.scan(world, walk[i].pose, scan, {}, plan.rows);
+            ASSERT_TRUE(used.rates_pruned(scan, plan, a));
+            const BoundaryVectorLayer fresh(m.bvc);
+            ASSERT_TRUE(fresh.rates_pruned(scan, plan, b));
+            ASSERT_EQ(a, b) << name << " step " << i;
+            // Irregular returns (a shuffled scan repeats no azimuth from one return to the next).
+            shuffled = scan;
+            std::shuffle(shuffled.begin(), shuffled.end(), gen);
+            used.rates(shuffled, a);
+            fresh.rates(shuffled, b);
+            ASSERT_EQ(a, b) << name << " step " << i << ", shuffled";
         }
     }
 }

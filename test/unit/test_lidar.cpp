@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
@@ -20,6 +22,29 @@ World box_world() {
     return World(w);
 }
 }  // namespace
+
+// wrap_pi takes a shortcut for angles one turn out; it must give the bits std::remainder gives.
+TEST(Angles, WrapPiOneTurnOutIsExactlyTheRemainder) {
+    auto by_remainder = [](double a) {
+        const double w = std::remainder(a, two_pi);
+        return w <= -pi ? w + two_pi : w;
+    };
+    std::vector<double> angles;
+    for (double edge : {pi, -pi, 3 * pi, -3 * pi, 2 * pi, -2 * pi})
+        for (double a = edge, up = edge, k = 0; k < 4; ++k) {
+            angles.push_back(a = std::nextafter(a, -INFINITY));
+            angles.push_back(up = std::nextafter(up, INFINITY));
+            angles.push_back(edge);
+        }
+    std::mt19937_64 gen(3);
+    std::uniform_real_distribution<double> u(-4 * pi, 4 * pi);
+    for (int i = 0; i < 200000; ++i) angles.push_back(u(gen));
+    for (double a : angles) {
+        if (a > -pi && a <= pi) continue;
+        const double fast = wrap_pi(a), slow = by_remainder(a);
+        ASSERT_EQ(std::memcmp(&fast, &slow, sizeof fast), 0) << std::hexfloat << a << ": " << fast << " vs " << slow;
+    }
+}
 
 TEST(BeamLayout, HorizontalScanner) {
     const auto s = LidarSpec::horizontal();

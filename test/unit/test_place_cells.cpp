@@ -117,6 +117,78 @@ TEST(PlaceCellNetwork, SameInputsSameSeedBitIdentical) {
     EXPECT_EQ(a.weights(), b.weights());
 }
 
+// The drive W·v_b is summed in a fixed order (8 running lanes, column blocks in order, a fixed
+// reduction tree) however many rows the kernel takes at once: checked bit for bit against that
+// order written out in scalar code, for row counts that leave every remainder of the row blocking.
+TEST(PlaceCellNetwork, DriveIsTheFixedOrderSumBitForBit) {
+    for (int n_place : {1, 3, 4, 7, 250}) {
+        PlaceParams p;
+        p.n_place = n_place;
+        p.gamma_pb = 0.0;  // s = k·drive exactly: the first step from rest, no inhibition
+        const int n_bvc = 37;
+        PlaceCellNetwork net(n_bvc, p, 4);
+        std::mt19937_64 gen(n_place);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        std::vector<float> w(static_cast<std::size_t>(n_place) * n_bvc);
+        for (auto& x : w) x = u(gen);
+        net.set_weights(w);
+        std::vector<double> vb(n_bvc);
+        for (auto& x : vb) x = static_cast<float>(u(gen) * 0.5f);
+        net.step(vb, false);
+        const float k = static_cast<float>(p.dt_over_tau);
+        for (int i = 0; i < n_place; ++i) {
+            float lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+            for (int j = 0; j < n_bvc; ++j)
+                lane[j % 8] += w[static_cast<std::size_t>(i) * n_bvc + j] * static_cast<float>(vb[j]);
+            const float drive = ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
+            const float s = 0.0f + k * (-0.0f + drive - 0.0f);
+            ASSERT_EQ(net.membrane()[i], s) << n_place << " cells, row " << i;
+        }
+    }
+}
+
+// Rates and weights below the smallest normal float in magnitude are taken as 0 (no subnormal number
+// enters the arithmetic): a network fed such rates behaves bit for bit like one fed zeros there, and
+// no weight is ever subnormal, even when Oja's rule is fed Gaussian tails down to 1e-300.
+TEST(PlaceCellNetwork, SubnormalOperandsAreZeros) {
+    PlaceCellNetwork tiny(960, PlaceParams{}, 8), zero(960, PlaceParams{}, 8);
+    std::vector<double> vb(960), vz(960);
+    std::mt19937_64 gen(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    int active = 0, subnormal_inputs = 0;
+    for (int t = 0; t < 3000; ++t) {
+        const int center = static_cast<int>(u(gen) * 960);
+        for (int j = 0; j < 960; ++j) {
+            const double d = std::abs(j - center);
+            vb[j] = 0.5 * std::exp(-0.5 * d * d / 400.0);  // down to 1e-300 and exact zeros
+            const float f = static_cast<float>(vb[j]);
+            vz[j] = f != 0.0f && std::fpclassify(f) == FP_SUBNORMAL ? 0.0 : vb[j];
+            subnormal_inputs += vz[j] != vb[j];
+        }
+        const auto a = tiny.step(vb, true);
+        const auto b = zero.step(vz, true);
+        ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin())) << t;
+        for (float r : a) active += r > 0;
+    }
+    EXPECT_GT(active, 100);
+    EXPECT_GT(subnormal_inputs, 1000);
+    int subnormal = 0, tiny_weights = 0;
+    for (float x : tiny.weights()) {
+        subnormal += std::fpclassify(x) == FP_SUBNORMAL;
+        tiny_weights += x != 0.0f && std::abs(x) < 1e-30f;  // Oja did write weights near the limit
+    }
+    EXPECT_EQ(subnormal, 0);
+    EXPECT_GT(tiny_weights, 0);
+    // Weights given from outside are taken the same way.
+    std::vector<float> w(250 * 960, 0.25f);
+    w[5] = 1e-30f;
+    w[6] = -1e-40f;
+    tiny.set_weights(w);
+    EXPECT_EQ(tiny.weights()[5], 1e-30f);
+    EXPECT_EQ(tiny.weights()[6], 0.0f);
+    EXPECT_EQ(tiny.weights()[7], 0.25f);
+}
+
 TEST(PlaceCellNetwork, ResetAndWeightsRoundTrip) {
     PlaceCellNetwork net(960, PlaceParams{}, 1);
     std::vector<double> vb(960, 0.0);

@@ -198,7 +198,7 @@ TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
     auto far = std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {100, 101}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
     EXPECT_THROW(run_trial_group({trial_with(far, "2d", 0.0001)}), InputError);
     // In trial YAML, next to the random walk's robot.
-    const auto yaml = temp_file("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.0002}\n");
+    const auto yaml = temp_file("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.001}\n");
     EXPECT_EQ(config::load_trial_file(yaml.string()).agent->kind(), "trajectory");
     const auto both = temp_file("both.yaml", "trajectory: " + header.string() + "\nrobot: {speed: 1}\n");
     EXPECT_THROW(config::load_trial_file(both.string()), ConfigError);
@@ -463,7 +463,7 @@ TEST(Seams, CommentedYamlReadsBackToTheSameConfiguration) {
     files.world = WorldSpec{std::string(BVC3D_SOURCE_DIR) + "/configs/worlds/two-rooms.yaml", std::nullopt, "+x+y"};
     const auto track = temp_file("config-track.csv", "t,x,y,heading\n0,-3,-1,0\n0.5,-2.9,-1,0\n");
     files.agent = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(track));
-    files.protocol = Protocol{Protocol::Kind::online, 0, 0.0001, false};
+    files.protocol = Protocol{Protocol::Kind::online, 0, 0.001, false};
     read_back(files);
     EXPECT_NE(config::trial_to_commented_yaml(files).find("trajectory: " + track.string()), std::string::npos);
     // A path given as arrays has no file to name.

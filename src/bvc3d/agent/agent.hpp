@@ -15,6 +15,10 @@
 
 namespace bvc3d {
 
+// The longest an agent may run, in simulated hours (2500 times the paper's 4 h): a longer walk or
+// protocol phase is refused before it starts, with this number.
+inline constexpr double max_agent_hours = 1e4;
+
 // One model update: its time and the agent's pose (a ground robot's pose is its base on the floor).
 struct ModelStep {
     double t = 0.0;  // seconds since the agent started
@@ -43,6 +47,10 @@ public:
     virtual ~AgentSpec() = default;
     virtual std::string kind() const = 0;  // "random_walk", "trajectory"
     virtual void validate() const = 0;     // InputError naming the bad parameter
+    // Whether the agent can run in this world (a random walk: every start point has room for the
+    // robot; a trajectory: every row lies inside the world): InputError naming the world's key
+    // (`start.points[1]`) or the agent's (`robot.radius`), whichever is at fault. make() checks it too.
+    virtual void check_world(const WorldDescription& world) const = 0;
     // `world` may be null (a replay of recorded data has none) for agents that do not need one;
     // the others throw InputError.
     virtual std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const = 0;

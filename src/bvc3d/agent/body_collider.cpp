@@ -193,6 +193,8 @@ const BodyCollider::FreeSpace& BodyCollider::free_space() const {
         FreeSpace& f = free_;
         f.box = walkable_.bounds();
         f.step = std::clamp(radius_ / 4, 0.02, 0.1);
+        // A coarser grid for huge floors keeps the memory and time bounded (4 million cells).
+        while (f.box.sizes().x() / f.step * (f.box.sizes().y() / f.step) > 4e6) f.step *= 2;
         f.nx = std::max(1, static_cast<int>(std::ceil(f.box.sizes().x() / f.step)));
         f.ny = std::max(1, static_cast<int>(std::ceil(f.box.sizes().y() / f.step)));
         const auto center = [&](int i, int j) {
@@ -254,6 +256,17 @@ int BodyCollider::component_at(const Vec2& p) const {
 std::pair<double, double> BodyCollider::free_area(const Vec2& p) const {
     const int c = component_at(p);
     return {c < 0 ? 0.0 : free_.area[c], free_space().largest};
+}
+
+bool BodyCollider::can_start_in(const Polygon2& region) const {
+    const FreeSpace& f = free_space();
+    for (int j = 0; j < f.ny; ++j)
+        for (int i = 0; i < f.nx; ++i) {
+            const int label = f.label[static_cast<std::size_t>(j) * f.nx + i];
+            const Vec2 c(f.box.min().x() + (i + 0.5) * f.step, f.box.min().y() + (j + 0.5) * f.step);
+            if (label >= 0 && f.area[label] >= 0.25 * f.largest && region.contains(c)) return true;
+        }
+    return false;
 }
 
 bool BodyCollider::can_start_at(const Vec2& p) const {

@@ -47,6 +47,10 @@ public:
     bool can_start_at(const Vec2& p) const;
     // Area of the free region p belongs to (0 if none) and of the largest one, m².
     std::pair<double, double> free_area(const Vec2& p) const;
+    // Whether some place inside `region` is one a walk may start from (on the free-space grid).
+    bool can_start_in(const Polygon2& region) const;
+    // Distance from p to the nearest geometry or walkable boundary: the largest radius that fits at p.
+    double room(const Vec2& p) const { return clearance(p) + radius_; }
 
 private:
     void add_segment(const Vec2& a, const Vec2& b);

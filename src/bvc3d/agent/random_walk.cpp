@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -70,6 +71,64 @@ Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& b
     return pose;
 }
 
+namespace {
+
+// An error about a key of the world's file (or, for a preset, of the world by name).
+[[noreturn]] void world_key_error(const WorldDescription& world, const std::string& key, const std::string& reason) {
+    if (world.file.empty()) throw InputError("world '" + world.name + "': " + key + ": " + reason);
+    throw ConfigError(world.file, key, reason);
+}
+
+std::string point_text(const Vec2& p) { return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ")"; }
+
+}  // namespace
+
+void RandomWalk::check_start(const WorldDescription& world, const BodyCollider& body) {
+    const double r = body.radius();
+    const std::string robot = "robot.radius = " + format_number(r) + " m";
+    const auto& points = world.start.points;
+    if (!points.empty()) {
+        double most_room = 0;
+        bool all_blocked = true;
+        for (const auto& p : points) {
+            const bool inside = world.walkable.contains(p);
+            if (inside) most_room = std::max(most_room, body.room(p));
+            all_blocked = all_blocked && inside && !body.is_free(p);
+        }
+        // Room at some start point for the paper's robot, but none for this one: the robot is at fault.
+        if (all_blocked && most_room >= RobotParams{}.radius)
+            throw InputError(robot + " is too large for world '" + world.name + "': the robot fits at none of its " +
+                             std::to_string(points.size()) + " start points (the most room around one is " +
+                             format_number(std::round(most_room * 1000) / 1000) + " m)");
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const std::string key = "start.points[" + std::to_string(i) + "]";
+            const Vec2& p = points[i];
+            if (!world.walkable.contains(p)) world_key_error(world, key, point_text(p) + " lies outside the walkable region");
+            if (!body.is_free(p))
+                world_key_error(world, key, point_text(p) + " is blocked: a robot of radius " + format_number(r) +
+                                                " m would overlap geometry there (room: " +
+                                                format_number(std::round(body.room(p) * 1000) / 1000) + " m)");
+            if (!body.can_start_at(p)) {
+                const auto [area, largest] = body.free_area(p);
+                world_key_error(world, key, point_text(p) + " lies in a closed-off free area of " +
+                                                format_number(std::round(area * 100) / 100) + " m² (the largest is " +
+                                                format_number(std::round(largest * 100) / 100) +
+                                                " m²): inside an obstacle, or a pocket the robot cannot leave");
+            }
+        }
+        return;
+    }
+    const auto& region = world.start.region;
+    if (region.points.size() < 3 || region.area() <= 0)
+        world_key_error(world, "start", "no start points and no start region with positive area");
+    if (body.can_start_in(region)) return;
+    if (body.free_area(region.points.front()).second <= 0)
+        throw InputError(robot + " is too large for world '" + world.name + "': the robot fits nowhere in it");
+    world_key_error(world, world.file.empty() ? "start" : "start",
+                    "the start region has no place where a robot of radius " + format_number(r) +
+                        " m fits, outside obstacles and closed-off pockets");
+}
+
 void RandomWalk::turn_to(double heading) {
     heading = wrap_pi(heading);
     state_.t += std::abs(wrap_pi(heading - state_.pose.heading)) / p_.turn_rate;
@@ -130,8 +189,8 @@ WalkState RandomWalk::state() const {
 }
 
 void RandomWalk::restore(const WalkState& s) {
+    rng_.set_state(s.rng_state);  // first: it may throw, and then nothing has changed
     state_ = s;
-    rng_.set_state(s.rng_state);
 }
 
 std::string RandomWalk::save_state() const {
@@ -162,10 +221,16 @@ void RandomWalk::restore_state(const std::string& text) {
     restore(w);
 }
 
+void RandomWalkSpec::check_world(const WorldDescription& world) const {
+    validate();
+    RandomWalk::check_start(world, BodyCollider(world, robot_.radius, robot_.height));
+}
+
 std::unique_ptr<Agent> RandomWalkSpec::make(const World* world, std::uint64_t seed) const {
     validate();
     if (!world) throw InputError("the random walk needs a world to walk in");
     auto body = std::make_shared<const BodyCollider>(world->description(), robot_.radius, robot_.height);
+    RandomWalk::check_start(world->description(), *body);
     Rng rng(seed, Stream::walk);
     const Pose start = RandomWalk::draw_start(world->description(), *body, rng);
     return std::make_unique<RandomWalk>(body, robot_, std::move(rng), start);
@@ -179,11 +244,18 @@ void RandomWalkSpec::write_yaml(params::CommentedYaml& out) const {
 }
 
 std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params) {
-    if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0");
+    if (!std::isfinite(hours) || hours < 0) throw InputError("walk: hours must be >= 0, got " + format_number(hours));
+    if (hours > max_agent_hours)
+        throw InputError("walk: hours = " + format_number(hours) + " is more than the limit of " +
+                         format_number(max_agent_hours) + " simulated hours");
+    params.validate();
     const auto walk = RandomWalkSpec(params).make(&world, seed);
     std::vector<ModelStep> steps;
     steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
-    while (auto s = walk->next(hours * 3600.0)) steps.push_back(*s);
+    while (auto s = walk->next(hours * 3600.0)) {
+        steps.push_back(*s);
+        if (steps.size() % 4096 == 0) poll_cancel();
+    }
     return steps;
 }
 

@@ -51,6 +51,9 @@ public:
     // A uniformly random start: one of the world's start points (or a free point of its start
     // region) and a uniform heading.
     static Pose draw_start(const WorldDescription& world, const BodyCollider& body, Rng& rng);
+    // Every start point (or the start region) has room for this body, or an InputError blaming the
+    // robot's radius (it fits at none) or the world's start point or region (it alone is bad).
+    static void check_start(const WorldDescription& world, const BodyCollider& body);
 
     std::optional<ModelStep> next(double t_end) override;
     double time() const override { return state_.t; }
@@ -80,6 +83,7 @@ public:
     const RobotParams& robot() const { return robot_; }
     std::string kind() const override { return "random_walk"; }
     void validate() const override { robot_.validate(); }
+    void check_world(const WorldDescription& world) const override;
     std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override { return 1.0 / robot_.model_dt; }

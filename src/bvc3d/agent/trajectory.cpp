@@ -86,6 +86,8 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
     const std::string name = "trajectory file '" + path.string() + "'";
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw InputError(name + " is a folder, not a file");
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw InputError(name + " is not a regular file");
     std::ifstream in(path);
     if (!in) throw InputError(name + (std::filesystem::exists(path, ec) ? " cannot be read" : " does not exist"));
     std::vector<std::string> columns;  // from the header, if any
@@ -181,18 +183,20 @@ void TrajectorySpec::write_yaml(params::CommentedYaml& out) const {
              "a given path instead of the random walk: a file of t, x, y, [z], heading rows");
 }
 
-std::unique_ptr<Agent> TrajectorySpec::make(const World* world_or_null, std::uint64_t) const {
-    if (!world_or_null) return std::make_unique<Trajectory>(steps_);
-    const World& world = *world_or_null;
-    const Eigen::AlignedBox3d box = world.description().bounds();
+std::unique_ptr<Agent> TrajectorySpec::make(const World* world, std::uint64_t) const {
+    if (world) check_world(world->description());
+    return std::make_unique<Trajectory>(steps_);
+}
+
+void TrajectorySpec::check_world(const WorldDescription& world) const {
+    const Eigen::AlignedBox3d box = world.bounds();  // triangles and point clouds
     for (std::size_t i = 0; i < steps_->size(); ++i) {
         const Pose& p = (*steps_)[i].pose;
         if (!box.contains(p.position()))
             throw InputError("trajectory '" + source_ + "', row " + std::to_string(i) + ": (" + format_number(p.x) +
                              ", " + format_number(p.y) + ", " + format_number(p.z) + ") lies outside world '" +
-                             world.name() + "' (another coordinate frame?)");
+                             world.name + "' (another coordinate frame?)");
     }
-    return std::make_unique<Trajectory>(steps_);
 }
 
 std::string TrajectorySpec::key() const {

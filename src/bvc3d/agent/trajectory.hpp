@@ -53,8 +53,10 @@ public:
     const std::vector<ModelStep>& steps() const { return *steps_; }
     std::string kind() const override { return "trajectory"; }
     void validate() const override {}
-    // Checks that every pose lies within the world's geometry (a path in another frame is a
-    // mistake); without a world (a replay of recorded data) there is nothing to check.
+    // Every pose lies within the world's geometry (a path in another frame is a mistake).
+    void check_world(const WorldDescription& world) const override;
+    // Checks the world when there is one; without a world (a replay of recorded data) there is
+    // nothing to check.
     std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override;

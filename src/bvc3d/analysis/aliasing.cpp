@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bvc3d/analysis/point_grid.hpp"
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::analysis {
@@ -40,6 +41,7 @@ AliasingResult spatial_aliasing(const Eigen::Ref<const Centers>& centers, const 
     const Eigen::RowVectorXd total = unit.colwise().sum();
     const PointGrid grid(centers, d_th);
     for (Eigen::Index i = 0; i < n_bins; ++i) {
+        if (i % 256 == 0) poll_cancel();
         const auto& nz = nonzero[static_cast<std::size_t>(i)];
         if (nz.empty()) continue;
         const auto ai = unit.row(i);

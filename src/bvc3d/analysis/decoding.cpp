@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bvc3d/analysis/rate_maps.hpp"
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::analysis {
@@ -52,6 +53,7 @@ std::vector<int> decode_sparse(const RowMatrixXd& unit, const Eigen::Ref<const R
     std::vector<int> best(static_cast<std::size_t>(rates.rows()), -1);
     Eigen::VectorXd score = Eigen::VectorXd::Zero(unit.rows());
     for (Eigen::Index s = 0; s < rates.rows(); ++s) {
+        if (s % 512 == 0) poll_cancel();
         for (Eigen::Index c = 0; c < rates.cols(); ++c) {
             const double rc = static_cast<double>(rates(s, c));
             if (rc == 0) continue;
@@ -72,6 +74,7 @@ std::vector<int> decode_dense(const RowMatrixXd& unit, const Eigen::Ref<const Ro
     constexpr Eigen::Index block = 512;
     RowMatrixXd scores;
     for (Eigen::Index s0 = 0; s0 < rates.rows(); s0 += block) {
+        poll_cancel();
         const Eigen::Index m = std::min(block, rates.rows() - s0);
         scores.noalias() = rates.middleRows(s0, m).template cast<double>() * unit.transpose();
         for (Eigen::Index i = 0; i < m; ++i) best[static_cast<std::size_t>(s0 + i)] = best_bin(scores.row(i));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::analysis {
@@ -149,6 +150,7 @@ Neighborhoods brute_neighbors(const PointSet& pts, double eps) {
     std::vector<double> norm(pts.size());
     for (std::size_t i = 0; i < pts.size(); ++i) norm[i] = dot(pts[i], pts[i]);
     for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (i % 1024 == 0) poll_cancel();
         for (std::size_t j = 0; j < pts.size(); ++j) {
             const double middle = -2.0 * dot(pts[i], pts[j]);
             if (std::max(norm[i] + middle + norm[j], 0.0) <= rr) nb.indices.push_back(static_cast<int>(j));
@@ -164,6 +166,7 @@ Neighborhoods neighbors(const PointSet& pts, double eps) {
     Neighborhoods nb;
     const SklearnKdTree tree(pts);
     for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (i % 4096 == 0) poll_cancel();
         tree.query_radius(pts[i], eps, nb.indices);
         nb.offsets.push_back(static_cast<int>(nb.indices.size()));
     }
@@ -248,6 +251,7 @@ std::vector<int> modality(const Eigen::Ref<const Centers>& centers, const Eigen:
     PointSet pts;
     pts.dims = static_cast<int>(centers.cols());
     for (Eigen::Index c = 0; c < maps.cols(); ++c) {
+        poll_cancel();
         pts.coords.clear();
         for (Eigen::Index b = 0; b < maps.rows(); ++b) {
             if (std::isnan(maps(b, c))) throw InputError("maps must not contain NaN (column " + std::to_string(c) + ")");

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::analysis {
@@ -46,6 +47,7 @@ void threshold_and_normalize(RowMatrixXd& maps, double quantile) {
     const double percent = 100 * quantile;
     std::vector<double> scratch(static_cast<std::size_t>(maps.rows()));
     for (Eigen::Index c = 0; c < maps.cols(); ++c) {
+        poll_cancel();
         auto col = maps.col(c);
         for (Eigen::Index b = 0; b < maps.rows(); ++b) scratch[static_cast<std::size_t>(b)] = col(b);
         const double threshold = percentile_linear(scratch, percent);

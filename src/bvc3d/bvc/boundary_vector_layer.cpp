@@ -7,6 +7,7 @@
 #include "bvc3d/bvc/bvc_kernels.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 
@@ -57,6 +58,11 @@ const params::Table<BvcParams>& BvcParams::table() {
 
 void BvcParams::validate() const {
     table().check(*this);
+    const double cells = static_cast<double>(n_layers()) * n_dir * n_per_axis;
+    if (cells > max_cells)
+        table().fail("n_per_axis", "makes " + std::to_string(n_layers()) + " layers × " + std::to_string(n_dir) +
+                                       " directions × " + std::to_string(n_per_axis) + " distances = " +
+                                       format_number(cells) + " cells; the limit is " + format_number(max_cells));
     if (reading == BvcReading::nearest_beam && !elevations.empty())
         table().fail("reading", "cannot be nearest_beam with elevation layers (the nearest_beam reading is a 2-D model)");
 }
@@ -75,21 +81,24 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     const int padded = (p_.n_per_axis + 7) / 8 * 8;
     dist_decay_.assign(padded, 0.0);
     for (int n = 0; n < p_.n_per_axis; ++n) dist_decay_[n] = std::exp(-0.5 * (n * d) * (n * d) / (p_.sigma_r * p_.sigma_r));
-    profile_.assign(padded, 0.0);
-    row_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
-    rows_.assign(row_weight_.size(), nullptr);
     elev_.assign(p_.n_layers(), 0.0);
     dropped_e_.assign(p_.n_layers(), 0.0);
+    row_factor_.assign(p_.n_layers(), 0.0);
+    kept_layers_.assign(p_.n_layers(), 0);
+    any_layers_.assign(p_.n_layers(), 0);
+    // A batch: 256 returns, or as many rows as fill 1024 entries (plus one return's worth).
+    jobs_.resize(256);
+    job_offset_.resize(1024 + static_cast<std::size_t>(p_.n_layers()) * p_.n_dir);
+    job_weight_.resize(job_offset_.size());
     kept_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
     layer_weight_.assign(p_.n_layers(), 0.0);
     far_weight_.assign(p_.n_layers(), 0.0);
     dropped_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
     axis_stride_ = padded + 8;
     padded_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir * axis_stride_, 0.0);
-    cache_key_.assign(cache_slots, NAN);
-    cache_count_.assign(cache_slots, 0);
-    cache_dir_.assign(cache_slots * p_.n_dir, 0);
-    cache_weight_.assign(cache_slots * p_.n_dir, 0.0);
+    memo_weight_.assign(cache_slots * (p_.n_dir + 1), 0.0);
+    memo_dir_.assign(cache_slots * (p_.n_dir + 1), 0);
+    for (std::size_t slot = 0; slot < cache_slots; ++slot) memo_weight_[slot * (p_.n_dir + 1)] = NAN;  // the keys
     direct_dir_.assign(p_.n_dir, 0);
     direct_weight_.assign(p_.n_dir, 0.0);
 }
@@ -121,15 +130,32 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
     // keeps the power recurrence below far from overflow.
     const bool recurrence = dd > 0 && dd <= p_.sigma_r;
-    // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_).
-    std::vector<double>& elev = elev_;
-    std::vector<double>& dropped_e = dropped_e_;
+    // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_);
+    // the layers with a summed factor (kept_l, n_kept of them) and with any factor (any_l, n_any).
+    double* elev = elev_.data();
+    double* dropped_e = dropped_e_.data();
+    int* kept_l = kept_layers_.data();
+    int* any_l = any_layers_.data();
+    int n_kept = 0, n_any = 0;
     // For the truncation bound: per (layer, direction) the kept weights Σ E·A and the dropped ones,
     // per layer Σ E over returns that reach it and Σ E over those whose distance window is empty.
     std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
     std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
     std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
     std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    double* kept_weight = kept_weight_.data();
+    double* layer_weight = layer_weight_.data();
+    // The recurrence path lists the returns' profiles (jobs) and the rows each feeds (offsets into
+    // the sums, weights), and adds a few hundred at a time in one kernel call, in return order.
+    kernels::ProfileJob* jobs = jobs_.data();
+    std::uint32_t* job_offset = job_offset_.data();
+    double* job_weight = job_weight_.data();
+    std::size_t n_jobs = 0, n_rows = 0;
+    const std::size_t rows_room = job_offset_.size() - static_cast<std::size_t>(K) * L;
+    auto flush = [&] {
+        kernels::add_distance_profiles(jobs, n_jobs, job_offset, job_weight, dist_decay_.data(), out_data);
+        n_jobs = n_rows = 0;
+    };
     std::size_t valid = 0;
     // A beam table comes row by row; returns whose elevation changes nearly every time are an
     // irregular point set, whose azimuths never repeat: the memo is left alone for them.
@@ -138,18 +164,18 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     for (std::size_t j = 1; j < probe; ++j) changes += !(returns[j].elevation == returns[j - 1].elevation);
     const bool use_memo = probe < 64 || changes < 56;
     double last_phi = NAN;
-    bool any_kept = true, any_dropped = false, skipped_row = false;
+    bool skipped_row = false;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
         const LidarReturn& ret = returns[j];
         if (is_no_return(ret)) continue;
-        check_return(ret, j);
+        if (!(ret.range >= 0) || !std::isfinite(ret.azimuth) || !std::isfinite(ret.elevation)) check_return(ret, j);
         // Elevation factors, cached across the returns of one scanner row.
         if (!(ret.elevation == last_phi)) {
             last_phi = ret.elevation;
             skipped_row = plan && std::find(plan->skipped_rows.begin(), plan->skipped_rows.end(), ret.elevation) !=
                                       plan->skipped_rows.end();
-            any_kept = any_dropped = false;
+            n_kept = n_any = 0;
             for (int l = 0; l < L; ++l) {
                 elev[l] = dropped_e[l] = 0.0;
                 if (planar) {
@@ -159,33 +185,39 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
                     if (std::abs(x) <= cut_row_) elev[l] = c_phi_ * std::exp(-x * x * h_p);
                     else if (std::abs(x) <= cut_phi_) dropped_e[l] = c_phi_ * std::exp(-x * x * h_p);
                 }
-                any_kept = any_kept || elev[l] > 0.0;
-                any_dropped = any_dropped || dropped_e[l] > 0.0;
+                row_factor_[l] = elev[l] + dropped_e[l];
+                if (elev[l] > 0.0) kept_l[n_kept++] = l;
+                if (row_factor_[l] > 0.0) any_l[n_any++] = l;  // adding 0 to layer_weight changes nothing
             }
         }
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
         ++valid;
-        if (!any_kept && !any_dropped) continue;
+        if (n_any == 0) continue;
         const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
         const int* dir = direct_dir_.data();
         const double* ang = direct_weight_.data();
         int n_dirs;
         if (use_memo) {
-            const std::size_t slot = slot_of(azimuth);
-            if (!(cache_key_[slot] == azimuth)) fill_angular(slot, azimuth);
-            dir = cache_dir_.data() + slot * K;
-            ang = cache_weight_.data() + slot * K;
-            n_dirs = cache_count_[slot];
+            const std::size_t at = slot_of(azimuth) * (K + 1);
+            double* const key = memo_weight_.data() + at;
+            int* const count = memo_dir_.data() + at;
+            if (!(*key == azimuth)) {
+                *count = angular_weights(azimuth, count + 1, key + 1);
+                *key = azimuth;
+            }
+            dir = count + 1;
+            ang = key + 1;
+            n_dirs = *count;
         } else {
             n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
         }
-        for (int l = 0; l < L; ++l) {
-            layer_weight_[l] += elev[l] + dropped_e[l];
-            if (dropped_e[l] > 0.0)
-                for (int d = 0; d < n_dirs; ++d)
-                    dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
-        }
-        if (!any_kept) continue;
+        for (int i = 0; i < n_any; ++i) layer_weight[any_l[i]] += row_factor_[any_l[i]];
+        if (n_any > n_kept)
+            for (int l = 0; l < L; ++l)
+                if (dropped_e[l] > 0.0)
+                    for (int d = 0; d < n_dirs; ++d)
+                        dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
+        if (n_kept == 0) continue;
 
         // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
         // truncation toward zero serves for floor and ceil (r >= 0; no libm call on baseline x86-64).
@@ -199,38 +231,42 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             m_lo = 1;  // no cell in reach
         }
         if (m_lo > m_hi) {
-            for (int l = 0; l < L; ++l) far_weight_[l] += elev[l];
+            for (int i = 0; i < n_kept; ++i) far_weight_[kept_l[i]] += elev[kept_l[i]];
             continue;
         }
         const int W = m_hi - m_lo + 1;
 
         // The (layer, direction) rows this return feeds, with their elevation × angular weights.
-        int count = 0;
+        const std::size_t first = n_rows;
         for (int d = 0; d < n_dirs; ++d)
-            for (int l = 0; l < L; ++l) {
-                if (elev[l] == 0.0) continue;
-                row_weight_[count] = elev[l] * ang[d];
-                kept_weight_[static_cast<std::size_t>(l) * K + dir[d]] += row_weight_[count];
-                rows_[count] = out_data + (static_cast<std::size_t>(l) * K + dir[d]) * stride + m_lo;
-                ++count;
+            for (int i = 0; i < n_kept; ++i) {
+                const int l = kept_l[i];
+                const double w = elev[l] * ang[d];
+                const std::size_t lk = static_cast<std::size_t>(l) * K + dir[d];
+                kept_weight[lk] += w;
+                job_weight[n_rows] = w;
+                job_offset[n_rows] = static_cast<std::uint32_t>(lk * stride + m_lo);
+                ++n_rows;
             }
+        const int count = static_cast<int>(n_rows - first);
         if (count == 0) continue;
 
         // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
         if (recurrence) {
             // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return.
             const double x0 = r - m_lo * dd;
-            kernels::add_distance_profile(c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd),
-                                          dist_decay_.data(), W, row_weight_.data(), rows_.data(), count,
-                                          profile_.data());
+            jobs[n_jobs++] = {c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd), W, count};
+            if (n_jobs == jobs_.size() || n_rows > rows_room) flush();
         } else {
             for (int n = 0; n < W; ++n) {
                 const double x = r - (m_lo + n) * dd;
                 const double u = c_r_ * std::exp(-h_r * x * x);
-                for (int i = 0; i < count; ++i) rows_[i][n] += row_weight_[i] * u;
+                for (int i = 0; i < count; ++i) out_data[job_offset[first + i] + n] += job_weight[first + i] * u;
             }
+            n_rows = 0;
         }
     }
+    if (n_jobs > 0) flush();
     for (int axis = 0; axis < L * K; ++axis)
         std::copy(out_data + static_cast<std::size_t>(axis) * stride, out_data + static_cast<std::size_t>(axis) * stride + M,
                   result.begin() + static_cast<std::ptrdiff_t>(axis) * M);
@@ -260,30 +296,33 @@ int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weigh
     const int K = p_.n_dir;
     const double dtheta = two_pi / K, h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta);
     const bool all_dirs = 2.0 * cut_theta_ >= two_pi;
-    const int k_first = all_dirs ? 0 : static_cast<int>(std::ceil((azimuth - cut_theta_) / dtheta));
-    const int k_last = all_dirs ? K - 1 : static_cast<int>(std::floor((azimuth + cut_theta_) / dtheta));
+    // ceil and floor of quotients within a few turns, from truncation (no libm call on baseline x86-64).
+    auto ceil_int = [](double t) {
+        const int i = static_cast<int>(t);
+        return i + (static_cast<double>(i) < t);
+    };
+    auto floor_int = [](double t) {
+        const int i = static_cast<int>(t);
+        return i - (static_cast<double>(i) > t);
+    };
+    const int k_first = all_dirs ? 0 : ceil_int((azimuth - cut_theta_) / dtheta);
+    const int k_last = all_dirs ? K - 1 : floor_int((azimuth + cut_theta_) / dtheta);
     int count = 0;
     for (int ki = k_first; ki <= k_last; ++ki) {
         const double x = all_dirs ? wrap_pi(azimuth - ki * dtheta) : azimuth - ki * dtheta;
         if (std::abs(x) > cut_theta_) continue;
-        dir[count] = ((ki % K) + K) % K;
+        dir[count] = ki < 0 ? ki + K : ki >= K ? ki - K : ki;  // |ki| < K: the window is under a turn
         weight[count] = c_theta_ * std::exp(-x * x * h_t);
         ++count;
     }
     return count;
 }
 
-void BoundaryVectorLayer::fill_angular(std::size_t slot, double azimuth) const {
-    const int K = p_.n_dir;
-    cache_count_[slot] = angular_weights(azimuth, cache_dir_.data() + slot * K, cache_weight_.data() + slot * K);
-    cache_key_[slot] = azimuth;
-}
-
 void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     std::fill(out.begin(), out.end(), 0.0);
     if (p_.reading == BvcReading::nearest_beam) {
-        raw_nearest_beam(returns, out);
+        raw_nearest_beam(returns, out, false);
         return;
     }
     const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis;
@@ -310,7 +349,8 @@ void BoundaryVectorLayer::raw_exact(std::span<const LidarReturn> returns, std::s
     }
 }
 
-void BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out) const {
+bool BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out,
+                                           bool prune) const {
     // For each direction, the first return with the smallest |wrap(azimuth - θ_k)|.
     const int K = p_.n_dir, M = p_.n_per_axis;
     best_return_.assign(K, returns.size());
@@ -329,20 +369,37 @@ void BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns,
             }
         }
     }
+    // Pruned, a direction's profile is evaluated over its distance window only (as raw_pruned does):
+    // a cell outside it would get less than tiny_r·c_r. Those Gaussian tails (down to 1e-56 of the
+    // peak) were the subnormal float rates, and the weights Oja's rule grew from them, that made
+    // the place cells take a microcode assist per product on many CPUs.
+    const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
+    prune = prune && dd > 0;
+    double max_raw = 0;
     for (int k = 0; k < K; ++k) {
         if (best_return_[k] == returns.size()) continue;
-        for (int m = 0; m < M; ++m) {
-            const double x = returns[best_return_[k]].range - m * p_.spacing();
-            out[static_cast<std::size_t>(k) * M + m] = c_r_ * std::exp(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
+        const double r = returns[best_return_[k]].range;
+        int m_lo = 0, m_hi = M - 1;
+        if (prune) {  // a superset of |r - d_m| <= cut, as in raw_pruned
+            const double lo = (r - cut_r_) * inv_dd, hi = (r + cut_r_) * inv_dd;
+            m_lo = lo > 0 ? static_cast<int>(std::min(lo, 1e9)) : 0;
+            m_hi = std::min(static_cast<int>(std::min(hi, static_cast<double>(M - 2))) + 1, M - 1);
+        }
+        for (int m = m_lo; m <= m_hi; ++m) {
+            const double x = r - m * p_.spacing();
+            const double v = c_r_ * std::exp(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
+            out[static_cast<std::size_t>(k) * M + m] = v;
+            max_raw = std::max(max_raw, v);
         }
     }
+    return !prune || c_r_ * tiny_r <= pruned_tolerance * max_raw;
 }
 
 void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     if (p_.reading == BvcReading::nearest_beam) {
         std::fill(out.begin(), out.end(), 0.0);
-        raw_nearest_beam(returns, out);
+        if (!raw_nearest_beam(returns, out, true)) raw_nearest_beam(returns, out, false);
     } else if (!raw_pruned(returns, nullptr, out)) {
         raw_exact(returns, out);
     }

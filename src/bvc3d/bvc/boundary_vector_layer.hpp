@@ -6,11 +6,11 @@
 // psi_l, azimuth theta_k = 2πk/n_dir and distance d_m = m·max_dist/(n_per_axis - 1).
 #include <array>
 #include <cstdint>
-#include <cstring>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "bvc3d/bvc/bvc_kernels.hpp"
 #include "bvc3d/core/params.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
@@ -34,6 +34,10 @@ struct BvcParams {
     BvcNormalization normalization = BvcNormalization::per_step_max;
     double norm_constant = 1.0;  // `fixed`: rate = raw / norm_constant
     BvcReading reading = BvcReading::gaussian;
+
+    // At most this many cells (layers × n_dir × n_per_axis): beyond it a layer is a mistake, and its
+    // weights and rates would not fit in memory.
+    static constexpr double max_cells = 1e6;
 
     int n_layers() const { return elevations.empty() ? 1 : static_cast<int>(elevations.size()); }
     int n_cells() const { return n_layers() * n_dir * n_per_axis; }
@@ -80,7 +84,9 @@ public:
 private:
     // Returns false if the pruning bound is not met (out then holds the pruned sums).
     bool raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out) const;
-    void raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out) const;
+    // The nearest_beam reading into `out` (zeroed by the caller). Pruned: only each direction's
+    // distance window; returns false if what that drops is not below the pruning tolerance.
+    bool raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out, bool prune) const;
     void normalize(std::span<double> out) const;
     static void check_return(const LidarReturn& r, std::size_t index);
 
@@ -90,32 +96,38 @@ private:
     std::vector<double> dist_decay_;    // exp(-n²Δ²/2σ_r²), n = 0..n_per_axis-1, zero-padded
     // The directions an azimuth reaches and their angular factors c_θ·exp(-x²/2σ_θ²): a pure
     // function of the azimuth, memoised in a direct-mapped table keyed by the azimuth's bits
-    // (scanners repeat the same azimuths row after row). Slot s holds count_[s] directions at
-    // dir_/weight_[s·n_dir ...]; a NaN key never matches.
+    // (scanners repeat the same azimuths row after row, and step after step while the agent does not
+    // turn). Slot s is memo_weight_[s·(n_dir + 1) ...] = key, factors and memo_dir_[same] = count,
+    // directions: two cache lines a lookup. A NaN key never matches.
     static constexpr std::size_t cache_slots = 1024;
-    // The slot for `azimuth`: a hit is a multiply, a shift and a compare; a miss fills the slot.
+    // The slot for `azimuth` in (-π, π]: its position on the circle, so a beam table's evenly spaced
+    // columns (up to cache_slots of them) never share a slot. A hit is an add, a multiply and a
+    // compare; a miss fills the slot.
     static std::size_t slot_of(double azimuth) {
-        std::uint64_t bits;
-        std::memcpy(&bits, &azimuth, sizeof bits);
-        return static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 54);
+        const auto s = static_cast<std::size_t>((azimuth + 3.14159265358979323846) * (cache_slots / 6.283185307179586477));
+        return s < cache_slots ? s : cache_slots - 1;
     }
-    void fill_angular(std::size_t slot, double azimuth) const;
     // The directions `azimuth` reaches and their angular factors; returns how many.
     int angular_weights(double azimuth, int* dir, double* weight) const;
-    mutable std::vector<double> cache_key_, cache_weight_;
-    mutable std::vector<int> cache_count_, cache_dir_;
+    mutable std::vector<double> memo_weight_;
+    mutable std::vector<int> memo_dir_;
     // Irregular point sets (real LiDAR) repeat no azimuth: the memo would only evict useful cache
     // lines, so their factors are computed directly (into direct_*). The numbers are the same.
     mutable std::vector<int> direct_dir_;
     mutable std::vector<double> direct_weight_;
 
-    // Scratch for one step (a layer is not shared between threads): a return's distance profile,
-    // the (layer, direction) rows it feeds with their weights, the elevation factors of its row.
-    mutable std::vector<double> profile_, row_weight_, elev_, dropped_e_;
+    // Scratch for one step (a layer is not shared between threads): the elevation factors of the
+    // current row (summed, dropped, their sum) and which layers have them; a batch of returns'
+    // distance profiles (jobs_) and the (layer, direction) rows each feeds, as offsets into padded_
+    // and weights.
+    mutable std::vector<double> elev_, dropped_e_, row_factor_;
+    mutable std::vector<int> kept_layers_, any_layers_;
+    mutable std::vector<kernels::ProfileJob> jobs_;
+    mutable std::vector<std::uint32_t> job_offset_;
+    mutable std::vector<double> job_weight_;
     mutable std::vector<double> kept_weight_, layer_weight_, far_weight_, dropped_weight_;  // truncation bound
     int axis_stride_ = 0;                 // n_per_axis rounded up to 8, plus 8
     mutable std::vector<double> padded_;  // sums with padded axes
-    mutable std::vector<double*> rows_;
     mutable std::vector<std::size_t> best_return_;  // nearest_beam reading
     mutable std::vector<double> best_gap_;
 };

@@ -1,6 +1,7 @@
 #include "bvc3d/config/model_spec.hpp"
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
 
@@ -8,6 +9,11 @@ void ModelSpec::validate() const {
     sensor.validate();
     bvc.validate();
     place.validate();
+    const double weights = static_cast<double>(place.n_place) * bvc.n_cells();
+    if (weights > max_weights)
+        PlaceParams::table().fail("n_place", "makes " + std::to_string(place.n_place) + " place cells × " +
+                                                 std::to_string(bvc.n_cells()) + " BVCs = " + format_number(weights) +
+                                                 " weights; the limit is " + format_number(max_weights));
 }
 
 namespace {

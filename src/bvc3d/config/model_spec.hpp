@@ -17,6 +17,7 @@ struct ModelSpec {
     LidarSpec sensor;
     BvcParams bvc;
     PlaceParams place;
+    static constexpr double max_weights = 1e9;  // n_place × BVCs (4 GB of float weights)
     void validate() const;
 };
 

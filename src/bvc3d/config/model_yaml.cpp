@@ -25,6 +25,14 @@ ModelSpec model_from_yaml(const YamlView& v) {
     if (v.has("sensor")) m.sensor = sensor_from_yaml(v["sensor"]);
     if (v.has("bvc")) read_table(v["bvc"], m.bvc, BvcParams::table());
     if (v.has("place")) read_table(v["place"], m.place, PlaceParams::table());
+    // The sections one by one may still not fit together (too many weights): at the key named.
+    try {
+        m.validate();
+    } catch (const params::ParamError& e) {
+        for (const char* section : {"place", "bvc", "sensor"})
+            if (v.has(section) && v[section].is_map() && v[section].has(e.key())) v[section][e.key()].fail(e.reason());
+        v.fail(e.what());
+    }
     return m;
 }
 

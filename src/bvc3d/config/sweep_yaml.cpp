@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "bvc3d/config/trial_yaml.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d::config {
 
@@ -83,6 +84,11 @@ std::vector<Condition> grid_conditions(const YamlView& grid, std::vector<std::st
         keys.push_back(key);
     }
     if (axes.empty()) grid.fail("has no keys");
+    double n = 1;
+    for (const auto& a : axes) n *= static_cast<double>(a.second.size());
+    if (n > max_trials)
+        grid.fail("makes " + format_number(n) + " conditions; the limit is " + std::to_string(static_cast<long long>(max_trials)) +
+                  " trials");
     std::vector<Condition> conditions;
     std::vector<std::size_t> idx(axes.size(), 0);
     for (bool more = true; more;) {
@@ -119,23 +125,25 @@ std::vector<Condition> list_conditions(const YamlView& list, std::vector<std::st
     return conditions;
 }
 
-// `seeds: N` (0 .. N-1) or a list; default: seed 0.
+// `seeds: N` (0 .. N-1) or a list of seeds (each 0 .. 2^64 - 1); default: seed 0.
 std::vector<std::uint64_t> read_seeds(const YamlView& v) {
     if (!v.has("seeds")) return {0};
     const YamlView s = v["seeds"];
     std::vector<std::uint64_t> seeds;
     if (s.is_scalar()) {
-        const long long n = s.as_int();
+        const std::uint64_t n = s.as_uint64();
         if (n < 1) s.fail("must be >= 1 (a number of seeds) or a list of seeds");
-        for (long long i = 0; i < n; ++i) seeds.push_back(static_cast<std::uint64_t>(i));
+        if (static_cast<double>(n) > max_trials)
+            s.fail("asks for " + std::to_string(n) + " seeds; the limit is " + std::to_string(static_cast<long long>(max_trials)) +
+                   " trials");
+        for (std::uint64_t i = 0; i < n; ++i) seeds.push_back(i);
         return seeds;
     }
     if (s.size() == 0) s.fail("lists no seeds");
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const long long x = s.at(i).as_int();
-        if (x < 0) s.at(i).fail("seeds must be >= 0");
-        seeds.push_back(static_cast<std::uint64_t>(x));
-    }
+    if (static_cast<double>(s.size()) > max_trials)
+        s.fail("lists " + std::to_string(s.size()) + " seeds; the limit is " + std::to_string(static_cast<long long>(max_trials)) +
+               " trials");
+    for (std::size_t i = 0; i < s.size(); ++i) seeds.push_back(s.at(i).as_uint64());
     return seeds;
 }
 
@@ -167,6 +175,7 @@ TrialConfig condition_trial(const std::string& path, const YAML::Node& base, con
     }
     t.condition = label;
     t.swept = swept;
+    t.origin = path + ", condition " + std::to_string(index);
     return t;
 }
 
@@ -187,6 +196,10 @@ Sweep load_sweep_file(const std::string& path) {
         conditions.insert(conditions.end(), listed.begin(), listed.end());
     }
     const auto seeds = read_seeds(v);
+    const double n_trials = static_cast<double>(conditions.size()) * static_cast<double>(seeds.size());
+    if (n_trials > max_trials)
+        v.fail(std::to_string(conditions.size()) + " conditions × " + std::to_string(seeds.size()) + " seeds = " +
+               format_number(n_trials) + " trials; the limit is " + std::to_string(static_cast<long long>(max_trials)));
     for (std::size_t c = 0; c < conditions.size(); ++c) {
         TrialConfig t = condition_trial(path, base, conditions[c], c);
         for (auto s : seeds) {

@@ -14,8 +14,12 @@ struct Sweep {
     std::vector<TrialConfig> trials;  // every condition × seed, conditions in grid order
 };
 
+// The most trials a sweep (conditions × seeds) or `bvc3d paper` may list: counted before any is
+// built, so that a mistaken grid is refused at once with its size.
+inline constexpr double max_trials = 100000;
+
 // Throws ConfigError naming the file, the key and the reason (unknown keys, empty grids, values
-// of the wrong type, impossible values, ...).
+// of the wrong type, impossible values, too many trials, ...).
 Sweep load_sweep_file(const std::string& path);
 
 }  // namespace bvc3d::config

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "bvc3d/config/model_yaml.hpp"
@@ -66,8 +67,9 @@ const params::Table<Protocol>& Protocol::table() {
         {choice("kind", &Protocol::kind,
                 {{Kind::explore_then_sample, "explore_then_sample"}, {Kind::online, "online"}},
                 "explore_then_sample (learn, then record frozen) or online (record while learning)"),
-         real("explore_hours", &Protocol::explore_hours, at_least(0), "h of exploration, learning on, not recorded"),
-         real("sample_hours", &Protocol::sample_hours, above(0), "h recorded (online: the one phase)"),
+         real("explore_hours", &Protocol::explore_hours, closed(0, max_agent_hours),
+              "h of exploration, learning on, not recorded"),
+         real("sample_hours", &Protocol::sample_hours, open_closed(0, max_agent_hours), "h recorded (online: the one phase)"),
          flag("record_bvc", &Protocol::record_bvc, "also record the BVC rates")});
     return t;
 }
@@ -112,7 +114,28 @@ void TrialConfig::validate() const {
                          std::to_string(model.place.n_place) + " × " + std::to_string(model.bvc.n_cells()));
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
     if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
-        throw InputError("sample_hours = " + format_number(protocol.sample_hours) + " h records fewer than 2 model steps");
+        Protocol::table().fail("sample_hours", "= " + format_number(protocol.sample_hours) +
+                                                   " h records fewer than 2 model steps");
+}
+
+void TrialConfig::check_runnable() const {
+    try {
+        validate();
+        if (!world.is_none()) agent->check_world(world.resolve());  // a replay has no world
+    } catch (const InputError& e) {
+        // Name the file the trial came from, unless the message already names a file of its own.
+        const std::string what = e.what();
+        if (origin.empty() || what.find(origin) != std::string::npos || dynamic_cast<const ConfigError*>(&e)) throw;
+        throw InputError(origin + ": " + what);
+    }
+}
+
+void check_runnable(const std::vector<TrialConfig>& trials) {
+    std::set<std::string> seen;
+    for (const auto& t : trials) {
+        t.validate();
+        if (seen.insert(t.world.fingerprint() + "\n" + t.agent->key()).second) t.check_runnable();
+    }
 }
 
 std::string TrialConfig::world_label() const {
@@ -134,7 +157,11 @@ std::string TrialConfig::walk_key() const {
 std::string TrialConfig::canonical() const {
     // The analysis keys, with `extent` before decoding_templates as trial files have always had it.
     std::string lines = params::yaml_lines(analysis::AnalysisParams::table(), analysis, "  ");
-    lines.insert(lines.find("  decoding_templates:"), std::string("  extent: ") + (arena_extent ? "arena" : "data") + "\n");
+    std::string extent = arena_extent ? "arena" : "data";
+    if (!arena_extent && analysis.extent)  // fixed bounds (rare): named in full, so they change the fingerprint
+        extent = params::to_text(std::vector<double>{analysis.extent->xmin, analysis.extent->xmax, analysis.extent->ymin,
+                                                     analysis.extent->ymax});
+    lines.insert(lines.find("  decoding_templates:"), "  extent: " + extent + "\n");
     return walk_key() + config::model_to_yaml(model) + (weights ? weights->key() : "") + "analysis:\n" + lines;
 }
 

@@ -69,12 +69,17 @@ struct TrialConfig {
     // change the results. Empty condition: "<world>_<model>".
     std::string condition;
     std::vector<std::pair<std::string, std::string>> swept;
+    // Where the trial was described ("trial.yaml", "sweep.yaml, condition 3"), for messages; a label.
+    std::string origin;
 
     std::string condition_label() const;
     // The world's label, or for a trial without one the label of its returns (the recording).
     std::string world_label() const;
     // Throws InputError for impossible values (model, protocol, agent, analysis, durations).
     void validate() const;
+    // validate(), and what needs the world: it resolves (files exist, geometry sound) and the agent
+    // can run in it (room for the robot at the start points; a trajectory inside it).
+    void check_runnable() const;
     std::string name() const;  // "<condition>_seed<N>", the trial file's stem
     // Everything that determines the agent's steps (world, seed, protocol, agent), as text: trials
     // with equal keys can share one agent.
@@ -86,6 +91,9 @@ struct TrialConfig {
     // arena_extent asks for them.
     analysis::AnalysisParams analysis_params(const WorldDescription& world) const;
 };
+
+// check_runnable() for many trials, once per distinct world and agent.
+void check_runnable(const std::vector<TrialConfig>& trials);
 
 std::string protocol_name(Protocol::Kind k);
 Protocol::Kind parse_protocol(const std::string& name);

@@ -52,10 +52,24 @@ ModelSpec model_from(const YamlView& v) {
     }
 }
 
+// extent: data (the trajectory's bounds), arena (the walkable region's) or [xmin, xmax, ymin, ymax].
 void analysis_from(const YamlView& v, TrialConfig& t) {
     read_table(v, t.analysis, analysis::AnalysisParams::table(), {"extent"});
-    const std::string extent = v.get("extent", "data");
-    if (extent != "data" && extent != "arena") v["extent"].fail("must be 'data' or 'arena'");
+    if (!v.has("extent")) return;
+    const YamlView e = v["extent"];
+    if (e.is_sequence()) {
+        const auto b = e.as_doubles(4);
+        t.analysis.extent = analysis::Extent{b[0], b[1], b[2], b[3]};
+        try {
+            t.analysis.extent->validate();
+        } catch (const InputError& err) {
+            e.fail(err.what());
+        }
+        t.arena_extent = false;
+        return;
+    }
+    const std::string extent = e.as_string();
+    if (extent != "data" && extent != "arena") e.fail("must be data, arena or [xmin, xmax, ymin, ymax], got '" + extent + "'");
     t.arena_extent = extent == "arena";
 }
 
@@ -88,14 +102,20 @@ TrialConfig trial_from_yaml(const YamlView& v) {
     TrialConfig t;
     if (v.has("world")) t.world = world_from(v["world"]);
     if (v.has("model")) t.model = model_from(v["model"]);
-    if (v.has("seed")) {
-        const long long s = v["seed"].as_int();
-        if (s < 0) v["seed"].fail("must be >= 0");
-        t.seed = static_cast<std::uint64_t>(s);
-    }
+    if (v.has("seed")) t.seed = v["seed"].as_uint64();
     if (v.has("protocol")) read_table(v["protocol"], t.protocol, Protocol::table());
     t.agent = agent_from(v);
     if (v.has("analysis")) analysis_from(v["analysis"], t);
+    t.origin = v.file();
+    // What the sections allow one by one may still not fit together (too short a protocol for
+    // two samples, too many weights): reported at the key the check names.
+    try {
+        t.validate();
+    } catch (const params::ParamError& e) {
+        for (const char* section : {"protocol", "robot", "analysis"})
+            if (v.has(section) && v[section].is_map() && v[section].has(e.key())) v[section][e.key()].fail(e.reason());
+        v.fail(e.what());
+    }
     return t;
 }
 

@@ -5,20 +5,57 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/recording/scan_file.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 
 namespace bvc3d::config {
 
 namespace {
 
+// Numbers that are coordinates or sizes in meters: within ±max_coordinate.
+std::vector<double> meters(const YamlView& v, std::size_t n) {
+    const auto d = v.as_doubles(n);
+    for (double x : d)
+        if (std::abs(x) > max_coordinate)
+            v.fail("holds " + format_number(x) + ": coordinates and sizes must lie within ±" + format_number(max_coordinate) + " m");
+    return d;
+}
+
 Vec3 vec3(const YamlView& v) {
-    const auto d = v.as_doubles(3);
+    const auto d = meters(v, 3);
     return Vec3(d[0], d[1], d[2]);
 }
 
 Vec2 vec2(const YamlView& v) {
-    const auto d = v.as_doubles(2);
+    const auto d = meters(v, 2);
     return Vec2(d[0], d[1]);
+}
+
+// Whether two segments ab and cd cross or touch (shared endpoints of neighbors excluded by the caller).
+bool segments_meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+    const auto orient = [](const Vec2& p, const Vec2& q, const Vec2& r) {
+        const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+        return (v > 0) - (v < 0);
+    };
+    const auto on = [](const Vec2& p, const Vec2& q, const Vec2& r) {  // r on segment pq, given collinear
+        return std::min(p.x(), q.x()) <= r.x() && r.x() <= std::max(p.x(), q.x()) && std::min(p.y(), q.y()) <= r.y() &&
+               r.y() <= std::max(p.y(), q.y());
+    };
+    const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+    if (o1 != o2 && o3 != o4) return true;
+    return (o1 == 0 && on(a, b, c)) || (o2 == 0 && on(a, b, d)) || (o3 == 0 && on(c, d, a)) || (o4 == 0 && on(c, d, b));
+}
+
+// A simple polygon: no edge crosses another (a figure eight has no inside the robot can use).
+void check_simple(const YamlView& v, const Polygon2& poly) {
+    const auto& p = poly.points;
+    const std::size_t n = p.size();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j) {
+            if (j == i + 1 || (i == 0 && j == n - 1)) continue;  // neighbors share a corner
+            if (segments_meet(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]))
+                v.fail("edges " + std::to_string(i) + " and " + std::to_string(j) + " cross: the polygon must not intersect itself");
+        }
 }
 
 // rect: [xmin, ymin, xmax, ymax] or polygon: [[x, y], ...]
@@ -26,14 +63,16 @@ Polygon2 region_from_yaml(const YamlView& v) {
     v.expect_map({"rect", "polygon"});
     if (v.has("rect") == v.has("polygon")) v.fail("give exactly one of 'rect' or 'polygon'");
     if (v.has("rect")) {
-        const auto r = v["rect"].as_doubles(4);
+        const auto r = meters(v["rect"], 4);
         if (!(r[2] > r[0] && r[3] > r[1])) v["rect"].fail("needs xmin < xmax and ymin < ymax");
         return Polygon2::rectangle(r[0], r[1], r[2], r[3]);
     }
     const auto pv = v["polygon"];
+    if (pv.size() > 10000) pv.fail("has " + std::to_string(pv.size()) + " points; the limit is 10000");
     Polygon2 poly;
     for (std::size_t i = 0; i < pv.size(); ++i) poly.points.push_back(vec2(pv.at(i)));
     if (poly.points.size() < 3 || poly.area() <= 0) pv.fail("needs at least 3 points enclosing a positive area");
+    check_simple(pv, poly);
     return poly;
 }
 
@@ -71,8 +110,17 @@ std::string mesh_path(const YamlView& mesh) {
     return rel.is_absolute() ? rel.string() : (std::filesystem::path(mesh.directory()) / rel).string();
 }
 
+// Every vertex within ±max_coordinate (after scaling and placing).
+void check_coordinates(const YamlView& v, const TriangleMesh& m) {
+    for (const auto& p : m.vertices)
+        if (!p.allFinite() || p.cwiseAbs().maxCoeff() > max_coordinate)
+            v.fail("reaches (" + format_number(p.x()) + ", " + format_number(p.y()) + ", " + format_number(p.z()) +
+                   "): coordinates must lie within ±" + format_number(max_coordinate) + " m");
+}
+
 void check_mesh(const YamlView& v, const TriangleMesh& m) {
     if (m.empty()) v.fail("produces no triangles");
+    check_coordinates(v, m);
     for (std::size_t t = 0; t < m.size(); ++t) {
         const auto c = m.corners(t);
         if (triangle_double_area(c[0], c[1], c[2]) <= 1e-12) v.fail("is degenerate (zero area)");
@@ -132,7 +180,7 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         if (!(size.minCoeff() > 0)) v["size"].fail("all three sizes must be > 0");
         part.append(box_mesh(size), pose_from_yaml(v, "center"));
     } else if (kind == "quad") {
-        if (v.size() != 4) v.fail("a quad is a list of 4 corners [x, y, z], in order around it");
+        if (!v.is_sequence() || v.size() != 4) v.fail("a quad is a list of 4 corners [x, y, z], in order around it");
         Vec3 c[4];
         for (int i = 0; i < 4; ++i) c[i] = vec3(v.at(i));
         part.add_quad(c[0], c[1], c[2], c[3]);
@@ -164,6 +212,7 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         for (auto& p : loaded.vertices) p *= scale;
         part.append(loaded, pose_from_yaml(v, "position"));
         if (part.empty()) v.fail("mesh has no triangles");
+        check_coordinates(v, part);
         w.mesh.append(part);
         return;  // assimp already dropped degenerate triangles
     } else if (kind == "point_cloud") {
@@ -184,12 +233,15 @@ WorldDescription world_from_yaml(const YamlView& v) {
     v.expect_map({"name", "objects", "walkable", "start"});
     WorldDescription w;
     w.name = v.get("name", std::filesystem::path(v.file()).stem().string());
+    w.file = v.file();
     const YamlView objects = v["objects"];
     if (objects.size() == 0) objects.fail("lists no objects: a world needs geometry");
     std::optional<WorldDescription> arena;
     for (std::size_t i = 0; i < objects.size(); ++i) add_object(objects.at(i), w, arena);
 
     if (arena) w.tilt_deg = arena->tilt_deg;
+    if (static_cast<double>(w.mesh.size()) > max_mesh_triangles)
+        objects.fail("hold " + std::to_string(w.mesh.size()) + " triangles; the limit is " + format_number(max_mesh_triangles));
     if (v.has("walkable")) {
         w.walkable = region_from_yaml(v["walkable"]);
     } else if (arena) {
@@ -197,6 +249,11 @@ WorldDescription world_from_yaml(const YamlView& v) {
     } else {
         v.fail_key("walkable", "is required (the floor region the robot may use) unless the world has a cross_arena");
     }
+    // A floor with no geometry over it is a world the sensors cannot see.
+    Eigen::AlignedBox2d geometry;
+    for (const auto& p : w.mesh.vertices) geometry.extend(Vec2(p.x(), p.y()));
+    if (!geometry.intersects(w.walkable.bounds()))
+        (v.has("walkable") ? v["walkable"] : objects).fail("the walkable region lies entirely outside the world's geometry");
     if (v.has("start")) {
         const YamlView s = v["start"];
         if (s.has("points")) {
@@ -262,6 +319,7 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
         if (name == "spherical") return LidarSpec::spherical();
         v.fail("expected horizontal, spherical, or a sensor mapping");
     }
+    if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping");
     const std::string preset = v.get("preset", "");
     const bool own_rows = v.has("elevations") || v.has("elevations_deg");
     LidarSpec s;

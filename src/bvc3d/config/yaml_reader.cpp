@@ -1,8 +1,12 @@
 #include "bvc3d/config/yaml_reader.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
 #include "bvc3d/core/format.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,9 +15,12 @@
 namespace bvc3d::config {
 
 YamlView YamlView::load_file(const std::string& file) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw ConfigError(file, "", "is a folder, not a file");
+    if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec))
+        throw ConfigError(file, "", "is not a regular file");
     std::ifstream in(file);
     if (!in) {
-        std::error_code ec;
         throw ConfigError(file, "", std::filesystem::exists(file, ec) ? "cannot be opened for reading" : "file does not exist");
     }
     std::stringstream text;
@@ -21,8 +28,62 @@ YamlView YamlView::load_file(const std::string& file) {
     return load_string(text.str(), file);
 }
 
+namespace {
+
+// Counts the values of a document with its aliases expanded, as reading it would visit them: a
+// few lines of anchors and aliases can stand for billions of values (a "billion laughs"), which
+// are refused before the document is built.
+class ExpandedSize : public YAML::EventHandler {
+public:
+    static constexpr double limit = 1e6;
+    void OnDocumentStart(const YAML::Mark&) override {}
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark&, YAML::anchor_t anchor) override { value(1, anchor); }
+    void OnAlias(const YAML::Mark&, YAML::anchor_t anchor) override {
+        value(anchor < sizes_.size() ? sizes_[anchor] : 1, 0);
+    }
+    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, const std::string&) override { value(1, anchor); }
+    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+        open_.push_back({1, anchor});
+    }
+    void OnSequenceEnd() override { close(); }
+    void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+        open_.push_back({1, anchor});
+    }
+    void OnMapEnd() override { close(); }
+    double total() const { return total_; }
+
+private:
+    void value(double size, YAML::anchor_t anchor) {
+        if (anchor) record(anchor, size);
+        if (open_.empty()) total_ += size;
+        else open_.back().first += size;
+    }
+    void close() {
+        const auto [size, anchor] = open_.back();
+        open_.pop_back();
+        value(std::min(size, 2 * limit), anchor);
+    }
+    void record(YAML::anchor_t anchor, double size) {
+        if (sizes_.size() <= anchor) sizes_.resize(anchor + 1, 1);
+        sizes_[anchor] = size;
+    }
+    std::vector<std::pair<double, YAML::anchor_t>> open_;
+    std::vector<double> sizes_;
+    double total_ = 0;
+};
+
+}  // namespace
+
 YamlView YamlView::load_string(const std::string& text, const std::string& name) {
     try {
+        std::istringstream in(text);
+        YAML::Parser parser(in);
+        ExpandedSize size;
+        parser.HandleNextDocument(size);
+        if (size.total() > ExpandedSize::limit)
+            throw ConfigError(name, "", "its anchors and aliases expand to more than " +
+                                            std::to_string(static_cast<long long>(ExpandedSize::limit)) + " values");
         YAML::Node n = YAML::Load(text);
         if (!n.IsDefined() || n.IsNull()) throw ConfigError(name, "", "is empty");
         return YamlView(n, name);
@@ -57,7 +118,8 @@ void YamlView::expect_map(const std::vector<std::string>& allowed) const {
     if (!node_.IsMap()) fail("expected a mapping of keys to values");
     std::vector<std::string> seen;
     for (const auto& kv : node_) {
-        const std::string k = kv.first.as<std::string>();
+        if (!kv.first.IsScalar()) YamlView(kv.first, file_, path_).fail("a key must be a name, not a list or a mapping");
+        const std::string k = kv.first.Scalar();
         if (std::find(seen.begin(), seen.end(), k) != seen.end())
             YamlView(kv.first, file_, child_path(k)).fail("appears twice in the same mapping");
         seen.push_back(k);
@@ -91,7 +153,10 @@ std::size_t YamlView::size() const {
 std::vector<std::string> YamlView::keys() const {
     if (!node_.IsMap()) fail("expected a mapping of keys to values");
     std::vector<std::string> out;
-    for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+    for (const auto& kv : node_) {
+        if (!kv.first.IsScalar()) YamlView(kv.first, file_, path_).fail("a key must be a name, not a list or a mapping");
+        out.push_back(kv.first.Scalar());
+    }
     return out;
 }
 
@@ -114,6 +179,16 @@ long long YamlView::as_int() const {
     } catch (const YAML::Exception&) {
         fail("expected an integer, got '" + node_.Scalar() + "'");
     }
+}
+
+std::uint64_t YamlView::as_uint64() const {
+    if (!node_.IsScalar()) fail("expected a whole number from 0 to 18446744073709551615");
+    const std::string& text = node_.Scalar();
+    std::uint64_t v = 0;
+    const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size())
+        fail("expected a whole number from 0 to 18446744073709551615 (2^64 - 1), got '" + text + "'");
+    return v;
 }
 
 bool YamlView::as_bool() const {

@@ -3,6 +3,7 @@
 // reason, and unknown keys are rejected. All YAML mappings of bvc3d are written with it.
 #include <yaml-cpp/yaml.h>
 
+#include <cstdint>
 #include <functional>
 #include <initializer_list>
 #include <optional>
@@ -49,6 +50,7 @@ public:
 
     double as_double() const;  // finite number
     long long as_int() const;
+    std::uint64_t as_uint64() const;  // decimal digits only: 0 .. 2^64 - 1 (seeds)
     bool as_bool() const;
     std::string as_string() const;
     std::vector<double> as_doubles(std::optional<std::size_t> n = std::nullopt) const;

@@ -1,5 +1,6 @@
 #include "bvc3d/core/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -14,7 +15,34 @@ namespace {
 std::atomic<unsigned> counter{0};
 }
 
+// Collects text in 64 KiB blocks and hands each to AtomicFile::append.
+class AtomicFile::Buffer : public std::streambuf {
+public:
+    explicit Buffer(AtomicFile& file) : file_(file) { setp(block_, block_ + sizeof block_); }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (!drain()) return traits_type::eof();
+        if (!traits_type::eq_int_type(c, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(c);
+            pbump(1);
+        }
+        return traits_type::not_eof(c);
+    }
+    int sync() override { return drain() ? 0 : -1; }
+
+private:
+    bool drain() {
+        const bool ok = file_.append(pbase(), static_cast<std::size_t>(pptr() - pbase()));
+        setp(block_, block_ + sizeof block_);
+        return ok;
+    }
+    AtomicFile& file_;
+    char block_[1 << 16];
+};
+
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+    require_not_directory(target_, "output file");
     temp_ = target_;
     temp_ += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
     const auto dir = target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
@@ -22,53 +50,72 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
 }
 
 AtomicFile::~AtomicFile() {
+    stream_.reset();
+    buffer_.reset();
+    if (fd_ >= 0) ::close(fd_);
     if (committed_) return;
-    if (out_.is_open()) out_.close();
     std::error_code ec;
     std::filesystem::remove(temp_, ec);
 }
 
-namespace {
-// Why the last write failed: the system's reason when it left one.
-std::string write_failure(const std::filesystem::path& target, int error) {
-    return "cannot write '" + target.string() + "': " + (error ? std::strerror(error) : "write error");
+void AtomicFile::fail(int error) const {
+    throw InputError("cannot write '" + target_.string() + "': " + std::strerror(error));
 }
-}  // namespace
 
-std::ofstream& AtomicFile::stream() {
-    if (!out_.is_open()) {
-        errno = 0;
-        out_.open(temp_, std::ios::out | std::ios::trunc | std::ios::binary);
-        if (!out_) throw InputError(write_failure(target_, errno));
+void AtomicFile::open() {
+    if (fd_ >= 0) return;
+    fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd_ < 0) fail(errno);
+}
+
+bool AtomicFile::append(const char* data, std::size_t n) {
+    if (error_) return false;
+    if (fd_ < 0) {
+        fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+        if (fd_ < 0) {
+            error_ = errno;
+            return false;
+        }
     }
-    return out_;
+    while (n > 0) {
+        const ssize_t k = ::write(fd_, data, n);
+        if (k < 0) {
+            if (errno == EINTR) continue;
+            error_ = errno;
+            return false;
+        }
+        data += k;
+        n -= static_cast<std::size_t>(k);
+    }
+    return true;
+}
+
+std::ostream& AtomicFile::stream() {
+    if (!stream_) {
+        open();
+        buffer_ = std::make_unique<Buffer>(*this);
+        stream_ = std::make_unique<std::ostream>(buffer_.get());
+    }
+    return *stream_;
 }
 
 void AtomicFile::write(std::string_view bytes) {
-    std::ofstream& out = stream();
-    errno = 0;
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw InputError(write_failure(target_, errno));
+    if (stream_) stream_->flush();
+    if (!append(bytes.data(), bytes.size())) fail(error_);
 }
 
 void AtomicFile::commit() {
-    if (out_.is_open()) {
-        errno = 0;
-        out_.flush();
-        if (!out_) throw InputError(write_failure(target_, errno));
-        out_.close();
-        if (out_.fail()) throw InputError(write_failure(target_, errno));
-    }
+    if (stream_) stream_->flush();
+    if (error_) fail(error_);
+    open();
+    // close() can report a delayed write error (network file systems): check it too.
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) fail(errno);
     std::error_code ec;
     std::filesystem::rename(temp_, target_, ec);
     if (ec) throw InputError("cannot write '" + target_.string() + "': " + ec.message());
     committed_ = true;
-}
-
-void write_file_atomically(const std::filesystem::path& target, std::string_view bytes) {
-    AtomicFile file(target);
-    file.write(bytes);
-    file.commit();
 }
 
 void ensure_writable_directory(const std::filesystem::path& dir) {
@@ -90,6 +137,12 @@ void ensure_writable_directory(const std::filesystem::path& dir) {
     }
     if (::access(dir.c_str(), W_OK) != 0)
         throw InputError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+}
+
+void require_not_directory(const std::filesystem::path& path, const std::string& what) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw InputError(what + " '" + path.string() + "' is a folder, not a file");
 }
 
 }  // namespace bvc3d

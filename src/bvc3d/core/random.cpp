@@ -32,8 +32,10 @@ std::string Rng::state() const {
 
 void Rng::set_state(const std::string& s) {
     std::istringstream is(s);
-    is >> engine_;
+    auto engine = engine_;
+    is >> engine;
     if (!is) throw InputError("random generator state is corrupt");
+    engine_ = engine;
 }
 
 namespace {

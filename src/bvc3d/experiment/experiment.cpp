@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -44,11 +45,12 @@ std::vector<Group> make_groups(const std::vector<TrialConfig>& trials, const std
     return groups;
 }
 
-// The progress line: trials done, simulated hours, steps per second, time left.
+// Progress: trials done, simulated hours, steps per second, time left. On a terminal one line
+// rewritten in place; otherwise a line per finished trial and per tenth of the simulated time.
 class Progress {
 public:
-    Progress(bool on, int total_trials, double total_seconds)
-        : on_(on), total_trials_(total_trials), total_seconds_(total_seconds), start_(Clock::now()) {}
+    Progress(ProgressStyle style, int total_trials, double total_seconds)
+        : style_(style), total_trials_(total_trials), total_seconds_(total_seconds), start_(Clock::now()) {}
     void add(double seconds, std::int64_t walk_steps, std::int64_t models) {
         seconds_.fetch_add(seconds);
         live_model_steps_.fetch_add(walk_steps * models);
@@ -59,36 +61,110 @@ public:
     }
     std::int64_t steps() const { return steps_.load(); }
     std::int64_t model_steps() const { return model_steps_.load(); }
-    void trial_done() { trials_.fetch_add(1); }
-    void print(bool final = false) {
-        if (!on_) return;
-        std::lock_guard lock(mutex_);
-        const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
-        const double done = seconds_.load();
-        char left[32] = "?";
-        if (final || done > 0) std::snprintf(left, sizeof left, "%.0f", final ? wall : wall * (total_seconds_ - done) / done);
-        std::fprintf(stderr, "\r  %d/%d trials  %.1f/%.1f simulated hours  %.0f model steps/s  %s%s s       %s",
-                     trials_.load(), total_trials_, done / 3600, total_seconds_ / 3600,
-                     wall > 0 ? static_cast<double>(live_model_steps_.load()) / wall : 0.0, final ? "took " : "~", left,
-                     final ? "\n" : "");
-        std::fflush(stderr);
+    void trial_done(const std::string& name) {
+        trials_.fetch_add(1);
+        if (style_ == ProgressStyle::lines) line(name);
+    }
+    // From the watcher thread, every fraction of a second.
+    void tick() {
+        if (style_ == ProgressStyle::terminal) {
+            terminal(false);
+        } else if (style_ == ProgressStyle::lines && total_seconds_ > 0) {
+            const int tenth = static_cast<int>(10 * seconds_.load() / total_seconds_);
+            if (tenth > printed_tenth_ && tenth < 10) {
+                printed_tenth_ = tenth;
+                line("");
+            }
+        }
+    }
+    void finish() {
+        if (style_ == ProgressStyle::terminal) terminal(true);
+        else if (style_ == ProgressStyle::lines && total_trials_ > 0) line("done");
     }
 
 private:
-    bool on_;
+    double wall() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+    std::string left() const {
+        const double done = seconds_.load();
+        if (!(done > 0)) return "?";
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.0f", wall() * std::max(0.0, total_seconds_ - done) / done);
+        return buf;
+    }
+    void terminal(bool final) {
+        std::lock_guard lock(mutex_);
+        const double w = wall();
+        std::fprintf(stderr, "\r  %d/%d trials  %.1f/%.1f simulated hours  %.0f model steps/s  %s%s s       %s",
+                     trials_.load(), total_trials_, seconds_.load() / 3600, total_seconds_ / 3600,
+                     w > 0 ? static_cast<double>(live_model_steps_.load()) / w : 0.0, final ? "took " : "~",
+                     final ? std::to_string(static_cast<long long>(w + 0.5)).c_str() : left().c_str(), final ? "\n" : "");
+        std::fflush(stderr);
+    }
+    // "bvc3d: 3/16 trials done (cross-30_2d_seed0), 0.40/1.60 simulated hours (25%), ~95 s left"
+    void line(const std::string& what) {
+        std::lock_guard lock(mutex_);
+        const double done = std::min(seconds_.load(), total_seconds_);
+        std::string text = "bvc3d: " + std::to_string(trials_.load()) + "/" + std::to_string(total_trials_) + " trials done";
+        if (!what.empty() && what != "done") text += " (" + what + ")";
+        char buf[160];
+        if (what == "done") {
+            std::snprintf(buf, sizeof buf, ", %.2f simulated hours in %.0f s", total_seconds_ / 3600, wall());
+        } else {
+            std::snprintf(buf, sizeof buf, ", %.2f/%.2f simulated hours (%.0f%%), ~%s s left", done / 3600,
+                          total_seconds_ / 3600, total_seconds_ > 0 ? 100 * done / total_seconds_ : 100.0, left().c_str());
+        }
+        std::fprintf(stderr, "%s%s\n", text.c_str(), buf);
+        std::fflush(stderr);
+    }
+
+    ProgressStyle style_;
     int total_trials_;
     double total_seconds_;
     Clock::time_point start_;
     std::atomic<double> seconds_{0};
     std::atomic<std::int64_t> steps_{0}, model_steps_{0}, live_model_steps_{0};
     std::atomic<int> trials_{0};
+    int printed_tenth_ = 0;  // the watcher's
     std::mutex mutex_;
 };
+
+// The peak memory of one group of trials sharing an agent.
+double group_memory(const std::vector<const TrialConfig*>& group) {
+    const TrialConfig& first = *group.front();
+    const double samples = first.protocol.sample_hours * 3600.0 * first.agent->steps_per_second() + 64;
+    double bytes = samples * 5 * sizeof(double);  // t, x, y, z, heading
+    double largest_trial = 0;
+    for (const auto* t : group) {
+        const double n_place = t->model.place.n_place, n_bvc = t->model.bvc.n_cells();
+        const double gridsize = t->analysis.gridsize;
+        const double bins = std::min(samples, 1.2 * gridsize * gridsize);  // hexagons visited, at most
+        const double recorded = samples * n_place * sizeof(float) + (t->protocol.record_bvc ? samples * n_bvc * sizeof(float) : 0);
+        const double weights = n_place * n_bvc * sizeof(float);
+        const double analysis = 4 * bins * n_place * sizeof(double) + samples * n_place * sizeof(double) / 8;
+        const double scan = static_cast<double>(t->model.sensor.beam_count()) * 3 * sizeof(double);
+        bytes += recorded + 3 * weights + scan;
+        largest_trial = std::max(largest_trial, analysis + recorded + weights);  // analyzed and written one at a time
+    }
+    // A checkpoint copies the samples since the last one; a trial file is built in memory first.
+    return bytes + largest_trial + samples * 5 * sizeof(double) + 64e6;
+}
 
 }  // namespace
 
 std::filesystem::path trial_path(const std::filesystem::path& out_dir, const TrialConfig& t) {
     return out_dir / (t.name() + ".h5");
+}
+
+double estimate_memory(const std::vector<TrialConfig>& trials, int jobs) {
+    std::map<std::string, std::vector<const TrialConfig*>> groups;
+    for (const auto& t : trials) groups[t.walk_key()].push_back(&t);
+    std::vector<double> sizes;
+    for (const auto& [key, group] : groups) sizes.push_back(group_memory(group));
+    std::sort(sizes.begin(), sizes.end(), std::greater<>());
+    const auto threads = static_cast<std::size_t>(jobs > 0 ? jobs : std::max(1u, std::thread::hardware_concurrency()));
+    double total = 0;
+    for (std::size_t i = 0; i < std::min(threads, sizes.size()); ++i) total += sizes[i];
+    return total;
 }
 
 namespace {
@@ -140,11 +216,9 @@ private:
 
 void ExperimentRun::check_trials() const {
     std::set<std::string> names;
-    for (const auto& t : trials_) {
+    for (const auto& t : trials_)
         if (!names.insert(t.name()).second) throw InputError("two trials would share the file name '" + t.name() + "'");
-        t.validate();
-        t.world.resolve();  // fail early on bad worlds
-    }
+    check_runnable(trials_);  // fail early on bad worlds, start points and robots
     ensure_writable_directory(options_.out_dir);
 }
 
@@ -188,7 +262,7 @@ void ExperimentRun::run_group(const Group& g) {
     const GroupOutcome done = run_analyze_write(members, paths, control);
     for (const auto& m : members) {
         if (options_.on_trial_done) options_.on_trial_done(m.name());
-        progress_->trial_done();
+        progress_->trial_done(m.name());
         ++ran_;
     }
     progress_->add_steps(done.result.stats.explore_steps + done.result.stats.sample_steps, n_models);
@@ -233,18 +307,21 @@ ExperimentOutcome ExperimentRun::run() {
         todo_trials += static_cast<int>(groups_[g].members.size());
     }
     if (!pending_.empty()) ensure_writable_directory(ckpt_dir_);
-    progress_ = std::make_unique<Progress>(options_.progress && coord_.is_root(), todo_trials, total_seconds);
+    progress_ = std::make_unique<Progress>(coord_.is_root() ? options_.progress : ProgressStyle::none, todo_trials,
+                                           total_seconds);
     {
         // Stop everything on Ctrl-C or on the first error.
         std::jthread watcher([&](std::stop_token st) {
             while (!st.stop_requested()) {
                 if ((options_.stop && options_.stop->load()) || failed_.load()) stop_all_ = true;
-                progress_->print();
+                progress_->tick();
                 std::this_thread::sleep_for(std::chrono::milliseconds(200));
             }
         });
-        const int jobs =
-            options_.jobs > 0 ? options_.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+        // More threads than groups would only wait.
+        const int jobs = static_cast<int>(std::min<std::size_t>(
+            options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency()),
+            std::max<std::size_t>(pending_.size(), 1)));
         {
             std::vector<std::jthread> workers;
             for (int j = 0; j < jobs; ++j) workers.emplace_back([this] { work(); });
@@ -253,7 +330,7 @@ ExperimentOutcome ExperimentRun::run() {
     }
     if (error_) std::rethrow_exception(error_);
     if (interrupted_ && !failed_) throw Interrupted();
-    progress_->print(true);
+    progress_->finish();
     std::error_code ec;
     std::filesystem::remove(ckpt_dir_, ec);  // only if empty
     outcome.skipped = complete_before;

@@ -14,10 +14,14 @@
 
 namespace bvc3d {
 
+// Progress on standard error: none, one line rewritten in place (a terminal), or plain lines
+// (one per finished trial, and one per tenth of the work for long trials: logs and batch jobs).
+enum class ProgressStyle { none, terminal, lines };
+
 struct ExperimentOptions {
     std::filesystem::path out_dir = "results";
     int jobs = 0;                              // threads; 0: every core
-    bool progress = false;                     // a progress line on standard error
+    ProgressStyle progress = ProgressStyle::none;
     double checkpoint_minutes = 0;             // periodic checkpoints (simulated minutes); 0: on interrupt only
     const std::atomic<bool>* stop = nullptr;   // Ctrl-C: checkpoint and stop
     std::function<void(const std::string& name)> on_trial_done;  // called from worker threads
@@ -46,6 +50,11 @@ struct ExperimentOutcome {
 };
 
 std::filesystem::path trial_path(const std::filesystem::path& out_dir, const TrialConfig& t);
+
+// Bytes a run of these trials needs at its peak with `jobs` groups at once (0: every core): the
+// recorded samples, weights, analysis and file images of the largest groups. An estimate, for
+// refusing runs that cannot fit (core/memory.hpp) before they start.
+double estimate_memory(const std::vector<TrialConfig>& trials, int jobs);
 
 // Throws InputError for bad configurations (before anything runs) and Interrupted if stopped.
 // Without a coordinator, options.jobs threads share the work.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <cmath>
 
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/core/error.hpp"
@@ -102,21 +103,33 @@ MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::An
     return r;
 }
 
-analysis::AnalysisParams stored_analysis_params(const TrialFileData& file) {
+analysis::AnalysisParams stored_analysis_params(const TrialFileData& file, const std::filesystem::path& path) {
     analysis::AnalysisParams p;
     const auto& table = analysis::AnalysisParams::table();
+    const auto where = [&](const std::string& name) { return "trial file '" + path.string() + "': attribute '/metrics/" + name + "'"; };
     bool any = false;
     for (const auto& [name, value] : file.metric_attributes) {
         const auto* f = table.find(name);
         if (!f) continue;
         params::Value v = value;
-        if (f->kind == params::Kind::integer && std::holds_alternative<double>(v))
-            v = static_cast<long long>(std::get<double>(v));
+        const bool number = f->kind == params::Kind::real || f->kind == params::Kind::integer;
+        if (f->kind == params::Kind::integer && std::holds_alternative<double>(v)) {
+            const double d = std::get<double>(v);
+            if (!(std::abs(d) < 1e15) || d != std::floor(d)) throw InputError(where(name) + " must be a whole number");
+            v = static_cast<long long>(d);
+        }
+        if (f->kind == params::Kind::real && std::holds_alternative<long long>(v))
+            v = static_cast<double>(std::get<long long>(v));
+        const bool right_type = number ? (std::holds_alternative<double>(v) || std::holds_alternative<long long>(v))
+                                       : std::holds_alternative<std::string>(v);
+        if (!right_type) throw InputError(where(name) + " has the wrong type");
         try {
             table.set(p, *f, v);
             any = true;
+        } catch (const params::ParamError& e) {
+            throw InputError(where(name) + ": " + e.reason());
         } catch (const std::bad_variant_access&) {
-            throw InputError("trial file '" + file.name + "': /metrics attribute '" + name + "' has the wrong type");
+            throw InputError(where(name) + " has the wrong type");
         }
     }
     // Files from before the template choice was recorded decoded with raw means.
@@ -126,6 +139,21 @@ analysis::AnalysisParams stored_analysis_params(const TrialFileData& file) {
     if (file.extent && file.extent->size() == 4)
         p.extent = analysis::Extent{(*file.extent)[0], (*file.extent)[1], (*file.extent)[2], (*file.extent)[3]};
     return p;
+}
+
+analysis::Extent arena_extent(const TrialFileData& file, const std::filesystem::path& path) {
+    WorldSpec spec;
+    spec.source = file.world_source.empty() ? std::string("cross") : file.world_source;
+    if (spec.source == "cross" && std::isfinite(file.tilt_deg)) spec.tilt_deg = file.tilt_deg;
+    WorldDescription world;
+    try {
+        world = spec.resolve();
+    } catch (const InputError& e) {
+        throw InputError("--extent arena: the world of trial file '" + path.string() + "' ('" + spec.source +
+                         "') cannot be loaded again (" + e.what() + "); give the bounds as XMIN,XMAX,YMIN,YMAX");
+    }
+    const auto box = world.walkable.bounds();
+    return analysis::Extent{box.min().x(), box.max().x(), box.min().y(), box.max().y()};
 }
 
 bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t) {

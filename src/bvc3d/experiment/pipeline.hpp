@@ -34,8 +34,12 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
 // What a trial file records of a trial: its identity and configuration, and its metrics.
 TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world);
 MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& params);
-// The analysis parameters a trial file's metrics were computed with (defaults for what it lacks).
-analysis::AnalysisParams stored_analysis_params(const TrialFileData& file);
+// The analysis parameters a trial file's metrics were computed with (defaults for what it lacks);
+// a stored value of the wrong type or out of its limits is an InputError naming `path` and the key.
+analysis::AnalysisParams stored_analysis_params(const TrialFileData& file, const std::filesystem::path& path);
+// The bounds of the walkable region of the trial's world (its `world_source` and `tilt_deg`), for
+// `--extent arena`; an InputError naming `path` when the world cannot be found again.
+analysis::Extent arena_extent(const TrialFileData& file, const std::filesystem::path& path);
 
 // True if `path` holds this trial, complete, with every metric the analysis stage now reports.
 bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t);

@@ -1,6 +1,7 @@
 #include "bvc3d/experiment/trial_runner.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "bvc3d/bvc/boundary_vector_layer.hpp"
@@ -181,7 +182,21 @@ GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {
 }
 
 void GroupRun::restore(const GroupCheckpoint& c) {
-    if (c.partial.models.size() != nets.size()) throw InputError("checkpoint does not match the group");
+    // Everything is checked before anything changes: a checkpoint that does not fit leaves the run
+    // as it was, to start from the beginning.
+    const auto mismatch = [] { throw InputError("its arrays do not match the group's models"); };
+    if (c.partial.models.size() != nets.size() || c.membrane.size() != nets.size() || c.place_rates.size() != nets.size())
+        mismatch();
+    for (std::size_t i = 0; i < nets.size(); ++i) {
+        const auto& m = c.partial.models[i];
+        if (m.n_place != result.models[i].n_place || m.n_bvc != result.models[i].n_bvc ||
+            m.weights.size() != static_cast<std::size_t>(m.n_place) * static_cast<std::size_t>(m.n_bvc) ||
+            c.membrane[i].size() != static_cast<std::size_t>(m.n_place) ||
+            c.place_rates[i].size() != static_cast<std::size_t>(m.n_place))
+            mismatch();
+        for (float w : m.weights)
+            if (!std::isfinite(w)) throw InputError("its weights are not finite");
+    }
     agent->restore_state(c.agent_state);
     step_index = c.step_index;
     ckpt_segments = c.segments;
@@ -216,9 +231,25 @@ GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& 
     const auto& returns = trials.front().returns;
     GroupRun run(world, trials, sources || !returns ? sources : returns->factory(trials.front().seed));
     const std::string fingerprint = group_fingerprint(trials);
-    if (!control.checkpoint.empty() && std::filesystem::exists(control.checkpoint)) {
+    if (!control.checkpoint.empty()) {
+        const auto warn = [&](const std::string& message) {
+            if (control.warn) control.warn(message);
+            else std::fprintf(stderr, "bvc3d: warning: %s\n", message.c_str());
+        };
         const auto saved = read_checkpoint(control.checkpoint);
-        if (saved && saved->fingerprint == fingerprint) run.restore(*saved);
+        if (!saved.problem.empty()) {
+            warn(saved.problem + "; the trial starts again from the beginning");
+        } else if (saved.checkpoint && saved.checkpoint->fingerprint != fingerprint) {
+            warn("checkpoint '" + control.checkpoint.string() +
+                 "' belongs to another configuration; the trial starts from the beginning");
+        } else if (saved.checkpoint) {
+            try {
+                run.restore(*saved.checkpoint);
+            } catch (const InputError& e) {
+                warn("checkpoint '" + control.checkpoint.string() + "' does not fit this trial (" + e.what() +
+                     "); the trial starts again from the beginning");
+            }
+        }
     }
     const Protocol& p = trials.front().protocol;
     const bool online = p.kind == Protocol::Kind::online;

@@ -14,16 +14,11 @@
 #include <vector>
 
 #include "bvc3d/config/trial_config.hpp"
+#include "bvc3d/core/cancel.hpp"  // Interrupted: thrown when RunControl::stop is set, after the checkpoint
 #include "bvc3d/recorder/trial_record.hpp"
 #include "bvc3d/sensor/return_source.hpp"
 
 namespace bvc3d {
-
-// Thrown when RunControl::stop is set; the group's checkpoint (if any) was written first.
-class Interrupted : public std::runtime_error {
-public:
-    Interrupted() : std::runtime_error("interrupted") {}
-};
 
 struct RunControl {
     const std::atomic<bool>* stop = nullptr;            // checked every few steps
@@ -31,6 +26,8 @@ struct RunControl {
     std::int64_t progress_every = 512;                  // a replay's steps are few and slow: every step
     std::filesystem::path checkpoint;                   // empty: no checkpoints
     double checkpoint_minutes = 0;                      // > 0: also every this many simulated minutes
+    // Warnings (a checkpoint that cannot be used, ...); default: a line on standard error.
+    std::function<void(const std::string& message)> warn;
 };
 
 // Where each model's returns come from (config/returns_spec.hpp): `sources` if given, else the

@@ -9,7 +9,8 @@ namespace bvc3d::kernels {
 void matvec8(const float* W, std::size_t stride, const float* v, std::size_t n, int rows, float* out);
 // Σ_j v[j], n a multiple of 8.
 float sum8(const float* v, std::size_t n);
-// Oja's update of one row: w[j] += a·(v[j] - c·w[j]).
-void oja_row(float* w, const float* v, float a, float c, std::size_t n);
+// Oja's update of one row: w[j] += a·(v[j] - c·w[j]), a result smaller than `tiny` in magnitude
+// stored as 0; n a multiple of 8.
+void oja_row(float* w, const float* v, float a, float c, float tiny, std::size_t n);
 
 }  // namespace bvc3d::kernels

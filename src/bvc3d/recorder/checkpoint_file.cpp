@@ -1,5 +1,7 @@
 #include "bvc3d/recorder/checkpoint_file.hpp"
 
+#include <algorithm>
+
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recorder/hdf5_io.hpp"
@@ -16,9 +18,10 @@ std::filesystem::path segment_path(const std::filesystem::path& state, std::size
 
 void write_segment(const std::filesystem::path& path, const GroupResult& r) {
     AtomicFile out(path);
+    std::string image;
     {
         auto lock = h5::hdf5_lock();
-        const auto f = h5::create_file(out.temp_path().string());
+        const auto f = h5::create_memory_file(out.temp_path().string());
         const std::size_t n = r.t.size();
         h5::write_attr(f, "format", std::string("bvc3d-checkpoint-segment"));
         h5::write_attr(f, "samples", static_cast<std::int64_t>(n));
@@ -31,7 +34,9 @@ void write_segment(const std::filesystem::path& path, const GroupResult& r) {
             h5::write(f, "rates" + std::to_string(i), r.models[i].rates, {r.models[i].rates.size()});
             h5::write(f, "bvc" + std::to_string(i), r.models[i].bvc, {r.models[i].bvc.size()});
         }
+        image = h5::file_image(f);
     }
+    out.write(image);
     out.commit();
 }
 
@@ -41,17 +46,23 @@ void append(std::vector<T>& to, const std::vector<T>& from) {
 }
 
 void read_segment(const std::filesystem::path& path, GroupResult& r) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw InputError("its segment '" + path.string() + "' is missing");
     auto lock = h5::hdf5_lock();
-    const auto f = h5::open_file(path.string());
-    if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint-segment") throw InputError("not a checkpoint segment");
-    append(r.t, h5::read_doubles(f, "t"));
-    append(r.x, h5::read_doubles(f, "x"));
-    append(r.y, h5::read_doubles(f, "y"));
-    append(r.z, h5::read_doubles(f, "z"));
-    append(r.heading, h5::read_doubles(f, "heading"));
-    for (std::size_t i = 0; i < r.models.size(); ++i) {
-        append(r.models[i].rates, h5::read_floats(f, "rates" + std::to_string(i)));
-        append(r.models[i].bvc, h5::read_floats(f, "bvc" + std::to_string(i)));
+    try {
+        const auto f = h5::open_file(path.string());
+        if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint-segment") throw InputError("not a checkpoint segment");
+        append(r.t, h5::read_doubles(f, "t"));
+        append(r.x, h5::read_doubles(f, "x"));
+        append(r.y, h5::read_doubles(f, "y"));
+        append(r.z, h5::read_doubles(f, "z"));
+        append(r.heading, h5::read_doubles(f, "heading"));
+        for (std::size_t i = 0; i < r.models.size(); ++i) {
+            append(r.models[i].rates, h5::read_floats(f, "rates" + std::to_string(i)));
+            append(r.models[i].bvc, h5::read_floats(f, "bvc" + std::to_string(i)));
+        }
+    } catch (const InputError& e) {
+        throw InputError("its segment '" + path.string() + "' is unreadable (" + e.what() + ")");
     }
 }
 
@@ -62,9 +73,10 @@ void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c) {
     if (fresh > 0) write_segment(segment_path(path, c.segments), c.partial);
     const std::size_t segments = c.segments + (fresh > 0 ? 1 : 0), saved = c.saved + fresh;
     AtomicFile out(path);
+    std::string image;
     {
         auto lock = h5::hdf5_lock();
-        const auto f = h5::create_file(out.temp_path().string());
+        const auto f = h5::create_memory_file(out.temp_path().string());
         h5::write_attr(f, "format", std::string("bvc3d-checkpoint"));
         h5::write_attr(f, "fingerprint", c.fingerprint);
         h5::write_attr(f, "segments", static_cast<std::int64_t>(segments));
@@ -86,23 +98,29 @@ void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c) {
             h5::write(g, "membrane", c.membrane[i], {c.membrane[i].size()}, false);
             h5::write(g, "place_rates", c.place_rates[i], {c.place_rates[i].size()}, false);
         }
+        image = h5::file_image(f);
     }
+    out.write(image);
     out.commit();
     c.segments = segments;
     c.saved = saved;
 }
 
-std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path) {
+CheckpointRead read_checkpoint(const std::filesystem::path& path) {
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) return std::nullopt;
+    if (!std::filesystem::exists(path, ec)) return {};
+    const auto broken = [&](const std::string& why) { return CheckpointRead{std::nullopt, "checkpoint '" + path.string() + "' " + why}; };
+    GroupCheckpoint c;
     try {
         auto lock = h5::hdf5_lock();
         const auto f = h5::open_file(path.string());
-        if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint") return std::nullopt;
-        GroupCheckpoint c;
+        if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint") return broken("is not a bvc3d checkpoint");
         c.fingerprint = h5::read_attr_string(f, "fingerprint");
-        c.segments = static_cast<std::size_t>(h5::read_attr_int(f, "segments"));
-        c.saved = static_cast<std::size_t>(h5::read_attr_int(f, "samples"));
+        const auto segments = h5::read_attr_int(f, "segments"), saved = h5::read_attr_int(f, "samples");
+        const auto n_models = h5::read_attr_int(f, "n_models");
+        if (segments < 0 || saved < 0 || n_models < 0 || n_models > 1000000) return broken("has impossible counts");
+        c.segments = static_cast<std::size_t>(segments);
+        c.saved = static_cast<std::size_t>(saved);
         c.step_index = h5::read_attr_int(f, "step_index");
         c.agent_state = h5::read_attr_string(f, "agent_state");
         auto& s = c.partial.stats;
@@ -110,7 +128,6 @@ std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path
         s.sample_steps = h5::read_attr_int(f, "sample_steps");
         s.bumps = h5::read_attr_int(f, "bumps");
         s.full_scan_fallbacks = h5::read_attr_int(f, "full_scan_fallbacks");
-        const auto n_models = h5::read_attr_int(f, "n_models");
         for (std::int64_t i = 0; i < n_models; ++i) {
             const auto mg = h5::open_group(f, "model" + std::to_string(i));
             ModelRecord m;
@@ -122,13 +139,18 @@ std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path
             c.partial.models.push_back(std::move(m));
         }
         for (std::size_t k = 0; k < c.segments; ++k) read_segment(segment_path(path, k), c.partial);
-        if (c.partial.t.size() != c.saved) return std::nullopt;
-        for (const auto& m : c.partial.models)
-            if (m.rates.size() != c.saved * static_cast<std::size_t>(m.n_place)) return std::nullopt;
-        return c;
-    } catch (const InputError&) {
-        return std::nullopt;
+    } catch (const InputError& e) {
+        const std::string why = e.what();
+        return broken(why.rfind("its segment", 0) == 0 ? why : "is unreadable or truncated (" + why + ")");
     }
+    if (c.partial.t.size() != c.saved)
+        return broken("holds " + std::to_string(c.partial.t.size()) + " samples in its segments, not the " +
+                      std::to_string(c.saved) + " it lists");
+    for (const auto& m : c.partial.models)
+        if (m.n_place < 1 || m.rates.size() != c.saved * static_cast<std::size_t>(m.n_place) ||
+            m.weights.size() != static_cast<std::size_t>(m.n_place) * static_cast<std::size_t>(std::max(m.n_bvc, 0)))
+            return broken("has arrays of the wrong size");
+    return {std::move(c), ""};
 }
 
 void remove_checkpoint(const std::filesystem::path& path) {

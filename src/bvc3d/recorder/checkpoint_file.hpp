@@ -5,6 +5,7 @@
 // (which lists the segments) last, so a crash leaves the previous checkpoint usable.
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "bvc3d/recorder/trial_record.hpp"
 
@@ -13,9 +14,14 @@ namespace bvc3d {
 // Writes c.partial's samples as segment number c.segments (unless there are none) and the state,
 // then advances c.segments and c.saved. c.partial holds only the samples recorded since c.saved.
 void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c);
-// The whole checkpoint with every segment's samples joined, or nullopt if the files are missing or
-// not a readable, consistent checkpoint (a stale or broken one is ignored).
-std::optional<GroupCheckpoint> read_checkpoint(const std::filesystem::path& path);
+// The whole checkpoint with every segment's samples joined, or why there is none to use: nothing
+// when the state file does not exist; otherwise `problem` says what is wrong (unreadable,
+// truncated, a segment missing, inconsistent), naming the file.
+struct CheckpointRead {
+    std::optional<GroupCheckpoint> checkpoint;
+    std::string problem;
+};
+CheckpointRead read_checkpoint(const std::filesystem::path& path);
 // Removes the state file and its segments.
 void remove_checkpoint(const std::filesystem::path& path);
 

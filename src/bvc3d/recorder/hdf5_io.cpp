@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/memory.hpp"
 
 namespace bvc3d::h5 {
 
@@ -54,6 +55,9 @@ std::vector<T> read_any(hid_t loc, const std::string& name, hid_t mem_type) {
     Handle ds(check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), "no dataset '" + name + "'"), H5Dclose);
     Handle space(check(H5Dget_space(ds), "space " + name), H5Sclose);
     const hssize_t n = H5Sget_simple_extent_npoints(space);
+    // A damaged or hostile file may claim any size: refuse what cannot fit before allocating it.
+    if (const double bytes = static_cast<double>(std::max<hssize_t>(n, 0)) * sizeof(T); bytes > 1e8)
+        check_memory(bytes, "dataset '" + name + "'", "the file is probably damaged");
     std::vector<T> out(static_cast<std::size_t>(std::max<hssize_t>(n, 0)));
     if (n > 0) check(H5Dread(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), "read " + name);
     return out;
@@ -90,11 +94,24 @@ void Handle::reset() {
     id_ = -1;
 }
 
-Handle create_file(const std::string& path) {
+Handle create_memory_file(const std::string& name) {
     auto lock = hdf5_lock();
     Handle fcpl(check(H5Pcreate(H5P_FILE_CREATE), "plist"), H5Pclose);
     check(H5Pset_obj_track_times(fcpl, false), "track times");
-    return Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT), "cannot create '" + path + "'"), H5Fclose);
+    Handle fapl(check(H5Pcreate(H5P_FILE_ACCESS), "plist"), H5Pclose);
+    check(H5Pset_fapl_core(fapl, 1 << 20, false), "core driver");  // grows by 1 MiB, no backing file
+    return Handle(check(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, fcpl, fapl), "cannot create '" + name + "' in memory"),
+                  H5Fclose);
+}
+
+std::string file_image(hid_t file) {
+    auto lock = hdf5_lock();
+    check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
+    const ssize_t n = H5Fget_file_image(file, nullptr, 0);
+    if (n < 0) fail("file image");
+    std::string bytes(static_cast<std::size_t>(n), '\0');
+    if (H5Fget_file_image(file, bytes.data(), bytes.size()) != n) fail("file image");
+    return bytes;
 }
 
 Handle open_file(const std::string& path) {
@@ -149,6 +166,43 @@ void write_attr(hid_t obj, const std::string& name, std::int64_t value) {
     Handle space(check(H5Screate(H5S_SCALAR), "space"), H5Sclose);
     Handle a = attr_for_write(obj, name, H5T_STD_I64LE, space);
     check(H5Awrite(a, H5T_NATIVE_INT64, &value), "write attribute " + name);
+}
+
+void write_attr_u64(hid_t obj, const std::string& name, std::uint64_t value) {
+    auto lock = hdf5_lock();
+    Handle space(check(H5Screate(H5S_SCALAR), "space"), H5Sclose);
+    Handle a = attr_for_write(obj, name, H5T_STD_U64LE, space);
+    check(H5Awrite(a, H5T_NATIVE_UINT64, &value), "write attribute " + name);
+}
+
+std::uint64_t read_attr_u64(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
+    Handle type(check(H5Aget_type(a), "type"), H5Tclose);
+    if (H5Tget_class(type) != H5T_INTEGER) fail("attribute '" + name + "' is not an integer");
+    if (H5Tget_sign(type) == H5T_SGN_NONE) {
+        std::uint64_t v = 0;
+        check(H5Aread(a, H5T_NATIVE_UINT64, &v), "read attribute " + name);
+        return v;
+    }
+    std::int64_t v = 0;
+    check(H5Aread(a, H5T_NATIVE_INT64, &v), "read attribute " + name);
+    if (v < 0) fail("attribute '" + name + "' is negative (" + std::to_string(v) + ")");
+    return static_cast<std::uint64_t>(v);
+}
+
+H5T_class_t attr_class(hid_t obj, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
+    Handle type(check(H5Aget_type(a), "type"), H5Tclose);
+    return H5Tget_class(type);
+}
+
+H5T_class_t dataset_class(hid_t loc, const std::string& name) {
+    auto lock = hdf5_lock();
+    Handle ds(check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), "no dataset '" + name + "'"), H5Dclose);
+    Handle type(check(H5Dget_type(ds), "type"), H5Tclose);
+    return H5Tget_class(type);
 }
 
 std::string read_attr_string(hid_t obj, const std::string& name) {

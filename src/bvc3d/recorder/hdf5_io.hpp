@@ -33,7 +33,11 @@ private:
     herr_t (*close_)(hid_t) = nullptr;
 };
 
-Handle create_file(const std::string& path);  // truncates
+// A new file built in memory (HDF5's core driver): nothing touches the disk until the caller
+// writes file_image() itself, so a full disk is reported with its reason (AtomicFile) and never
+// leaves HDF5 holding a half-written file. `name` must be unique among open files.
+Handle create_memory_file(const std::string& name);
+std::string file_image(hid_t file);  // the bytes of the file as it stands (flushed first)
 Handle open_file(const std::string& path);    // read-only
 Handle create_group(hid_t loc, const std::string& name);
 Handle open_group(hid_t loc, const std::string& name);
@@ -43,9 +47,15 @@ bool exists_attr(hid_t obj, const std::string& name);
 void write_attr(hid_t obj, const std::string& name, const std::string& value);
 void write_attr(hid_t obj, const std::string& name, double value);
 void write_attr(hid_t obj, const std::string& name, std::int64_t value);
+void write_attr_u64(hid_t obj, const std::string& name, std::uint64_t value);  // stored as uint64
 std::string read_attr_string(hid_t obj, const std::string& name);
 double read_attr_double(hid_t obj, const std::string& name);
 std::int64_t read_attr_int(hid_t obj, const std::string& name);
+// An integer attribute of any integer type as uint64 (InputError if negative or not an integer).
+std::uint64_t read_attr_u64(hid_t obj, const std::string& name);
+// The type class (H5T_INTEGER, H5T_FLOAT, H5T_STRING, ...) of an attribute or a dataset.
+H5T_class_t attr_class(hid_t obj, const std::string& name);
+H5T_class_t dataset_class(hid_t loc, const std::string& name);
 // A parameter value as an attribute: reals as float64, integers as int64, text, flags as int64 0/1,
 // lists as float64 datasets are not attributes (rejected).
 void write_attr(hid_t obj, const std::string& name, const params::Value& value);

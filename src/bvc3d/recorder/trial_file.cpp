@@ -1,7 +1,9 @@
 #include "bvc3d/recorder/trial_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
@@ -24,7 +26,7 @@ void write_identity(hid_t f, const TrialIdentity& id) {
     if (std::isfinite(id.tilt_deg)) h5::write_attr(f, "tilt_deg", id.tilt_deg);
     h5::write_attr(f, "model", id.model);
     h5::write_attr(f, "sensor", id.sensor);
-    h5::write_attr(f, "seed", static_cast<std::int64_t>(id.seed));
+    h5::write_attr_u64(f, "seed", id.seed);  // all of 0 .. 2^64 - 1, no sign change
     h5::write_attr(f, "protocol", id.protocol);
     h5::write_attr(f, "explore_hours", id.explore_hours);
     h5::write_attr(f, "sample_hours", id.sample_hours);
@@ -51,9 +53,10 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
     const ModelRecord& rec = group.models.at(model_index);
     const std::size_t n = group.t.size();
     AtomicFile out(path);
+    std::string image;
     {
         auto lock = h5::hdf5_lock();
-        const auto f = h5::create_file(out.temp_path().string());
+        const auto f = h5::create_memory_file(out.temp_path().string());
         write_identity(f, id);
         const auto s = h5::create_group(f, "samples");
         h5::write(s, "t", group.t, {n});
@@ -72,7 +75,9 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         h5::write_attr(w, "full_scan_fallbacks", group.stats.full_scan_fallbacks);
         h5::write_attr(w, "end_time", group.stats.end_time);
         write_metrics(f, metrics);
+        image = h5::file_image(f);
     }
+    out.write(image);
     out.commit();
 }
 
@@ -92,39 +97,116 @@ std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
 
 namespace {
 
-h5::Handle open_trial(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec))
-        throw InputError("trial file '" + path.string() + "' does not exist");
-    auto f = h5::open_file(path.string());
-    std::string format;
-    try {
-        format = h5::read_attr_string(f, "format");
-    } catch (const InputError&) {
+// Reading a trial file: every error names the file and the dataset or attribute.
+class TrialReader {
+public:
+    explicit TrialReader(const std::filesystem::path& path) : path_(path) {
+        std::error_code ec;
+        if (std::filesystem::is_directory(path, ec)) fail("is a folder, not a file");
+        if (!std::filesystem::exists(path, ec)) fail("does not exist");
+        try {
+            file_ = h5::open_file(path.string());
+        } catch (const InputError&) {
+            fail("is not an HDF5 file, or is truncated or damaged");
+        }
+        if (!h5::exists_attr(file_, "format") || h5::attr_class(file_, "format") != H5T_STRING ||
+            h5::read_attr_string(file_, "format") != "bvc3d-trial")
+            fail("is not a bvc3d trial file (its 'format' attribute is not 'bvc3d-trial')");
+        // Files of the first version may lack the attribute.
+        if (h5::exists_attr(file_, "format_version")) {
+            if (h5::attr_class(file_, "format_version") != H5T_INTEGER) fail("attribute 'format_version' is not an integer");
+            const auto version = h5::read_attr_int(file_, "format_version");
+            if (version < 1 || version > trial_file_format_version)
+                fail("format_version " + std::to_string(version) + " is not supported (this bvc3d reads version " +
+                     std::to_string(trial_file_format_version) + (version > trial_file_format_version ? "; a newer bvc3d wrote it)" : ")"));
+        }
     }
-    if (format != "bvc3d-trial") throw InputError("'" + path.string() + "' is not a bvc3d trial file");
-    return f;
-}
 
-TrialIdentity read_identity(hid_t f) {
+    hid_t file() const { return file_; }
+    [[noreturn]] void fail(const std::string& why) const {
+        throw InputError("trial file '" + path_.string() + "'" + (why.rfind(":", 0) == 0 ? why : " " + why));
+    }
+    // Runs `read`, turning an HDF5 error into one that names the file and `what`.
+    template <class F>
+    auto guarded(const std::string& what, F&& read) const {
+        try {
+            return read();
+        } catch (const InputError& e) {
+            std::string why = e.what();
+            if (why.rfind("HDF5: ", 0) == 0) why.erase(0, 6);
+            fail(": " + what + ": " + why);
+        }
+    }
+
+    std::string text(hid_t obj, const std::string& where, const std::string& name, bool required = true) const {
+        if (!h5::exists_attr(obj, name)) {
+            if (required) fail(": attribute '" + where + name + "' is missing");
+            return {};
+        }
+        if (h5::attr_class(obj, name) != H5T_STRING) fail(": attribute '" + where + name + "' is not text");
+        return guarded("attribute '" + where + name + "'", [&] { return h5::read_attr_string(obj, name); });
+    }
+    // NaN when absent; an error when present but not a number.
+    double number(hid_t obj, const std::string& where, const std::string& name) const {
+        if (!h5::exists_attr(obj, name)) return NAN;
+        const auto c = h5::attr_class(obj, name);
+        if (c != H5T_FLOAT && c != H5T_INTEGER) fail(": attribute '" + where + name + "' is not a number");
+        return guarded("attribute '" + where + name + "'", [&] { return h5::read_attr_double(obj, name); });
+    }
+
+    h5::Handle group(const std::string& name) const {
+        if (!h5::exists(file_, name)) fail(": group '/" + name + "' is missing");
+        return guarded("group '/" + name + "'", [&] { return h5::open_group(file_, name); });
+    }
+
+    // A float dataset of `rank` dimensions, its shape checked by the caller.
+    std::vector<std::size_t> shape(hid_t loc, const std::string& where, const std::string& name, std::size_t rank) const {
+        if (!h5::exists(loc, name)) fail(": dataset '" + where + name + "' is missing");
+        const auto c = guarded("dataset '" + where + name + "'", [&] { return h5::dataset_class(loc, name); });
+        if (c != H5T_FLOAT) fail(": dataset '" + where + name + "' does not hold floating-point numbers");
+        const auto d = guarded("dataset '" + where + name + "'", [&] { return h5::dims(loc, name); });
+        if (d.size() != rank)
+            fail(": dataset '" + where + name + "' has " + std::to_string(d.size()) + " dimensions, not " + std::to_string(rank));
+        return d;
+    }
+    template <class T>
+    std::vector<T> finite(hid_t loc, const std::string& where, const std::string& name, std::size_t per_row = 1) const {
+        auto v = guarded("dataset '" + where + name + "'", [&] {
+            if constexpr (std::is_same_v<T, float>) return h5::read_floats(loc, name);
+            else return h5::read_doubles(loc, name);
+        });
+        for (std::size_t i = 0; i < v.size(); ++i)
+            if (!std::isfinite(v[i]))
+                fail(": dataset '" + where + name + "' holds a non-finite value (" + std::to_string(v[i]) + ") at " +
+                     (per_row > 1 ? "sample " + std::to_string(i / per_row) + ", column " + std::to_string(i % per_row)
+                                  : "sample " + std::to_string(i)));
+        return v;
+    }
+
+private:
+    std::filesystem::path path_;
+    h5::Handle file_;
+};
+
+TrialIdentity read_identity(const TrialReader& r) {
+    const hid_t f = r.file();
     TrialIdentity id;
-    auto text = [&](const char* name) { return h5::exists_attr(f, name) ? h5::read_attr_string(f, name) : std::string(); };
-    auto number = [&](const char* name) { return h5::exists_attr(f, name) ? h5::read_attr_double(f, name) : NAN; };
-    id.name = h5::read_attr_string(f, "name");
-    id.world = h5::read_attr_string(f, "world");
-    id.model = h5::read_attr_string(f, "model");
-    id.seed = static_cast<std::uint64_t>(h5::read_attr_int(f, "seed"));
-    id.tilt_deg = number("tilt_deg");
-    id.world_source = text("world_source");
-    id.sensor = text("sensor");
-    id.protocol = text("protocol");
-    id.config = text("config");
-    id.fingerprint = text("fingerprint");
-    id.explore_hours = number("explore_hours");
-    id.sample_hours = number("sample_hours");
+    id.name = r.text(f, "/", "name");
+    id.world = r.text(f, "/", "world");
+    id.model = r.text(f, "/", "model");
+    if (!h5::exists_attr(f, "seed")) r.fail(": attribute '/seed' is missing");
+    id.seed = r.guarded("attribute '/seed'", [&] { return h5::read_attr_u64(f, "seed"); });
+    id.tilt_deg = r.number(f, "/", "tilt_deg");
+    id.world_source = r.text(f, "/", "world_source", false);
+    id.sensor = r.text(f, "/", "sensor", false);
+    id.protocol = r.text(f, "/", "protocol", false);
+    id.config = r.text(f, "/", "config", false);
+    id.fingerprint = r.text(f, "/", "fingerprint", false);
+    id.explore_hours = r.number(f, "/", "explore_hours");
+    id.sample_hours = r.number(f, "/", "sample_hours");
     // Files from before conditions were recorded: the paper's condition, model and world.
-    id.condition = h5::exists_attr(f, "condition") ? h5::read_attr_string(f, "condition") : id.world + "_" + id.model;
-    std::istringstream swept(text("swept"));
+    id.condition = h5::exists_attr(f, "condition") ? r.text(f, "/", "condition") : id.world + "_" + id.model;
+    std::istringstream swept(r.text(f, "/", "swept", false));
     for (std::string line; std::getline(swept, line);) {
         const auto eq = line.find('=');
         if (eq != std::string::npos) id.swept.emplace_back(line.substr(0, eq), line.substr(eq + 1));
@@ -132,25 +214,41 @@ TrialIdentity read_identity(hid_t f) {
     return id;
 }
 
+std::optional<std::vector<double>> read_extent(const TrialReader& r, hid_t metrics) {
+    if (!h5::exists(metrics, "extent")) return std::nullopt;
+    const auto d = r.shape(metrics, "/metrics/", "extent", 1);
+    if (d[0] != 4) r.fail(": dataset '/metrics/extent' holds " + std::to_string(d[0]) + " values, not 4 (xmin, xmax, ymin, ymax)");
+    const auto e = r.finite<double>(metrics, "/metrics/", "extent");
+    if (!(e[0] < e[1] && e[2] < e[3])) r.fail(": dataset '/metrics/extent' needs xmin < xmax and ymin < ymax");
+    return e;
+}
+
 }  // namespace
 
 TrialFileData read_trial_samples(const std::filesystem::path& path) {
     auto lock = h5::hdf5_lock();
-    const auto f = open_trial(path);
+    const TrialReader r(path);
     TrialFileData d;
-    static_cast<TrialIdentity&>(d) = read_identity(f);
-    const auto g = h5::open_group(f, "metrics");
-    for (const auto& name : h5::attribute_names(g)) d.metric_attributes.emplace_back(name, h5::read_attr(g, name));
-    if (h5::exists(g, "extent")) d.extent = h5::read_doubles(g, "extent");
-    const auto s = h5::open_group(f, "samples");
-    d.x = h5::read_doubles(s, "x");
-    d.y = h5::read_doubles(s, "y");
-    if (h5::exists(s, "z")) d.z = h5::read_doubles(s, "z");
-    const auto dims = h5::dims(s, "rates");
-    if (dims.size() != 2 || dims[0] != d.x.size() || d.y.size() != d.x.size() || (!d.z.empty() && d.z.size() != d.x.size()))
-        throw InputError("'" + path.string() + "': samples/rates has the wrong shape");
-    d.rates = h5::read_floats(s, "rates");
-    d.n_place = dims[1];
+    static_cast<TrialIdentity&>(d) = read_identity(r);
+    const auto g = r.group("metrics");
+    for (const auto& name : r.guarded("group '/metrics'", [&] { return h5::attribute_names(g); }))
+        d.metric_attributes.emplace_back(name, r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
+    d.extent = read_extent(r, g);
+    const auto s = r.group("samples");
+    const auto nx = r.shape(s, "/samples/", "x", 1)[0];
+    if (r.shape(s, "/samples/", "y", 1)[0] != nx)
+        r.fail(": datasets '/samples/x' and '/samples/y' differ in length");
+    const bool has_z = h5::exists(s, "z");
+    if (has_z && r.shape(s, "/samples/", "z", 1)[0] != nx) r.fail(": dataset '/samples/z' differs in length from '/samples/x'");
+    const auto rates = r.shape(s, "/samples/", "rates", 2);
+    if (rates[0] != nx)
+        r.fail(": dataset '/samples/rates' has " + std::to_string(rates[0]) + " rows for " + std::to_string(nx) + " samples");
+    if (rates[1] < 1) r.fail(": dataset '/samples/rates' has no cells");
+    d.x = r.finite<double>(s, "/samples/", "x");
+    d.y = r.finite<double>(s, "/samples/", "y");
+    if (has_z) d.z = r.finite<double>(s, "/samples/", "z");
+    d.rates = r.finite<float>(s, "/samples/", "rates", rates[1]);
+    d.n_place = rates[1];
     return d;
 }
 
@@ -191,7 +289,8 @@ TrialWeights read_trial_weights(const std::filesystem::path& path) {
 
 std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, const std::string& dataset) {
     auto lock = h5::hdf5_lock();
-    const auto f = open_trial(path);
+    const TrialReader reader(path);
+    const hid_t f = reader.file();
     // Walk the groups one name at a time: H5Lexists needs every link on the way to exist.
     std::vector<h5::Handle> groups;
     hid_t loc = f;
@@ -215,15 +314,24 @@ std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, co
     return a;
 }
 
-TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names) {
+TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names,
+                                   const std::vector<std::string>& parameter_names) {
     auto lock = h5::hdf5_lock();
-    const auto f = open_trial(path);
-    TrialSummaryRow r;
-    static_cast<TrialIdentity&>(r) = read_identity(f);
-    const auto g = h5::open_group(f, "metrics");
-    for (const auto& name : metric_names)
-        r.metrics.emplace_back(name, h5::exists_attr(g, name) ? h5::read_attr_double(g, name) : NAN);
-    return r;
+    const TrialReader r(path);
+    TrialSummaryRow row;
+    static_cast<TrialIdentity&>(row) = read_identity(r);
+    const auto g = r.group("metrics");
+    for (const auto& name : metric_names) row.metrics.emplace_back(name, r.number(g, "/metrics/", name));
+    for (const auto& name : parameter_names) {
+        std::string value = "(not recorded)";
+        if (h5::exists_attr(g, name))
+            value = params::to_text(r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
+        row.parameters.emplace_back(name, value);
+    }
+    std::string extent = "data";
+    if (const auto e = read_extent(r, g)) extent = params::to_text(*e);
+    row.parameters.emplace_back("extent", extent);
+    return row;
 }
 
 }  // namespace bvc3d

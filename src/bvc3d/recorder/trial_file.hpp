@@ -58,7 +58,9 @@ struct TrialStamp {
 };
 std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path);
 
-// What `bvc3d analyze` reads back.
+// What `bvc3d analyze` reads back. Reading checks what it reads: errors (InputError) name the file
+// and the dataset or attribute — missing, of the wrong type or shape, non-finite positions or rates,
+// a format_version this code does not read.
 struct TrialFileData : TrialIdentity {
     std::vector<std::pair<std::string, params::Value>> metric_attributes;  // everything under /metrics
     std::optional<std::vector<double>> extent;                          // /metrics/extent, if fixed
@@ -90,10 +92,13 @@ TrialWeights read_trial_weights(const std::filesystem::path& path);
 std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, const std::string& dataset);
 
 // The named scalar metrics of a file, for summaries; a metric the file lacks (written before it
-// existed) reads as NaN.
+// existed) reads as NaN. `parameters`: the named /metrics attributes (the analysis parameters) as
+// text, "(not recorded)" where missing, and last `extent` ("data" or the fixed bounds).
 struct TrialSummaryRow : TrialIdentity {
     std::vector<std::pair<std::string, double>> metrics;
+    std::vector<std::pair<std::string, std::string>> parameters;
 };
-TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names);
+TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std::vector<std::string>& metric_names,
+                                   const std::vector<std::string>& parameter_names = {});
 
 }  // namespace bvc3d

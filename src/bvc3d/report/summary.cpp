@@ -4,9 +4,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/analysis/trial_metrics.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -50,11 +52,63 @@ std::string csv(const std::string& s) {
 
 }  // namespace
 
+TrialSummaryRow read_summary(const std::filesystem::path& file) {
+    std::vector<std::string> parameters;
+    for (const auto& f : analysis::AnalysisParams::table().fields()) parameters.push_back(f.key);
+    return read_trial_summary(file, analysis::metric_names(), parameters);
+}
+
 std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::path>& files) {
     std::vector<TrialSummaryRow> rows;
-    const auto names = analysis::metric_names();
-    for (const auto& f : files) rows.push_back(read_trial_summary(f, names));
+    for (const auto& f : files) rows.push_back(read_summary(f));
     return rows;
+}
+
+namespace {
+
+// What must agree between trials of one table: (name, its text in a trial, the swept keys that vary it).
+struct Facet {
+    std::string name;
+    std::function<std::string(const TrialSummaryRow&)> value;
+    std::vector<std::string> swept_by;
+};
+
+std::vector<Facet> facets(const std::vector<TrialSummaryRow>& trials) {
+    std::vector<Facet> out{
+        {"protocol", [](const TrialSummaryRow& t) { return t.protocol; }, {"protocol", "protocol.kind"}},
+        {"explore_hours", [](const TrialSummaryRow& t) { return num(t.explore_hours); }, {"protocol", "protocol.explore_hours"}},
+        {"sample_hours", [](const TrialSummaryRow& t) { return num(t.sample_hours); }, {"protocol", "protocol.sample_hours"}}};
+    if (!trials.empty())
+        for (std::size_t i = 0; i < trials.front().parameters.size(); ++i) {
+            const std::string key = trials.front().parameters[i].first;
+            out.push_back({"analysis " + key,
+                           [i](const TrialSummaryRow& t) { return i < t.parameters.size() ? t.parameters[i].second : ""; },
+                           {"analysis", "analysis." + key}});
+        }
+    return out;
+}
+
+}  // namespace
+
+std::string mixing_problem(const std::vector<TrialSummaryRow>& trials, const std::vector<std::filesystem::path>& files) {
+    const auto file = [&](std::size_t i) { return i < files.size() ? "'" + files[i].string() + "'" : "trial " + trials[i].name; };
+    for (const auto& f : facets(trials)) {
+        const auto swept = [&](const TrialSummaryRow& t) {
+            for (const auto& [k, v] : t.swept)
+                if (std::find(f.swept_by.begin(), f.swept_by.end(), k) != f.swept_by.end()) return true;
+            return false;
+        };
+        std::map<std::string, std::size_t> first_of_condition;  // condition -> first trial
+        for (std::size_t i = 0; i < trials.size(); ++i) {
+            // Trials of one condition always agree; across conditions unless a sweep varies it.
+            const auto [it, fresh] = first_of_condition.emplace(trials[i].condition, i);
+            const std::size_t j = swept(trials[i]) ? it->second : 0;
+            if ((!fresh || j == 0) && f.value(trials[i]) != f.value(trials[j]))
+                return "trials differ in " + f.name + ": " + f.value(trials[j]) + " in " + file(j) + ", " +
+                       f.value(trials[i]) + " in " + file(i);
+        }
+    }
+    return "";
 }
 
 std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials) {
@@ -154,14 +208,14 @@ void write_trials_csv(const std::filesystem::path& path, const std::vector<Trial
     const auto keys = swept_keys(trials);
     os << "name,condition,model,world,tilt_deg";
     for (const auto& k : keys) os << ',' << csv("swept:" + k);
-    os << ",seed";
+    os << ",seed,protocol,explore_hours,sample_hours";
     if (!trials.empty())
         for (const auto& [name, v] : trials.front().metrics) os << ',' << name;
     os << '\n';
     for (const auto& t : trials) {
         os << csv(t.name) << ',' << csv(t.condition) << ',' << csv(t.model) << ',' << csv(t.world) << ',' << num(t.tilt_deg);
         for (const auto& k : keys) os << ',' << csv(swept_value(t, k));
-        os << ',' << t.seed;
+        os << ',' << t.seed << ',' << csv(t.protocol) << ',' << num(t.explore_hours) << ',' << num(t.sample_hours);
         for (const auto& [name, v] : t.metrics) os << ',' << num(v);
         os << '\n';
     }

@@ -4,6 +4,7 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/world/ray_caster.hpp"
 
@@ -47,7 +48,14 @@ const params::Table<LidarSpec>& LidarSpec::table() {
     return t;
 }
 
-void LidarSpec::validate() const { table().check(*this); }
+void LidarSpec::validate() const {
+    table().check(*this);
+    const double beams = static_cast<double>(elevations.size()) * azimuth_count;
+    if (beams > max_beams)
+        table().fail("azimuth_count", "makes " + std::to_string(elevations.size()) + " rows × " +
+                                          std::to_string(azimuth_count) + " columns = " + format_number(beams) +
+                                          " beams; the limit is " + format_number(max_beams));
+}
 
 Lidar::Lidar(LidarSpec spec) : spec_(std::move(spec)) {
     spec_.validate();
@@ -90,15 +98,27 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
         azimuths_[j] = wrap_pi(pose.heading + column_azimuth_[j]);
         horizontal_[j] = Vec2(ch * column_cos_[j] - sh * column_sin_[j], sh * column_cos_[j] + ch * column_sin_[j]);
     }
-    dirs_.resize(n_cols);
-    ranges_.resize(n_cols);
-    for (std::size_t i = 0; i < n_rows; ++i) {
-        if (!rows.empty() && !rows[i]) continue;
-        for (std::size_t j = 0; j < n_cols; ++j)
-            dirs_[j] = Vec3(cos_el_[i] * horizontal_[j].x(), cos_el_[i] * horizontal_[j].y(), sin_el_[i]);
-        world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
+    // Every row to cast in one call, column by column: the rays of one ray packet then share an
+    // azimuth or two and meet the same walls, which Embree traverses a third faster than packets
+    // that sweep 16 columns of one row. Each ray's range is its own; the returns keep the beam
+    // table's order (row by row).
+    cast_rows_.clear();
+    for (std::size_t i = 0; i < n_rows; ++i)
+        if (rows.empty() || rows[i]) cast_rows_.push_back(i);
+    const std::size_t n_cast = cast_rows_.size();
+    dirs_.resize(n_cols * n_cast);
+    ranges_.resize(n_cols * n_cast);
+    for (std::size_t j = 0; j < n_cols; ++j)
+        for (std::size_t c = 0; c < n_cast; ++c) {
+            const std::size_t i = cast_rows_[c];
+            dirs_[j * n_cast + c] = Vec3(cos_el_[i] * horizontal_[j].x(), cos_el_[i] * horizontal_[j].y(), sin_el_[i]);
+        }
+    world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
+    out.reserve(n_cols * n_cast);
+    for (std::size_t c = 0; c < n_cast; ++c) {
+        const std::size_t i = cast_rows_[c];
         for (std::size_t j = 0; j < n_cols; ++j) {
-            double r = ranges_[j];
+            double r = ranges_[j * n_cast + c];
             if (r == RayCaster::no_hit || (noisy && !add_noise(r, noise, i * n_cols + j))) continue;
             out.push_back({r, azimuths_[j], spec_.elevations[i]});
         }

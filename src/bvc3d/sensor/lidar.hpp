@@ -46,6 +46,7 @@ struct LidarSpec {
     }
     static const params::Table<LidarSpec>& table();
     void validate() const;  // throws params::ParamError naming the bad field
+    static constexpr double max_beams = 1e7;  // rows × azimuth_count: beyond it a scan would not fit
 };
 
 // Seeds the optional range noise and dropout. The noise of beam b in scan s depends only on
@@ -83,6 +84,7 @@ private:
     mutable std::vector<Vec3> dirs_;
     mutable std::vector<Vec2> horizontal_;
     mutable std::vector<double> ranges_, azimuths_;
+    mutable std::vector<std::size_t> cast_rows_;
 };
 
 }  // namespace bvc3d

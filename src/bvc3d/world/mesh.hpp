@@ -8,6 +8,10 @@
 
 namespace bvc3d {
 
+// World coordinates lie within ±max_coordinate meters: anything beyond is a unit or frame mistake
+// (and far beyond it ray casting loses all precision).
+inline constexpr double max_coordinate = 1e6;
+
 struct TriangleMesh {
     std::vector<Vec3> vertices;
     std::vector<std::array<std::uint32_t, 3>> triangles;

@@ -6,9 +6,14 @@
 
 namespace bvc3d {
 
+// The largest mesh file and mesh: beyond them a world is a mistake (or would not fit in memory).
+inline constexpr double max_mesh_file_bytes = 1e9;
+inline constexpr double max_mesh_triangles = 2e7;
+
 // Loads every triangle of every mesh in the file, with node transforms applied, in the file's
 // units. Degenerate triangles are dropped. Throws InputError naming the file and the reason when
-// the file is missing, unreadable, not a mesh, or holds no usable triangle.
+// the file is missing, unreadable, not a mesh, truncated or inconsistent (mesh_check.hpp), too
+// large, has coordinates beyond ±max_coordinate, or holds no usable triangle.
 TriangleMesh load_mesh_file(const std::string& path);
 
 }  // namespace bvc3d

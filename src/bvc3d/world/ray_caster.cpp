@@ -80,12 +80,11 @@ RayCaster::RayCaster(const TriangleMesh& mesh, const std::vector<SphereSet>& sph
     if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) impl_->packet = 16;
     else if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) impl_->packet = 8;
 
-    plane_point_.reserve(mesh.size());
-    plane_normal_.reserve(mesh.size());
+    planes_.reserve(mesh.size());
     for (std::size_t t = 0; t < mesh.size(); ++t) {
         const auto c = mesh.corners(t);
-        plane_point_.push_back(c[0]);
-        plane_normal_.push_back((c[1] - c[0]).cross(c[2] - c[0]));
+        const Vec3 normal = (c[1] - c[0]).cross(c[2] - c[0]);
+        planes_.push_back({normal, c[0], 1e-9 * normal.norm()});
     }
 }
 
@@ -96,11 +95,11 @@ double RayCaster::refine(unsigned geom, unsigned prim, const Vec3& origin, const
         const SphereSet& set = spheres_[geom - first_sphere_geom_];
         return refine_sphere(set.centers[prim], set.radius, origin, dir, t_float);
     }
-    const Vec3& n = plane_normal_[prim];
-    const double nd = n.dot(dir);
+    const Plane& p = planes_[prim];
+    const double nd = p.normal.dot(dir);
     // Grazing rays: the plane solve is ill-conditioned, Embree's float distance is better.
-    if (std::abs(nd) <= 1e-9 * n.norm()) return t_float;
-    return std::max(0.0, n.dot(plane_point_[prim] - origin) / nd);
+    if (std::abs(nd) <= p.grazing) return t_float;
+    return std::max(0.0, p.normal.dot(p.point - origin) / nd);
 }
 
 double RayCaster::refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir,
@@ -124,67 +123,60 @@ double RayCaster::cast(const Vec3& origin, const Vec3& dir, double max_range) co
     return r;
 }
 
-namespace {
-
-// One packet of up to N rays from a common origin, through rtcIntersect{4,8,16}.
+// Packets of N rays from a common origin through rtcIntersect{4,8,16}. The fields every ray of the
+// call shares are written once; each packet writes its directions and resets its hit.
 template <int N, class RayHitN, class Intersect>
-void cast_packet(RTCScene scene, RTCIntersectContext* ctx, Intersect intersect, const Vec3& origin,
-                 const Vec3* dirs, std::size_t count, float tfar, unsigned* geom, unsigned* prim, float* t) {
-    alignas(64) RayHitN rh;
-    alignas(64) int valid[N];
-    for (int k = 0; k < N; ++k) {
-        const bool on = static_cast<std::size_t>(k) < count;
-        valid[k] = on ? -1 : 0;
-        const Vec3& d = dirs[on ? k : 0];
-        rh.ray.org_x[k] = static_cast<float>(origin.x());
-        rh.ray.org_y[k] = static_cast<float>(origin.y());
-        rh.ray.org_z[k] = static_cast<float>(origin.z());
-        rh.ray.dir_x[k] = static_cast<float>(d.x());
-        rh.ray.dir_y[k] = static_cast<float>(d.y());
-        rh.ray.dir_z[k] = static_cast<float>(d.z());
-        rh.ray.tnear[k] = 0.0f;
-        rh.ray.tfar[k] = tfar;
-        rh.ray.time[k] = 0.0f;
-        rh.ray.mask[k] = 0xFFFFFFFFu;
-        rh.ray.id[k] = static_cast<unsigned>(k);
-        rh.ray.flags[k] = 0;
-        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-    }
-    intersect(valid, scene, ctx, &rh);
-    for (std::size_t k = 0; k < count; ++k) {
-        geom[k] = rh.hit.geomID[k];
-        prim[k] = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : rh.hit.primID[k];
-        t[k] = rh.ray.tfar[k];
-    }
-}
-
-}  // namespace
-
-void RayCaster::cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range,
-                     std::span<double> ranges) const {
+void RayCaster::cast_packets(Intersect intersect, const Vec3& origin, std::span<const Vec3> dirs, double max_range,
+                             std::span<double> ranges) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // every ray shares the origin
     // Embree's far limit is float: widen it by a hair so the exact double test below decides.
     const float tfar = static_cast<float>(max_range) * (1.0f + 1e-6f);
-    unsigned geom[16], prim[16];
-    float t[16];
-    for (std::size_t i = 0; i < dirs.size(); i += impl_->packet) {
-        const std::size_t n = std::min<std::size_t>(impl_->packet, dirs.size() - i);
-        switch (impl_->packet) {
-            case 16: cast_packet<16, RTCRayHit16>(impl_->scene, &ctx, rtcIntersect16, origin, &dirs[i], n, tfar, geom, prim, t); break;
-            case 8: cast_packet<8, RTCRayHit8>(impl_->scene, &ctx, rtcIntersect8, origin, &dirs[i], n, tfar, geom, prim, t); break;
-            default: cast_packet<4, RTCRayHit4>(impl_->scene, &ctx, rtcIntersect4, origin, &dirs[i], n, tfar, geom, prim, t); break;
+    alignas(64) RayHitN rh;
+    alignas(64) int valid[N];
+    for (int k = 0; k < N; ++k) {
+        valid[k] = -1;
+        rh.ray.org_x[k] = static_cast<float>(origin.x());
+        rh.ray.org_y[k] = static_cast<float>(origin.y());
+        rh.ray.org_z[k] = static_cast<float>(origin.z());
+        rh.ray.tnear[k] = 0.0f;
+        rh.ray.time[k] = 0.0f;
+        rh.ray.mask[k] = 0xFFFFFFFFu;
+        rh.ray.id[k] = static_cast<unsigned>(k);
+        rh.ray.flags[k] = 0;
+    }
+    for (std::size_t i = 0; i < dirs.size(); i += N) {
+        const std::size_t n = std::min<std::size_t>(N, dirs.size() - i);
+        for (int k = 0; k < N; ++k) {
+            const Vec3& d = dirs[i + (static_cast<std::size_t>(k) < n ? k : 0)];
+            rh.ray.dir_x[k] = static_cast<float>(d.x());
+            rh.ray.dir_y[k] = static_cast<float>(d.y());
+            rh.ray.dir_z[k] = static_cast<float>(d.z());
+            rh.ray.tfar[k] = tfar;
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
+        if (n < N)
+            for (int k = 0; k < N; ++k) valid[k] = static_cast<std::size_t>(k) < n ? -1 : 0;
+        intersect(valid, impl_->scene, &ctx, &rh);
         for (std::size_t k = 0; k < n; ++k) {
             double r = no_hit;
-            if (prim[k] != RTC_INVALID_GEOMETRY_ID) {
-                r = refine(geom[k], prim[k], origin, dirs[i + k], t[k]);
+            if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) {
+                r = refine(rh.hit.geomID[k], rh.hit.primID[k], origin, dirs[i + k], rh.ray.tfar[k]);
                 if (r > max_range) r = no_hit;
             }
             ranges[i + k] = r;
         }
+    }
+}
+
+void RayCaster::cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range,
+                     std::span<double> ranges) const {
+    switch (impl_->packet) {
+        case 16: return cast_packets<16, RTCRayHit16>(rtcIntersect16, origin, dirs, max_range, ranges);
+        case 8: return cast_packets<8, RTCRayHit8>(rtcIntersect8, origin, dirs, max_range, ranges);
+        default: return cast_packets<4, RTCRayHit4>(rtcIntersect4, origin, dirs, max_range, ranges);
     }
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "bvc3d/world/mesh.hpp"
 #include "bvc3d/world/world.hpp"
@@ -32,10 +33,19 @@ public:
 private:
     double refine(unsigned geom, unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const;
     double refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir, float t_float) const;
+    template <int N, class RayHitN, class Intersect>
+    void cast_packets(Intersect intersect, const Vec3& origin, std::span<const Vec3> dirs, double max_range,
+                      std::span<double> ranges) const;
 
     struct Impl;
     std::unique_ptr<Impl> impl_;  // the Embree device and scene
-    std::vector<Vec3> plane_point_, plane_normal_;  // per triangle, double precision
+    // Per triangle, in double precision: its plane (unnormalized normal, a corner) and the |n·d|
+    // below which a ray grazes it.
+    struct Plane {
+        Vec3 normal, point;
+        double grazing;
+    };
+    std::vector<Plane> planes_;
     // Embree geometry IDs: the triangles (if any) first, then one per sphere set, in order.
     unsigned first_sphere_geom_ = 0;
     std::vector<SphereSet> spheres_;  // its own copy: a caster is shared by copies of a World

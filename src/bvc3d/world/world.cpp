@@ -32,6 +32,8 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
             "tilt_deg must be in [0, 90), got " + format_number(p.tilt_deg));
     require(p.half_width > 0 && p.height > 0 && p.wall_thickness > 0 && p.wall_length > 0,
             "sizes must be positive");
+    require(p.half_width <= max_coordinate && p.height <= max_coordinate && p.wall_thickness <= max_coordinate,
+            "sizes must be at most " + format_number(max_coordinate) + " m");
     require(p.wall_length < 2.0 * p.half_width, "wall_length must be shorter than the arena");
     const double alpha = deg_to_rad(p.tilt_deg);
     const double reach = p.height * std::tan(alpha) + 0.5 * p.wall_thickness / std::cos(alpha);

@@ -27,6 +27,7 @@ struct SphereSet {
 
 struct WorldDescription {
     std::string name;
+    std::string file;  // the YAML file it came from (errors about its keys name it); empty for presets
     std::optional<double> tilt_deg;  // the tilt of the cross arena, when the world is (or holds) one
     TriangleMesh mesh;
     std::vector<SphereSet> spheres;

@@ -1,0 +1,10 @@
+// Model YAML (config::model_from_yaml), as `--model FILE` reads it; also its sensor mapping.
+#include "bvc3d/config/model_yaml.hpp"
+#include "fuzz_common.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    return bvc3d::fuzz::expect_input_errors([&] {
+        const std::string text(reinterpret_cast<const char*>(data), size);
+        bvc3d::config::model_from_yaml(bvc3d::config::YamlView::load_string(text, "fuzz.yaml")).validate();
+    });
+}
