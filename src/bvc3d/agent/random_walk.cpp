@@ -79,7 +79,15 @@ namespace {
     throw ConfigError(world.file, key, reason);
 }
 
-std::string point_text(const Vec2& p) { return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ")"; }
+// Built by appending: GCC 12's -Wrestrict misfires on "(" + std::string at -O3.
+std::string point_text(const Vec2& p) {
+    std::string s = "(";
+    s += format_number(p.x());
+    s += ", ";
+    s += format_number(p.y());
+    s += ")";
+    return s;
+}
 
 }  // namespace
 

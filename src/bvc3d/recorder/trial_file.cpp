@@ -254,34 +254,37 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
 
 TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc) {
     auto lock = h5::hdf5_lock();
-    const auto f = open_trial(path);
-    const auto s = h5::open_group(f, "samples");
-    const char* name = bvc ? "bvc_rates" : "rates";
+    const TrialReader r(path);
+    const auto s = r.group("samples");
+    const std::string name = bvc ? "bvc_rates" : "rates";
     if (!h5::exists(s, name))
-        throw InputError("trial file '" + path.string() + "' has no " + (bvc ? "BVC rates (samples/bvc_rates): rerun it recording them" : "samples/rates"));
-    TrialRates r;
-    r.t = h5::read_doubles(s, "t");
-    r.x = h5::read_doubles(s, "x");
-    r.y = h5::read_doubles(s, "y");
-    r.z = h5::exists(s, "z") ? h5::read_doubles(s, "z") : std::vector<double>(r.x.size(), 0.0);
-    r.heading = h5::read_doubles(s, "heading");
-    const auto dims = h5::dims(s, name);
-    const std::size_t n = r.x.size();
-    if (dims.size() != 2 || dims[0] != n || r.y.size() != n || r.z.size() != n || r.t.size() != n || r.heading.size() != n)
-        throw InputError("trial file '" + path.string() + "': samples/" + name + " has the wrong shape");
-    r.rates = h5::read_floats(s, name);
-    r.n_cells = dims[1];
-    return r;
+        r.fail(bvc ? "has no BVC rates (samples/bvc_rates): rerun it recording them" : "has no samples/rates");
+    const auto n = r.shape(s, "/samples/", "x", 1)[0];
+    const bool has_z = h5::exists(s, "z");
+    for (const std::string k : {"y", "z", "t", "heading"})
+        if ((k != "z" || has_z) && r.shape(s, "/samples/", k, 1)[0] != n)
+            r.fail(": dataset '/samples/" + k + "' differs in length from '/samples/x'");
+    const auto dims = r.shape(s, "/samples/", name, 2);
+    if (dims[0] != n)
+        r.fail(": dataset '/samples/" + name + "' has " + std::to_string(dims[0]) + " rows for " + std::to_string(n) + " samples");
+    TrialRates out;
+    out.t = r.finite<double>(s, "/samples/", "t");
+    out.x = r.finite<double>(s, "/samples/", "x");
+    out.y = r.finite<double>(s, "/samples/", "y");
+    out.z = has_z ? r.finite<double>(s, "/samples/", "z") : std::vector<double>(n, 0.0);
+    out.heading = r.finite<double>(s, "/samples/", "heading");
+    out.rates = r.finite<float>(s, "/samples/", name, dims[1]);
+    out.n_cells = dims[1];
+    return out;
 }
 
 TrialWeights read_trial_weights(const std::filesystem::path& path) {
     auto lock = h5::hdf5_lock();
-    const auto f = open_trial(path);
-    if (!h5::exists(f, "weights")) throw InputError("trial file '" + path.string() + "' has no weights");
-    const auto dims = h5::dims(f, "weights");
-    if (dims.size() != 2) throw InputError("trial file '" + path.string() + "': weights has the wrong shape");
+    const TrialReader r(path);
+    if (!h5::exists(r.file(), "weights")) r.fail("has no weights");
+    const auto dims = r.shape(r.file(), "/", "weights", 2);
     TrialWeights w;
-    w.values = h5::read_floats(f, "weights");
+    w.values = r.finite<float>(r.file(), "/", "weights", dims[1]);
     w.n_place = dims[0];
     w.n_bvc = dims[1];
     return w;
