@@ -257,7 +257,7 @@ TEST(RecordingWriters, FailedWriteLeavesNoFileAndNamesTheReason) {
     write_pcd(dir / "missing" / "a.pcd", cloud, PcdEncoding::binary, PcdPrecision::f8);
     EXPECT_EQ(read_pcd(dir / "missing" / "a.pcd").xyz, cloud.xyz);
     fs::create_directories(dir / "folder.pcd");
-    expect_input_error([&] { write_pcd(dir / "folder.pcd", cloud); }, (dir / "folder.pcd").string(), {"cannot write"});
+    expect_input_error([&] { write_pcd(dir / "folder.pcd", cloud); }, (dir / "folder.pcd").string(), {"is a folder, not a file"});
     write_kitti_bin(dir / "file.bin", cloud);
     expect_input_error([&] { write_ply(dir / "file.bin" / "a.ply", cloud); }, (dir / "file.bin").string(),
                        {"is not a folder"});

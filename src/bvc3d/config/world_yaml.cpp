@@ -252,6 +252,8 @@ WorldDescription world_from_yaml(const YamlView& v) {
     // A floor with no geometry over it is a world the sensors cannot see.
     Eigen::AlignedBox2d geometry;
     for (const auto& p : w.mesh.vertices) geometry.extend(Vec2(p.x(), p.y()));
+    for (const auto& set : w.spheres)  // point clouds
+        for (const auto& c : set.centers) geometry.extend(Vec2(c.x(), c.y()));
     if (!geometry.intersects(w.walkable.bounds()))
         (v.has("walkable") ? v["walkable"] : objects).fail("the walkable region lies entirely outside the world's geometry");
     if (v.has("start")) {
