@@ -1,6 +1,11 @@
 #include "cli_common.hpp"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -97,6 +102,33 @@ Pose parse_pose(const std::string& text) {
 }
 
 std::string num(double v) { return format_number(v); }
+
+int run_python_module(const std::string& module, const std::vector<std::string>& args) {
+    const char* py_env = std::getenv("BVC3D_PYTHON");
+    const std::string python = py_env && *py_env ? py_env : BVC3D_PYTHON;
+    const char* path_env = std::getenv("BVC3D_PYTHONPATH");
+    std::string pythonpath = path_env && *path_env ? path_env : BVC3D_PYTHON_DIR;
+    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && pythonpath != existing)
+        pythonpath += std::string(":") + existing;  // as the report's command (cmd_experiment.cpp) does
+    std::vector<std::string> argv_text{python, "-m", module};
+    argv_text.insert(argv_text.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : argv_text) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::fflush(stdout);  // our lines first, then the module's
+    const pid_t pid = ::fork();
+    if (pid < 0) return -1;
+    if (pid == 0) {
+        ::setenv("PYTHONPATH", pythonpath.c_str(), 1);
+        ::execv(python.c_str(), argv.data());
+        std::perror(("bvc3d: cannot run " + python).c_str());
+        ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
 
 const char* const extent_help =
     "Rate-map grid: 'data' (each trajectory's own bounds, the default), 'arena' (the walkable region's) or "

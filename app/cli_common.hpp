@@ -18,6 +18,10 @@ namespace bvc3d::cli {
 // "X,Y,HEADING": meters and radians, a pose on the floor; the heading may end in "deg" for degrees.
 Pose parse_pose(const std::string& text);
 
+// Runs `python3 -m MODULE ARGS...` (the package's figure modules) as a child process, no shell;
+// returns its exit status. BVC3D_PYTHON and BVC3D_PYTHONPATH override the interpreter and path.
+int run_python_module(const std::string& module, const std::vector<std::string>& args);
+
 // Full-precision decimal text for numbers written to CSV.
 std::string num(double v);
 
@@ -93,6 +97,7 @@ void add_model_commands(CLI::App& app);
 void add_experiment_commands(CLI::App& app);
 void add_sweep_command(CLI::App& app);
 void add_flight_command(CLI::App& app);
+void add_recording_commands(CLI::App& app);
 void add_view_command(CLI::App& app);  // view/cmd_view.cpp
 void add_adaptive_command(CLI::App& app);  // cmd_adaptive.cpp
 

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
     bvc3d::cli::add_experiment_commands(app);
     bvc3d::cli::add_sweep_command(app);
     bvc3d::cli::add_flight_command(app);
+    bvc3d::cli::add_recording_commands(app);
     bvc3d::cli::add_view_command(app);
     bvc3d::cli::add_adaptive_command(app);
     try {

@@ -149,5 +149,6 @@ void bind_simulator(pyb::module_& m);
 void bind_model(pyb::module_& m);
 void bind_experiment(pyb::module_& m);
 void bind_analysis(pyb::module_& m);
+void bind_recording(pyb::module_& m);
 
 }  // namespace bvc3d::py

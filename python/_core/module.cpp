@@ -106,4 +106,5 @@ PYBIND11_MODULE(_core, m) {
     bvc3d::py::bind_model(m);
     bvc3d::py::bind_experiment(m);
     bvc3d::py::bind_analysis(m);
+    bvc3d::py::bind_recording(m);
 }

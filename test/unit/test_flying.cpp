@@ -324,11 +324,11 @@ TEST(FlyingWalk, SameSeedSameFlightAndResumesFromItsState) {
     EXPECT_TRUE(a.size() != c.size() || a[5].pose.x != c[5].pose.x);
 
     const auto spec = FlightSpec();
-    auto full = spec.make(world, 9), part = spec.make(world, 9);
+    auto full = spec.make(&world, 9), part = spec.make(&world, 9);
     std::vector<ModelStep> x, y;
     while (auto s = full->next(1800)) x.push_back(*s);
     while (auto s = part->next(900)) y.push_back(*s);
-    auto resumed = spec.make(world, 0);
+    auto resumed = spec.make(&world, 0);
     resumed->restore_state(part->save_state());
     while (auto s = resumed->next(1800)) y.push_back(*s);
     ASSERT_EQ(x.size(), y.size());

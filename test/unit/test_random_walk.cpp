@@ -359,7 +359,7 @@ TEST(RandomWalk, FixedStartHeadingKeepsTheDrawnStartPoint) {
     fixed.fixed_start_heading = true;
     fixed.start_heading = 1.25;
     for (std::uint64_t seed = 0; seed < 8; ++seed) {
-        auto a = RandomWalkSpec().make(world, seed), b = RandomWalkSpec(fixed).make(world, seed);
+        auto a = RandomWalkSpec().make(&world, seed), b = RandomWalkSpec(fixed).make(&world, seed);
         const auto& wa = dynamic_cast<const RandomWalk&>(*a);
         const auto& wb = dynamic_cast<const RandomWalk&>(*b);
         EXPECT_EQ(wb.pose().heading, 1.25);
@@ -409,4 +409,56 @@ TEST(RandomWalk, LogLagLogsWhereTheRobotIsLater) {
     EXPECT_GT(moved, checked / 2);  // most steps are followed by straight driving: 0.192 s × 0.5 m/s
     EXPECT_GT(still, checked / 50);  // turns longer than the lag
     EXPECT_FALSE(plain[0].logged_pose.has_value());
+}
+
+TEST(BodyCollider, SpheresAreTheirDiscsInTheBodySlab) {
+    // A ball of radius 0.25 centered 0.2 m above the body's top (H = 0.1): its slice through the
+    // slab is a disc of radius √(0.25² − 0.2²) = 0.15. A ball 0.3 m above misses the slab.
+    WorldDescription w;
+    w.name = "balls";
+    w.spheres.push_back(SphereSet{{Vec3(0, 0, 0.3), Vec3(0, 3, 0.4)}, 0.25});
+    w.walkable = Polygon2::rectangle(-5, -5, 5, 5);
+    const BodyCollider body(w, R, 0.1);
+    EXPECT_NEAR(body.free_distance(Vec2(-2, 0), Vec2(1, 0), 5.0), 2.0 - (R + 0.15), 1e-12);
+    EXPECT_NEAR(body.free_distance(Vec2(-2, 3), Vec2(1, 0), 5.0), 5.0, 1e-12);  // passes under the high ball
+    EXPECT_NEAR(body.clearance(Vec2(1, 0)), 1.0 - 0.15 - R, 1e-12);
+
+    // Against an independent oracle: the body (cylinder, 0 < z <= H) and a ball overlap iff some
+    // height z in the slab has the ball's cross-section disc reaching the body's disc; checked on
+    // a fine grid of z for random positions not within 1 mm of contact.
+    std::uint64_t state = 99;
+    auto uniform = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return static_cast<double>(state >> 11) / 9007199254740992.0;
+    };
+    WorldDescription cloud;
+    cloud.name = "cloud";
+    cloud.spheres.push_back({});
+    cloud.spheres[0].radius = 0.08;
+    for (int i = 0; i < 60; ++i) cloud.spheres[0].centers.emplace_back(-2 + 4 * uniform(), -2 + 4 * uniform(), -0.1 + 0.35 * uniform());
+    cloud.walkable = Polygon2::rectangle(-5, -5, 5, 5);
+    const double H = 0.1;
+    const BodyCollider cb(cloud, R, H);
+    int overlaps = 0, checked = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec2 p(-2 + 4 * uniform(), -2 + 4 * uniform());
+        double reach = INFINITY;  // min over z of (horizontal gap to the body) - (cross-section radius)
+        for (const Vec3& c : cloud.spheres[0].centers) {
+            if ((p - c.head<2>()).norm() > R + 0.1) {  // too far for any slice to reach
+                reach = std::min(reach, (p - c.head<2>()).norm() - R - 0.08);
+                continue;
+            }
+            for (int k = 1; k <= 2000; ++k) {
+                const double z = H * k / 2000.0, dz = z - c.z();
+                if (std::abs(dz) >= 0.08) continue;
+                reach = std::min(reach, (p - c.head<2>()).norm() - R - std::sqrt(0.08 * 0.08 - dz * dz));
+            }
+        }
+        if (std::abs(reach) < 1e-3) continue;
+        ++checked;
+        overlaps += reach < 0;
+        ASSERT_EQ(cb.clearance(p) < 0, reach < 0) << i;
+    }
+    EXPECT_GT(overlaps, 50);
+    EXPECT_GT(checked, 2500);
 }

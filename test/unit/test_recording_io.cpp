@@ -250,13 +250,19 @@ TEST(RecordingRoundTrip, ReadScanChoosesTheReaderByExtensionInAnyCase) {
 // ======================= Writers: all or nothing =======================
 
 TEST(RecordingWriters, FailedWriteLeavesNoFileAndNamesTheReason) {
+    // Writers go through core/atomic_file, as every output of the program does: a missing folder
+    // is created; a target that is a folder, or a folder path through a file, is an error.
     TempDir dir;
     const PointCloud cloud = random_cloud(10, 5);
-    expect_input_error([&] { write_pcd(dir / "missing" / "a.pcd", cloud); }, (dir / "missing" / "a.pcd").string(),
-                       {"cannot write", "No such file or directory"});
+    write_pcd(dir / "missing" / "a.pcd", cloud, PcdEncoding::binary, PcdPrecision::f8);
+    EXPECT_EQ(read_pcd(dir / "missing" / "a.pcd").xyz, cloud.xyz);
     fs::create_directories(dir / "folder.pcd");
-    expect_input_error([&] { write_pcd(dir / "folder.pcd", cloud); }, (dir / "folder.pcd").string(), {"cannot write"});
-    EXPECT_EQ(dir.file_count(), 1u);  // just the folder: no temporary left behind
+    expect_input_error([&] { write_pcd(dir / "folder.pcd", cloud); }, (dir / "folder.pcd").string(), {"is a folder, not a file"});
+    write_kitti_bin(dir / "file.bin", cloud);
+    expect_input_error([&] { write_ply(dir / "file.bin" / "a.ply", cloud); }, (dir / "file.bin").string(),
+                       {"is not a folder"});
+    EXPECT_EQ(dir.file_count(), 3u);  // the two folders and file.bin: no temporary left behind
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir / "folder.pcd"), fs::directory_iterator()), 0);
 }
 
 TEST(RecordingWriters, WriteErrorKeepsTheOldFileAndRemovesTheTemporary) {
@@ -283,7 +289,8 @@ TEST(RecordingWriters, WriteErrorKeepsTheOldFileAndRemovesTheTemporary) {
     signal(SIGXFSZ, old_handler);
 
     EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-    EXPECT_NE(message.find("cannot write: File too large"), std::string::npos) << message;
+    EXPECT_NE(message.find("cannot write"), std::string::npos) << message;
+    EXPECT_NE(message.find("File too large"), std::string::npos) << message;
     EXPECT_EQ(fs::file_size(file), old_size);
     EXPECT_EQ(read_pcd(file).xyz, small.xyz);
     EXPECT_EQ(dir.file_count(), 1u);

@@ -218,7 +218,7 @@ TEST(Seams, ReturnsFedFromArraysDriveTheModel) {
     auto source = std::make_shared<ArrayReturnSource>(scans);
     const World world(trial.world.resolve());
     const GroupResult res =
-        run_trial_group(world, {trial}, {}, [&](const ModelSpec&, const World&) { return source; });
+        run_trial_group(world, {trial}, {}, [&](const ModelSpec&, const World*) { return source; });
     ASSERT_GT(res.t.size(), 300u);
     const std::size_t nb = static_cast<std::size_t>(trial.model.bvc.n_cells());
     for (std::size_t i = 0; i < res.t.size(); i += 61) {

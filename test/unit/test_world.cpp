@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
@@ -173,4 +174,89 @@ TEST(RayCaster, MaxRangeAndMisses) {
     EXPECT_EQ(rc.cast(Vec3::Zero(), Vec3::UnitX(), 4.999), RayCaster::no_hit);
     EXPECT_EQ(rc.cast(Vec3::Zero(), -Vec3::UnitX(), 20.0), RayCaster::no_hit);
     EXPECT_THROW(RayCaster(TriangleMesh{}), InputError);
+}
+
+namespace {
+// Nearest intersection of the ray o + t·d (t >= 0, d unit) with a ball, from the textbook quadratic
+// t² + 2(d·(o−c))t + |o−c|² − ρ² = 0; inf if none.
+double analytic_sphere(const Vec3& o, const Vec3& d, const Vec3& c, double rho) {
+    const Vec3 oc = o - c;
+    const double half_b = d.dot(oc), cc = oc.dot(oc) - rho * rho;
+    const double disc = half_b * half_b - cc;
+    if (disc < 0) return inf;
+    const double t1 = -half_b - std::sqrt(disc), t2 = -half_b + std::sqrt(disc);
+    if (t1 >= 0) return t1;
+    return t2 >= 0 ? t2 : inf;
+}
+}  // namespace
+
+TEST(RayCaster, SpheresAreHitExactlyInDouble) {
+    // A cloud of spheres in front of a wall: every ray's range equals the nearest analytic hit.
+    std::vector<SphereSet> sets(2);
+    sets[0].radius = 0.05;
+    sets[1].radius = 0.2;
+    std::uint64_t state = 12345;
+    auto uniform = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return static_cast<double>(state >> 11) / 9007199254740992.0;
+    };
+    for (int i = 0; i < 400; ++i) sets[0].centers.emplace_back(3 + 4 * uniform(), -3 + 6 * uniform(), -1 + 2 * uniform());
+    for (int i = 0; i < 30; ++i) sets[1].centers.emplace_back(3 + 4 * uniform(), -3 + 6 * uniform(), -1 + 2 * uniform());
+    TriangleMesh wall;
+    wall.add_quad(Vec3(9, -20, -20), Vec3(9, 20, -20), Vec3(9, 20, 20), Vec3(9, -20, 20));
+    const RayCaster rc(wall, sets);
+    const Vec3 origin(0.1, 0.2, 0.05);
+    int sphere_hits = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const Vec3 d = direction(-0.6 + 1.2 * uniform(), -0.3 + 0.6 * uniform());
+        double expected = (9.0 - origin.x()) / d.x();
+        bool on_sphere = false;
+        for (const auto& set : sets)
+            for (const Vec3& c : set.centers) {
+                const double t = analytic_sphere(origin, d, c, set.radius);
+                if (t < expected) expected = t, on_sphere = true;
+            }
+        sphere_hits += on_sphere;
+        ASSERT_NEAR(rc.cast(origin, d, 100.0), expected, 1e-9) << i;
+    }
+    EXPECT_GT(sphere_hits, 400);  // the test exercises spheres, not only the wall
+    // From inside a sphere, the ray leaves through its far side.
+    std::vector<SphereSet> one{{{Vec3(1, 0, 0)}, 0.5}};
+    const RayCaster inside(TriangleMesh{}, one);
+    EXPECT_NEAR(inside.cast(Vec3(1.2, 0, 0), Vec3::UnitX(), 10.0), 0.3, 1e-12);
+    EXPECT_NEAR(inside.cast(Vec3(-1, 0, 0), Vec3::UnitX(), 10.0), 1.5, 1e-12);
+    EXPECT_EQ(inside.cast(Vec3(-1, 0, 0), -Vec3::UnitX(), 10.0), RayCaster::no_hit);
+    std::vector<SphereSet> bad{{{Vec3(1, 0, 0)}, 0.0}};
+    EXPECT_THROW(RayCaster(TriangleMesh{}, bad), InputError);
+}
+
+TEST(World, PointCloudWorldScansAndBounds) {
+    // A ring of spheres around the sensor at 4 m: a horizontal scanner sees it at 4 - radius.
+    WorldDescription w;
+    w.name = "ring";
+    SphereSet ring;
+    ring.radius = 0.1;
+    for (int k = 0; k < 3600; ++k) ring.centers.emplace_back(4 * std::cos(k * two_pi / 3600), 4 * std::sin(k * two_pi / 3600), 0.08);
+    w.spheres.push_back(ring);
+    w.walkable = Polygon2::rectangle(-3, -3, 3, 3);
+    EXPECT_TRUE(w.has_geometry());
+    EXPECT_NEAR(w.bounds().max().x(), 4.1, 1e-12);
+    const World world(w);
+    const Scan s = Lidar(LidarSpec::horizontal()).scan(world, Pose::on_floor(0, 0, 0.3));
+    ASSERT_EQ(s.size(), 720u);
+    for (const auto& r : s) ASSERT_NEAR(r.range, 3.9, 1e-3);  // between sphere centers the ring is slightly deeper
+}
+
+TEST(World, CopiesOutliveTheOriginalWithSpheres) {
+    // Copies of a World share its caster: the caster must not point into the original's data.
+    std::optional<World> copy;
+    {
+        WorldDescription w;
+        w.name = "one";
+        w.spheres.push_back(SphereSet{{Vec3(2, 0, 0)}, 0.5});
+        w.walkable = Polygon2::rectangle(-1, -1, 1, 1);
+        const World original(w);
+        copy.emplace(original);
+    }
+    EXPECT_NEAR(copy->rays().cast(Vec3::Zero(), Vec3::UnitX(), 10.0), 1.5, 1e-12);
 }

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/recording/ply.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 #include "bvc3d/world/ray_caster.hpp"
 
@@ -207,4 +208,33 @@ TEST(SensorYaml, CustomBeamTableAndErrors) {
         EXPECT_NE(std::string(e.what()).find("dropout"), std::string::npos) << e.what();
     }
     EXPECT_THROW(config::resolve_sensor("lidar9000"), InputError);
+}
+
+TEST(WorldYaml, PointCloudObjectIsPlacedCroppedAndHitAsSpheres) {
+    TempDir dir;
+    recording::PointCloud cloud;
+    cloud.xyz = {2, 0, 0.5, 2, 0, -3, 2, 1, 0.5};  // the second point is cropped away below z = -1 after moving
+    recording::write_ply(dir.path() / "map.ply", cloud);
+    const auto file = dir.write("w.yaml", std::string(R"(
+objects:
+  - point_cloud: {file: map.ply, radius: 0.1, position: [1, 0, 0], crop_z: [-1, 5]}
+)") + walls);
+    const World w(config::load_world_file(file.string()));
+    ASSERT_EQ(w.spheres().size(), 1u);
+    EXPECT_EQ(w.spheres()[0].centers.size(), 2u);
+    EXPECT_NEAR(w.rays().cast(Vec3(0, 0, 0.5), Vec3::UnitX(), 20), 2.9, 1e-12);
+    EXPECT_EQ(w.rays().cast(Vec3(0, 0, -3), Vec3::UnitX(), 20), RayCaster::no_hit);
+    const auto files = config::world_file_meshes(file.string());
+    ASSERT_EQ(files.size(), 1u);
+    EXPECT_NE(files[0].find("map.ply"), std::string::npos);
+
+    expect_config_error("objects:\n  - point_cloud: {file: missing.pcd}\n" + std::string(walls),
+                        "objects[0].point_cloud.file", "no such file");
+    const std::string ply = (dir.path() / "map.ply").string();
+    expect_config_error("objects:\n  - point_cloud: {file: " + ply + ", radius: 0}\n" + std::string(walls),
+                        "objects[0].point_cloud.radius", "must be > 0");
+    expect_config_error("objects:\n  - point_cloud: {file: " + ply + ", crop_z: [10, 20]}\n" + std::string(walls),
+                        "objects[0].point_cloud", "keeps no points");
+    expect_config_error("objects:\n  - point_cloud: {file: " + ply + ", size: 1}\n" + std::string(walls),
+                        "objects[0].point_cloud.size", "unknown key");
 }

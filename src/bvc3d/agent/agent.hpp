@@ -1,6 +1,6 @@
 #pragma once
 // Agent stage: where the agent goes.
-// Takes: a World (for collision) and a seed, or a given path. Gives: the model steps — when and at
+// Takes: a World (for collision) and a seed, or a given path (which needs no world). Gives: the model steps — when and at
 // which pose the model is updated — one at a time, and its state as text for checkpoints.
 // Kinds of agent: the ground robot's random walk (random_walk.hpp), a given trajectory
 // (trajectory.hpp) and the flying agent (flying_walk.hpp). The trial runner, checkpoints and walk sharing see only this interface.
@@ -56,7 +56,9 @@ public:
     // flying agent: the world has a flight volume that holds its body): InputError naming the world's key
     // (`start.points[1]`) or the agent's (`robot.radius`), whichever is at fault. make() checks it too.
     virtual void check_world(const WorldDescription& world) const = 0;
-    virtual std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const = 0;
+    // `world` may be null (a replay of recorded data has none) for agents that do not need one;
+    // the others throw InputError.
+    virtual std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const = 0;
     // Configuration text that fixes the steps: the YAML a trial file records.
     virtual std::string key() const = 0;
     // Model steps per second of agent time, on average (for buffer sizes and duration checks).

@@ -73,11 +73,12 @@ double contact_time(const Vec2& p, const Vec2& u, double R, const Segment2& s, d
     return best;
 }
 
+// Distance from p to the obstacle s (its segment grown by its radius; negative inside).
 double point_segment_distance(const Vec2& p, const Segment2& s) {
     const Vec2 ab = s.b - s.a;
     const double len2 = ab.squaredNorm();
     const double lam = len2 > 0 ? std::clamp((p - s.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    return (p - (s.a + lam * ab)).norm();
+    return (p - (s.a + lam * ab)).norm() - s.radius;
 }
 
 }  // namespace
@@ -99,13 +100,14 @@ BodyCollider::BodyCollider(const WorldDescription& world, double radius, double 
             add_segment(a.head<2>(), b.head<2>());
         }
     }
+    for (const auto& set : world.spheres) add_spheres(set, z_lo, height);
     const auto& w = walkable_.points;
     for (std::size_t i = 0; i < w.size(); ++i) add_segment(w[i], w[(i + 1) % w.size()]);
 
     // Grid cells about the size of the body: a move query touches a handful of them.
     for (const auto& s : segments_) {
-        bounds_.extend(s.a);
-        bounds_.extend(s.b);
+        bounds_.extend(s.a - Vec2::Constant(s.radius));
+        bounds_.extend(s.b + Vec2::Constant(s.radius));
     }
     cell_ = std::max(4.0 * radius_, 1e-3);
     nx_ = std::max(1, static_cast<int>(std::ceil(bounds_.sizes().x() / cell_)));
@@ -118,8 +120,8 @@ BodyCollider::BodyCollider(const WorldDescription& world, double radius, double 
     grid_.assign(static_cast<std::size_t>(nx_) * ny_, {});
     for (std::size_t i = 0; i < segments_.size(); ++i) {
         Eigen::AlignedBox2d box;
-        box.extend(segments_[i].a);
-        box.extend(segments_[i].b);
+        box.extend(segments_[i].a - Vec2::Constant(segments_[i].radius));
+        box.extend(segments_[i].b + Vec2::Constant(segments_[i].radius));
         const int x0 = std::clamp(static_cast<int>((box.min().x() - bounds_.min().x()) / cell_), 0, nx_ - 1);
         const int x1 = std::clamp(static_cast<int>((box.max().x() - bounds_.min().x()) / cell_), 0, nx_ - 1);
         const int y0 = std::clamp(static_cast<int>((box.min().y() - bounds_.min().y()) / cell_), 0, ny_ - 1);
@@ -128,6 +130,16 @@ BodyCollider::BodyCollider(const WorldDescription& world, double radius, double 
             for (int x = x0; x <= x1; ++x) grid_[static_cast<std::size_t>(y) * nx_ + x].push_back(static_cast<int>(i));
     }
     stamp_.assign(segments_.size(), 0);
+}
+
+void BodyCollider::add_spheres(const SphereSet& set, double z_lo, double z_hi) {
+    const double rho = set.radius;
+    for (const Vec3& c : set.centers) {
+        const double dz = c.z() < z_lo ? z_lo - c.z() : c.z() > z_hi ? c.z() - z_hi : 0.0;
+        if (dz >= rho) continue;  // the sphere misses the slab
+        const Vec2 xy = c.head<2>();
+        segments_.push_back({xy, xy, std::sqrt(rho * rho - dz * dz)});
+    }
 }
 
 void BodyCollider::add_segment(const Vec2& a, const Vec2& b) {
@@ -170,7 +182,9 @@ double BodyCollider::free_distance(const Vec2& p, const Vec2& u, double max_dist
     box.min().array() -= radius_;
     box.max().array() += radius_;
     double t = max_dist;
-    for_segments_near(box, [&](int i) { t = std::min(t, contact_time(p, u, radius_, segments_[i], t)); });
+    for_segments_near(box, [&](int i) {
+        t = std::min(t, contact_time(p, u, radius_ + segments_[i].radius, segments_[i], t));
+    });
     return t;
 }
 

@@ -5,6 +5,10 @@
 // projection of the triangle's part with 0 < z <= H. Those projections are convex polygons, so
 // the 3-D test reduces to a disc against 2-D segments (their edges), exactly. Triangles lying at
 // z <= 0 are floor and never collide. The walkable region's boundary also counts as a wall.
+// A sphere (a point of a point cloud, center c, radius ρ) cut by the same slab is a ball whose
+// floor-plane projection is the disc of radius √(ρ² − dz²) around c's (x, y), dz being the distance
+// from c.z to the slab (0 inside it): the body touches it iff its disc touches that disc, so a
+// sphere is a round obstacle of that radius, exactly too.
 #include <mutex>
 #include <vector>
 
@@ -12,8 +16,10 @@
 
 namespace bvc3d {
 
+// A segment, or a disc when a == b; `radius` grows it into a capsule (a sphere's cross-section).
 struct Segment2 {
     Vec2 a, b;
+    double radius = 0.0;
 };
 
 class BodyCollider {
@@ -27,7 +33,8 @@ public:
     // it touches geometry. 0 if it already touches and u points into the contact.
     double free_distance(const Vec2& p, const Vec2& u, double max_dist) const;
 
-    // Distance from the center p to the nearest segment, minus the radius (< 0: overlap).
+    // Distance from the center p to the nearest obstacle (segment or disc), minus the body's radius
+    // (< 0: overlap).
     double clearance(const Vec2& p) const;
 
     // Inside the walkable region and not touching any wall. (A center deep inside a solid obstacle is
@@ -47,6 +54,7 @@ public:
 
 private:
     void add_segment(const Vec2& a, const Vec2& b);
+    void add_spheres(const SphereSet& set, double z_lo, double z_hi);
     template <class F>
     void for_segments_near(const Eigen::AlignedBox2d& box, F&& f) const;
 

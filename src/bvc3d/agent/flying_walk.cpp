@@ -180,12 +180,13 @@ void FlightSpec::check_world(const WorldDescription& world) const {
     }
 }
 
-std::unique_ptr<Agent> FlightSpec::make(const World& world, std::uint64_t seed) const {
+std::unique_ptr<Agent> FlightSpec::make(const World* world, std::uint64_t seed) const {
     validate();
-    check_world(world.description());
-    auto body = std::make_shared<const SphereCollider>(world.description(), flight_.radius);
+    if (!world) throw InputError("the flying walk needs a world to fly in");
+    check_world(world->description());
+    auto body = std::make_shared<const SphereCollider>(world->description(), flight_.radius);
     Rng rng(seed, Stream::walk);
-    const FlightState start = FlyingWalk::draw_start(*body, flight_, rng, world.name());
+    const FlightState start = FlyingWalk::draw_start(*body, flight_, rng, world->name());
     return std::make_unique<FlyingWalk>(body, flight_, std::move(rng), start);
 }
 
@@ -198,7 +199,7 @@ void FlightSpec::write_yaml(params::CommentedYaml& out) const {
 
 std::vector<ModelStep> flying_walk(const World& world, double hours, std::uint64_t seed, const FlightParams& params) {
     if (!std::isfinite(hours) || hours < 0) throw InputError("flight: hours must be >= 0");
-    const auto walk = FlightSpec(params).make(world, seed);
+    const auto walk = FlightSpec(params).make(&world, seed);
     std::vector<ModelStep> steps;
     steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
     while (auto s = walk->next(hours * 3600.0)) steps.push_back(*s);

@@ -90,7 +90,7 @@ public:
     const FlightParams& flight() const { return flight_; }
     std::string kind() const override { return "flight"; }
     void validate() const override { flight_.validate(); }
-    std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
+    std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override { return 1.0 / flight_.model_dt; }
     void write_yaml(params::CommentedYaml& out) const override;

@@ -302,13 +302,14 @@ void RandomWalkSpec::check_world(const WorldDescription& world) const {
     RandomWalk::check_start(world, BodyCollider(world, robot_.radius, robot_.height));
 }
 
-std::unique_ptr<Agent> RandomWalkSpec::make(const World& world, std::uint64_t seed) const {
+std::unique_ptr<Agent> RandomWalkSpec::make(const World* world, std::uint64_t seed) const {
     validate();
-    if (world.description().walkable.points.empty() && world.description().flight) check_world(world.description());
-    auto body = std::make_shared<const BodyCollider>(world.description(), robot_.radius, robot_.height);
-    RandomWalk::check_start(world.description(), *body);
+    if (!world) throw InputError("the random walk needs a world to walk in");
+    if (world->description().walkable.points.empty() && world->description().flight) check_world(world->description());
+    auto body = std::make_shared<const BodyCollider>(world->description(), robot_.radius, robot_.height);
+    RandomWalk::check_start(world->description(), *body);
     Rng rng(seed, Stream::walk);
-    Pose start = RandomWalk::draw_start(world.description(), *body, rng);
+    Pose start = RandomWalk::draw_start(world->description(), *body, rng);
     if (robot_.fixed_start_heading) start.heading = robot_.start_heading;  // the start point is still drawn
     return std::make_unique<RandomWalk>(body, robot_, std::move(rng), start);
 }
@@ -326,7 +327,7 @@ std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64
         throw InputError("walk: hours = " + format_number(hours) + " is more than the limit of " +
                          format_number(max_agent_hours) + " simulated hours");
     params.validate();
-    const auto walk = RandomWalkSpec(params).make(world, seed);
+    const auto walk = RandomWalkSpec(params).make(&world, seed);
     std::vector<ModelStep> steps;
     steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
     while (auto s = walk->next(hours * 3600.0)) {

@@ -104,7 +104,7 @@ public:
     std::string kind() const override { return "random_walk"; }
     void validate() const override { robot_.validate(); }
     void check_world(const WorldDescription& world) const override;
-    std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
+    std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override { return 1.0 / robot_.model_dt; }
     void write_yaml(params::CommentedYaml& out) const override;

@@ -32,23 +32,27 @@ void Trajectory::restore_state(const std::string& state) {
 
 std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std::vector<double>& x,
                                         const std::vector<double>& y, const std::vector<double>& z,
-                                        const std::vector<double>& heading, const std::string& source) {
+                                        const std::vector<double>& heading, const std::string& source,
+                                        const std::vector<double>& pitch, const std::vector<double>& roll) {
     const std::size_t n = t.size();
-    if (x.size() != n || y.size() != n || heading.size() != n || (!z.empty() && z.size() != n))
-        throw InputError(source + ": t, x, y, z and heading must have the same length");
+    if (x.size() != n || y.size() != n || heading.size() != n || (!z.empty() && z.size() != n) ||
+        (!pitch.empty() && pitch.size() != n) || (!roll.empty() && roll.size() != n))
+        throw InputError(source + ": t, x, y, z, heading, pitch and roll must have the same length");
     if (n == 0) throw InputError(source + ": the trajectory has no rows");
     std::vector<ModelStep> steps(n);
     for (std::size_t i = 0; i < n; ++i) {
         const double zi = z.empty() ? 0.0 : z[i];
+        const double pi_ = pitch.empty() ? 0.0 : pitch[i], ri = roll.empty() ? 0.0 : roll[i];
         const auto where = [&] { return source + ": row " + std::to_string(i) + ": "; };
-        for (double v : {t[i], x[i], y[i], zi, heading[i]})
+        for (double v : {t[i], x[i], y[i], zi, heading[i], pi_, ri})
             if (!std::isfinite(v)) throw InputError(where() + "every value must be finite");
+        if (std::abs(pi_) > pi / 2) throw InputError(where() + "pitch must lie within ±90°");
         if (std::abs(x[i]) > 1e6 || std::abs(y[i]) > 1e6 || std::abs(zi) > 1e6)
             throw InputError(where() + "coordinates must lie within ±1e6 m");
         if (i > 0 && !(t[i] > t[i - 1]))
             throw InputError(where() + "times must increase (" + format_number(t[i]) + " after " +
                              format_number(t[i - 1]) + ")");
-        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), 0.0, 0.0}, false, std::nullopt};
+        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), pi_, wrap_pi(ri)}, false, std::nullopt};
     }
     return steps;
 }
@@ -87,7 +91,7 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
     std::ifstream in(path);
     if (!in) throw InputError(name + (std::filesystem::exists(path, ec) ? " cannot be read" : " does not exist"));
     std::vector<std::string> columns;  // from the header, if any
-    std::vector<double> t, x, y, z, heading;
+    std::vector<double> t, x, y, z, heading, pitch, roll;
     bool degrees = false;
     std::string line;
     for (int line_no = 1; std::getline(in, line); ++line_no) {
@@ -100,9 +104,16 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             for (const auto& c : {"t", "x", "y"})
                 if (std::find(columns.begin(), columns.end(), c) == columns.end())
                     throw InputError(at + "the header lacks the column '" + c + "'");
-            const bool h = std::find(columns.begin(), columns.end(), "heading") != columns.end();
-            degrees = std::find(columns.begin(), columns.end(), "heading_deg") != columns.end();
-            if (h == degrees) throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
+            const auto has = [&](const char* c) { return std::find(columns.begin(), columns.end(), c) != columns.end(); };
+            degrees = has("heading_deg");
+            if (has("heading") == degrees) throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
+            for (const auto& c : columns)
+                if (c != "t" && c != "x" && c != "y" && c != "z" && c != "heading" && c != "heading_deg" && c != "pitch" &&
+                    c != "roll" && c != "pitch_deg" && c != "roll_deg")
+                    throw InputError(at + "unknown column '" + c +
+                                     "' (known: t, x, y, z, heading or heading_deg, pitch or pitch_deg, roll or roll_deg)");
+            if ((has("pitch") && has("pitch_deg")) || (has("roll") && has("roll_deg")))
+                throw InputError(at + "give each angle in radians or in degrees, not both");
             continue;
         }
         if (columns.empty()) {
@@ -125,9 +136,13 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             else if (col == "z") z.push_back(v);
             else if (col == "heading") heading.push_back(v);
             else if (col == "heading_deg") heading.push_back(deg_to_rad(v));
+            else if (col == "pitch") pitch.push_back(v);
+            else if (col == "pitch_deg") pitch.push_back(deg_to_rad(v));
+            else if (col == "roll") roll.push_back(v);
+            else if (col == "roll_deg") roll.push_back(deg_to_rad(v));
         }
     }
-    return trajectory_steps(t, x, y, z, heading, name);
+    return trajectory_steps(t, x, y, z, heading, name, pitch, roll);
 }
 
 namespace {
@@ -139,8 +154,13 @@ std::uint64_t hash_steps(const std::vector<ModelStep>& steps) {
         std::memcpy(&bits, &v, sizeof bits);
         h = hash_u64(h, bits, 0x51);
     };
-    for (const auto& s : steps)
+    for (const auto& s : steps) {
         for (double v : {s.t, s.pose.x, s.pose.y, s.pose.z, s.pose.heading}) mix(v);
+        if (!s.pose.level()) {  // level paths keep the keys they always had
+            mix(s.pose.pitch);
+            mix(s.pose.roll);
+        }
+    }
     return h;
 }
 
@@ -163,14 +183,13 @@ void TrajectorySpec::write_yaml(params::CommentedYaml& out) const {
              "a given path instead of the random walk: a file of t, x, y, [z], heading rows");
 }
 
-std::unique_ptr<Agent> TrajectorySpec::make(const World& world, std::uint64_t) const {
-    check_world(world.description());
+std::unique_ptr<Agent> TrajectorySpec::make(const World* world, std::uint64_t) const {
+    if (world) check_world(world->description());
     return std::make_unique<Trajectory>(steps_);
 }
 
 void TrajectorySpec::check_world(const WorldDescription& world) const {
-    Eigen::AlignedBox3d box;
-    for (const auto& v : world.mesh.vertices) box.extend(v);
+    const Eigen::AlignedBox3d box = world.bounds();  // triangles and point clouds
     for (std::size_t i = 0; i < steps_->size(); ++i) {
         const Pose& p = (*steps_)[i].pose;
         if (!box.contains(p.position()))

@@ -1,7 +1,8 @@
 #pragma once
 // A given path as the agent: model steps at given times and poses, e.g. a real robot's or animal's
 // track, in place of the random walk (docs/experiments.md#user-trajectories).
-// Takes: rows (t, x, y, [z], heading), from arrays or a text file. Gives: one model step per row.
+// Takes: rows (t, x, y, [z], heading, [pitch, roll]), from arrays or a text file. Gives: one model
+// step per row.
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -30,13 +31,16 @@ private:
 };
 
 // Rows checked and shifted to start at t = 0. `source` names the data in errors (a file, "arrays").
+// Pitch and roll (radians; empty: 0) tilt the agent, e.g. a hand-held sensor's attitude.
 std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std::vector<double>& x,
                                         const std::vector<double>& y, const std::vector<double>& z,
-                                        const std::vector<double>& heading, const std::string& source);
+                                        const std::vector<double>& heading, const std::string& source,
+                                        const std::vector<double>& pitch = {}, const std::vector<double>& roll = {});
 
 // A text file, comma- or whitespace-separated, `#` comments: columns t, x, y, heading or
-// t, x, y, z, heading; an optional header line names them (then in any order, and `heading_deg`
-// may replace `heading`). Errors name the file, the line and the reason.
+// t, x, y, z, heading; an optional header line names them (then in any order, `heading_deg` may
+// replace `heading`, and `pitch`/`roll` or `pitch_deg`/`roll_deg` may be added). Errors name the
+// file, the line and the reason.
 std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path);
 
 // A trajectory as a trial's agent: from a file (its name and contents fix the key) or from arrays.
@@ -51,7 +55,9 @@ public:
     void validate() const override {}
     // Every pose lies within the world's geometry (a path in another frame is a mistake).
     void check_world(const WorldDescription& world) const override;
-    std::unique_ptr<Agent> make(const World& world, std::uint64_t seed) const override;
+    // Checks the world when there is one; without a world (a replay of recorded data) there is
+    // nothing to check.
+    std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;
     double steps_per_second() const override;
     void write_yaml(params::CommentedYaml& out) const override;

@@ -1,6 +1,7 @@
 #include "bvc3d/config/trial_config.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -26,9 +27,13 @@ std::uint64_t text_hash(const std::string& s) {
 
 }  // namespace
 
-WorldDescription WorldSpec::resolve() const { return config::resolve_world(source, tilt_deg, lean); }
+WorldDescription WorldSpec::resolve() const {
+    if (is_none()) throw InputError("this trial has no world (its returns are recorded data)");
+    return config::resolve_world(source, tilt_deg, lean);
+}
 
 std::string WorldSpec::label() const {
+    if (is_none()) return "none";
     if (config::world_preset_takes_tilt(source)) {
         std::string l = source + "-" + format_number(tilt_deg.value_or(0.0));
         return lean == "+x+y" ? l : l + "_" + lean;
@@ -39,6 +44,7 @@ std::string WorldSpec::label() const {
 }
 
 std::string WorldSpec::fingerprint() const {
+    if (is_none()) return "none";
     const auto presets = config::world_preset_names();
     if (std::find(presets.begin(), presets.end(), source) != presets.end())
         return "preset " + source + " tilt " + format_number(tilt_deg.value_or(0.0)) + " lean " + lean;
@@ -89,6 +95,19 @@ void TrialConfig::set_agent(std::shared_ptr<const AgentSpec> a) {
     agent = std::move(a);
 }
 
+std::string InitialWeights::key() const {
+    std::uint64_t h = 0x77656967;  // "weig"
+    for (const float v : values) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        h = hash_u64(h, bits, 0x57);
+    }
+    std::ostringstream os;
+    os << "weights:\n  source: " << std::filesystem::path(source).filename().string() << "\n  shape: [" << n_place
+       << ", " << n_bvc << "]\n  hash: " << std::hex << h << "\n";
+    return os.str();
+}
+
 void TrialConfig::validate() const {
     model.validate();
     protocol.validate();
@@ -105,6 +124,14 @@ void TrialConfig::validate() const {
             throw InputError("model '" + preset + "' is a preset for the ground robot (its scanner sits on the robot, "
                              "above the floor): flying agents use fly-up, fly-5l or fly-9l (docs/flying.md#models)");
     }
+    if (world.is_none() && (!returns || returns->needs_world()))
+        throw InputError("a trial without a world needs recorded returns (a replay)");
+    if (world.is_none() && arena_extent) throw InputError("a trial without a world has no arena to bin over");
+    if (weights && (weights->n_place != model.place.n_place || weights->n_bvc != model.bvc.n_cells() ||
+                    weights->values.size() != static_cast<std::size_t>(weights->n_place) * weights->n_bvc))
+        throw InputError("weights from '" + weights->source + "' are " + std::to_string(weights->n_place) + " × " +
+                         std::to_string(weights->n_bvc) + "; model '" + model.name + "' needs " +
+                         std::to_string(model.place.n_place) + " × " + std::to_string(model.bvc.n_cells()));
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
     if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
         Protocol::table().fail("sample_hours", "= " + format_number(protocol.sample_hours) +
@@ -114,7 +141,7 @@ void TrialConfig::validate() const {
 void TrialConfig::check_runnable() const {
     try {
         validate();
-        agent->check_world(world.resolve());
+        if (!world.is_none()) agent->check_world(world.resolve());  // a replay has no world
     } catch (const InputError& e) {
         // Name the file the trial came from, unless the message already names a file of its own.
         const std::string what = e.what();
@@ -131,15 +158,20 @@ void check_runnable(const std::vector<TrialConfig>& trials) {
     }
 }
 
+std::string TrialConfig::world_label() const {
+    return world.is_none() && returns ? returns->label() : world.label();
+}
+
 std::string TrialConfig::condition_label() const {
-    return condition.empty() ? world.label() + "_" + model.name : condition;
+    return condition.empty() ? world_label() + "_" + model.name : condition;
 }
 
 std::string TrialConfig::name() const { return condition_label() + "_seed" + std::to_string(seed); }
 
 std::string TrialConfig::walk_key() const {
+    // What older trials lack (returns, weights) is added only when present: their text is unchanged.
     return "world: " + world.fingerprint() + "\nprotocol:\n" + params::yaml_lines(Protocol::table(), protocol, "  ") +
-           agent->key() + "seed: " + std::to_string(seed) + "\n";
+           agent->key() + (returns ? returns->key() : "") + "seed: " + std::to_string(seed) + "\n";
 }
 
 std::string TrialConfig::canonical() const {
@@ -150,7 +182,7 @@ std::string TrialConfig::canonical() const {
         extent = params::to_text(std::vector<double>{analysis.extent->xmin, analysis.extent->xmax, analysis.extent->ymin,
                                                      analysis.extent->ymax});
     lines.insert(lines.find("  decoding_templates:"), "  extent: " + extent + "\n");
-    return walk_key() + config::model_to_yaml(model) + "analysis:\n" + lines;
+    return walk_key() + config::model_to_yaml(model) + (weights ? weights->key() : "") + "analysis:\n" + lines;
 }
 
 analysis::AnalysisParams TrialConfig::analysis_params(const WorldDescription& w) const {

@@ -1,6 +1,8 @@
 #pragma once
 // Config stage: what one trial is (docs/experiments.md) — a world, a model, an agent, a protocol, a
-// seed, and how to analyze it — as plain data with its canonical text and fingerprint.
+// seed, and how to analyze it — as plain data with its canonical text and fingerprint. A replay of a
+// recording (docs/recordings.md) is a trial with no world, the recording's path as its agent and
+// its scans as the returns.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -10,17 +12,21 @@
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
 #include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/config/returns_spec.hpp"
 #include "bvc3d/core/params.hpp"
 
 namespace bvc3d {
 
-// A world by name: a preset (with tilt and lean for `cross`) or a YAML file.
+// A world by name: a preset (with tilt and lean for `cross`) or a YAML file; or none (an empty
+// source: a replay of recorded data).
 struct WorldSpec {
     std::string source = "cross";
     std::optional<double> tilt_deg;
     std::string lean = "+x+y";
 
-    WorldDescription resolve() const;
+    static WorldSpec none() { return WorldSpec{"", std::nullopt, "+x+y"}; }
+    bool is_none() const { return source.empty(); }
+    WorldDescription resolve() const;  // InputError for none
     // "cross-45", "two-rooms", ...: used in file names and tables.
     std::string label() const;
     // Text that changes whenever the world does (for a YAML file: its contents).
@@ -38,11 +44,22 @@ struct Protocol {
     double seconds() const;  // agent time the protocol runs
 };
 
+// Place-cell weights to start from (a trained network, e.g. from a trial file) instead of the
+// seed's Bernoulli draw.
+struct InitialWeights {
+    std::string source;         // where they came from (a file name), for trial files
+    std::vector<float> values;  // n_place × n_bvc, row-major
+    int n_place = 0, n_bvc = 0;
+    std::string key() const;    // the source and a hash of the values
+};
+
 struct TrialConfig {
     WorldSpec world;
     ModelSpec model = model_preset("3d-0.2");
     Protocol protocol;
     std::shared_ptr<const AgentSpec> agent = std::make_shared<RandomWalkSpec>();  // where the agent goes
+    std::shared_ptr<const ReturnsSpec> returns;          // null: each model's sensor ray-cast in the world
+    std::shared_ptr<const InitialWeights> weights;       // null: drawn from the seed
     analysis::AnalysisParams analysis;  // defaults as the paper; its extent is set from arena_extent
     bool arena_extent = false;          // bin over the walkable region's bounds, not the trajectory's
     std::uint64_t seed = 0;
@@ -59,6 +76,8 @@ struct TrialConfig {
     // dimension's default takes the new one's (20 in 2-D, 10 in 3-D).
     void set_agent(std::shared_ptr<const AgentSpec> a);
     std::string condition_label() const;
+    // The world's label, or for a trial without one the label of its returns (the recording).
+    std::string world_label() const;
     // Throws InputError for impossible values (model, protocol, agent, analysis, durations).
     void validate() const;
     // validate(), and what needs the world: it resolves (files exist, geometry sound) and the agent

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/recording/scan_file.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 
@@ -106,7 +107,7 @@ CrossArenaParams cross_from_yaml(const YamlView& v) {
     return p;
 }
 
-// The file a `mesh:` object loads: its `file`, relative to the YAML file unless absolute.
+// The file a `mesh:` or `point_cloud:` object loads: its `file`, relative to the YAML file unless absolute.
 std::string mesh_path(const YamlView& mesh) {
     const std::filesystem::path rel = mesh["file"].as_string();
     return rel.is_absolute() ? rel.string() : (std::filesystem::path(mesh.directory()) / rel).string();
@@ -129,10 +130,42 @@ void check_mesh(const YamlView& v, const TriangleMesh& m) {
     }
 }
 
+// A `point_cloud:` object: the points of a PCD, PLY or KITTI file drawn as spheres, placed like a
+// mesh, optionally cropped in z (after placing).
+SphereSet point_cloud_from_yaml(const YamlView& v) {
+    v.expect_map({"file", "radius", "position", "yaw_deg", "rotation_deg", "scale", "crop_z"});
+    recording::PointCloud cloud;
+    try {
+        cloud = recording::read_scan(mesh_path(v));
+    } catch (const InputError& e) {
+        v["file"].fail(e.what());
+    }
+    SphereSet set;
+    set.radius = v.get("radius", set.radius);
+    require_positive(v, "radius", set.radius);
+    const double scale = v.get("scale", 1.0);
+    require_positive(v, "scale", scale);
+    double zmin = -INFINITY, zmax = INFINITY;
+    if (v.has("crop_z")) {
+        const auto z = v["crop_z"].as_doubles(2);
+        if (!(z[0] < z[1])) v["crop_z"].fail("needs [zmin, zmax] with zmin < zmax");
+        zmin = z[0];
+        zmax = z[1];
+    }
+    const Eigen::Isometry3d pose = pose_from_yaml(v, "position");
+    set.centers.reserve(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Vec3 c = pose * (scale * Vec3(cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]));
+        if (c.z() >= zmin && c.z() <= zmax) set.centers.push_back(c);
+    }
+    if (set.centers.empty()) v.fail("keeps no points (all cropped away by crop_z)");
+    return set;
+}
+
 // One entry of `objects`: a map with exactly one key naming the primitive.
 void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDescription>& arena) {
     if (!obj.is_map() || obj.keys().size() != 1)
-        obj.fail("each object is a mapping with one key: cross_arena, box, quad, tilted_wall or mesh");
+        obj.fail("each object is a mapping with one key: cross_arena, box, quad, tilted_wall, mesh or point_cloud");
     const std::string kind = obj.keys().front();
     const YamlView v = obj[kind];
     TriangleMesh part;
@@ -185,8 +218,11 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         check_coordinates(v, part);
         w.mesh.append(part);
         return;  // assimp already dropped degenerate triangles
+    } else if (kind == "point_cloud") {
+        w.spheres.push_back(point_cloud_from_yaml(v));
+        return;
     } else {
-        obj.fail("unknown object kind '" + kind + "' (expected cross_arena, box, quad, tilted_wall or mesh)");
+        obj.fail("unknown object kind '" + kind + "' (expected cross_arena, box, quad, tilted_wall, mesh or point_cloud)");
     }
     check_mesh(v, part);
     w.mesh.append(part);
@@ -302,6 +338,8 @@ WorldDescription world_from_yaml(const YamlView& v) {
     // A floor with no geometry over it is a world the sensors cannot see.
     Eigen::AlignedBox2d geometry;
     for (const auto& p : w.mesh.vertices) geometry.extend(Vec2(p.x(), p.y()));
+    for (const auto& set : w.spheres)  // point clouds
+        for (const auto& c : set.centers) geometry.extend(Vec2(c.x(), c.y()));
     if (!geometry.intersects(w.walkable.bounds()))
         (v.has("walkable") ? v["walkable"] : objects).fail("the walkable region lies entirely outside the world's geometry");
     if (v.has("start")) {
@@ -333,8 +371,8 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
     const YamlView objects = v["objects"];
     for (std::size_t i = 0; i < objects.size(); ++i) {
         const YamlView o = objects.at(i);
-        if (!o.has("mesh") || !o["mesh"].has("file")) continue;
-        files.push_back(mesh_path(o["mesh"]));
+        for (const char* kind : {"mesh", "point_cloud"})
+            if (o.has(kind) && o[kind].has("file")) files.push_back(mesh_path(o[kind]));
     }
     return files;
 }

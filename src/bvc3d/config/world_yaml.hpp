@@ -16,7 +16,7 @@ bool world_preset_takes_tilt(const std::string& name);
 
 WorldDescription world_from_yaml(const YamlView& v);
 WorldDescription load_world_file(const std::string& path);
-// The mesh files a world file refers to (paths as opened), for fingerprints.
+// The geometry files (meshes, point clouds) a world file refers to (paths as opened), for fingerprints.
 std::vector<std::string> world_file_meshes(const std::string& path);
 
 // A preset name ("cross", "cross-30", "cross-webots", ...) or a YAML file. `tilt_deg` sets the tilt

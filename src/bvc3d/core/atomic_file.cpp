@@ -118,6 +118,12 @@ void AtomicFile::commit() {
     committed_ = true;
 }
 
+void write_file_atomically(const std::filesystem::path& target, std::string_view bytes) {
+    AtomicFile file(target);
+    file.write(bytes);
+    file.commit();
+}
+
 void ensure_writable_directory(const std::filesystem::path& dir) {
     std::error_code ec;
     if (std::filesystem::exists(dir, ec)) {

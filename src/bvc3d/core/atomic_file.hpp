@@ -40,6 +40,9 @@ private:
     bool committed_ = false;
 };
 
+// The whole of `bytes` as the file `target`, all or nothing (an AtomicFile written at once).
+void write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
+
 // Creates `dir` (and parents) or throws InputError saying why it cannot be written.
 void ensure_writable_directory(const std::filesystem::path& dir);
 

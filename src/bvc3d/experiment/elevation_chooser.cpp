@@ -38,13 +38,16 @@ private:
 // it still share one scan per step.
 SourceFactory replay_factory(const SourceFactory& inner, std::uint64_t walk_steps, std::uint64_t noise_seed) {
     auto wrapped = std::make_shared<std::vector<std::pair<std::shared_ptr<ReturnSource>, std::shared_ptr<ReturnSource>>>>();
-    return [=](const ModelSpec& model, const World& world) -> std::shared_ptr<ReturnSource> {
+    return [=](const ModelSpec& model, const World* world) -> std::shared_ptr<ReturnSource> {
         std::shared_ptr<ReturnSource> made = inner ? inner(model, world) : nullptr;
         for (const auto& [from, replay] : *wrapped) {
             const LidarSpec* table = from->beam_table();
             if (made ? from == made : table && table->same_beams(model.sensor)) return replay;
         }
-        if (!made) made = std::make_shared<RayCastSource>(world, model.sensor, noise_seed);
+        if (!made) {
+            if (!world) throw InputError("choosing elevations needs a world to cast rays in");
+            made = std::make_shared<RayCastSource>(*world, model.sensor, noise_seed);
+        }
         auto replay = std::make_shared<ReplaySource>(made, walk_steps);
         wrapped->emplace_back(made, replay);
         return replay;
@@ -169,7 +172,7 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
 std::vector<ModelStep> exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
                                         double d_th) {
     agent.validate();
-    const auto walker = agent.make(world, seed);
+    const auto walker = agent.make(&world, seed);
     std::vector<ModelStep> steps;
     while (const auto s = walker->next(minutes * 60.0)) steps.push_back(*s);
     // A pair farther apart than d_th, or aliasing has nothing to compare.

@@ -1,6 +1,7 @@
 #include "bvc3d/experiment/pipeline.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 
 #include "bvc3d/analysis/metrics.hpp"
@@ -38,12 +39,24 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
     return a;
 }
 
+namespace {
+
+// The group's world, or none for a trial without one (a replay).
+std::optional<World> group_world(const std::vector<TrialConfig>& trials) {
+    if (trials.front().world.is_none()) return std::nullopt;
+    return World(trials.front().world.resolve());
+}
+
+}  // namespace
+
 GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunControl& control) {
     if (trials.empty()) throw InputError("a trial group needs at least one trial");
-    const World world(trials.front().world.resolve());
+    const std::optional<World> world = group_world(trials);
+    const WorldDescription none;
     GroupOutcome out;
-    out.result = run_trial_group(world, trials, control);
-    for (std::size_t k = 0; k < trials.size(); ++k) out.trials.push_back(analyze(trials[k], world.description(), out.result, k));
+    out.result = run_trial_group(world ? &*world : nullptr, trials, control);
+    for (std::size_t k = 0; k < trials.size(); ++k)
+        out.trials.push_back(analyze(trials[k], world ? world->description() : none, out.result, k));
     return out;
 }
 
@@ -51,7 +64,7 @@ GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std
                                const RunControl& control) {
     if (paths.size() != trials.size()) throw std::logic_error("one path per trial");
     GroupOutcome out = run_and_analyze(trials, control);
-    const WorldDescription world = trials.front().world.resolve();
+    const WorldDescription world = trials.front().world.is_none() ? WorldDescription{} : trials.front().world.resolve();
     for (std::size_t k = 0; k < trials.size(); ++k)
         write_trial_file(paths[k], trial_identity(trials[k], world), out.result, k,
                          metrics_record(out.trials[k].metrics, out.trials[k].params));
@@ -64,11 +77,12 @@ TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world
     id.name = t.name();
     id.condition = t.condition_label();
     id.swept = t.swept;
-    id.world = t.world.label();
+    id.world = t.world_label();
     id.world_source = t.world.source;
+    if (t.returns) id.data_source = t.returns->attributes();
     id.tilt_deg = world.tilt_deg.value_or(NAN);
     id.model = t.model.name;
-    id.sensor = t.model.sensor.name;
+    id.sensor = t.returns ? t.returns->sensor_label() : t.model.sensor.name;
     id.seed = t.seed;
     id.protocol = protocol_name(t.protocol.kind);
     id.explore_hours = t.protocol.explore_hours;

@@ -29,14 +29,14 @@ void check_group(const std::vector<TrialConfig>& trials) {
     for (const auto& b : trials) {
         b.validate();
         if (b.walk_key() != a.walk_key())
-            throw InputError("trials in one group must share world, seed, protocol and agent");
+            throw InputError("trials in one group must share world, seed, protocol, agent and returns");
     }
 }
 
 // The group's running state: everything a checkpoint saves.
 struct GroupRun {
     const std::vector<TrialConfig>& trials;
-    const World& world;
+    const World* world;  // null: a trial without one
     std::unique_ptr<Agent> agent;
     std::vector<SourceUse> sources;
     std::vector<int> source_of;  // per model
@@ -48,7 +48,7 @@ struct GroupRun {
     std::int64_t step_index = 0;
     std::size_t ckpt_segments = 0, ckpt_saved = 0;  // samples already in checkpoint segments
 
-    GroupRun(const World& w, const std::vector<TrialConfig>& t, const SourceFactory& factory);
+    GroupRun(const World* w, const std::vector<TrialConfig>& t, const SourceFactory& factory);
     int use_source(const ModelSpec& model, const SourceFactory& factory);
     void reserve_samples();
     bool model_rates(std::size_t i, const Pose& pose);
@@ -57,11 +57,12 @@ struct GroupRun {
     void restore(const GroupCheckpoint& c);
 };
 
-GroupRun::GroupRun(const World& w, const std::vector<TrialConfig>& t, const SourceFactory& factory)
+GroupRun::GroupRun(const World* w, const std::vector<TrialConfig>& t, const SourceFactory& factory)
     : trials(t), world(w), agent(t.front().agent->make(w, t.front().seed)) {
     for (const auto& c : trials) {
         layers.emplace_back(c.model.bvc);
         nets.emplace_back(c.model.bvc.n_cells(), c.model.place, c.seed);
+        if (c.weights) nets.back().set_weights(c.weights->values);
         bvc_rates.emplace_back(layers.back().n_cells());
         const int si = use_source(c.model, factory);
         source_of.push_back(si);
@@ -85,10 +86,12 @@ int GroupRun::use_source(const ModelSpec& model, const SourceFactory& factory) {
         if (made ? sources[i].source == made : table && table->same_beams(model.sensor)) return static_cast<int>(i);
     }
     if (!made) {
+        if (!world)
+            throw InputError("model '" + model.name + "' has no source of returns: without a world its sensor cannot be cast");
         // Sensor noise: the trial's own stream, the same draws for every sensor of the group (common
         // random numbers: conditions that differ in their noise level see the same underlying draws).
         const std::uint64_t noise_seed = hash_u64(trials.front().seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
-        made = std::make_shared<RayCastSource>(world, model.sensor, noise_seed);
+        made = std::make_shared<RayCastSource>(*world, model.sensor, noise_seed);
     }
     const LidarSpec* table = made->beam_table();
     sources.push_back(SourceUse{made, std::vector<char>(table ? table->elevations.size() : 0, 0), {}, {}, false});
@@ -218,14 +221,16 @@ std::string group_fingerprint(const std::vector<TrialConfig>& trials) {
 
 GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunControl& control) {
     check_group(trials);
+    if (trials.front().world.is_none()) return run_trial_group(nullptr, trials, control);
     const World world(trials.front().world.resolve());
-    return run_trial_group(world, trials, control);
+    return run_trial_group(&world, trials, control);
 }
 
-GroupResult run_trial_group(const World& world, const std::vector<TrialConfig>& trials, const RunControl& control,
+GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& trials, const RunControl& control,
                             const SourceFactory& sources) {
     check_group(trials);
-    GroupRun run(world, trials, sources);
+    const auto& returns = trials.front().returns;
+    GroupRun run(world, trials, sources || !returns ? sources : returns->factory(trials.front().seed));
     const std::string fingerprint = group_fingerprint(trials);
     if (!control.checkpoint.empty()) {
         const auto warn = [&](const std::string& message) {
@@ -265,7 +270,8 @@ GroupResult run_trial_group(const World& world, const std::vector<TrialConfig>& 
             continue;  // exploration is over: go on sampling from here
         }
         run.step(*s, !sampling || online, sampling);
-        if (control.progress && n % 512 == 0) control.progress(run.agent->time(), run.step_index);
+        if (control.progress && n % std::max<std::int64_t>(1, control.progress_every) == 0)
+            control.progress(run.agent->time(), run.step_index);
         const bool stop = control.stop && n % 64 == 0 && control.stop->load();
         if (!control.checkpoint.empty() && (stop || run.agent->time() >= next_ckpt)) {
             GroupCheckpoint c = run.checkpoint(fingerprint);

@@ -22,22 +22,27 @@ namespace bvc3d {
 
 struct RunControl {
     const std::atomic<bool>* stop = nullptr;            // checked every few steps
-    std::function<void(double seconds_done, std::int64_t steps_done)> progress;  // every few hundred steps
+    std::function<void(double seconds_done, std::int64_t steps_done)> progress;  // every progress_every steps
+    std::int64_t progress_every = 512;                  // a replay's steps are few and slow: every step
     std::filesystem::path checkpoint;                   // empty: no checkpoints
     double checkpoint_minutes = 0;                      // > 0: also every this many simulated minutes
     // Warnings (a checkpoint that cannot be used, ...); default: a line on standard error.
     std::function<void(const std::string& message)> warn;
 };
 
-// Where each model's returns come from. Models given the same source share it. Default: the
-// model's sensor ray-cast in the world (models with the same beam table share one).
-using SourceFactory = std::function<std::shared_ptr<ReturnSource>(const ModelSpec& model, const World& world)>;
+// Where each model's returns come from (config/returns_spec.hpp): `sources` if given, else the
+// trials' `returns`, else each model's sensor ray-cast in the world (models with the same beam table
+// share one).
 
-// All trials must share world, seed, protocol and agent (InputError otherwise).
+// All trials must share world, seed, protocol, agent and returns (InputError otherwise).
 GroupResult run_trial_group(const std::vector<TrialConfig>& trials, const RunControl& control = {});
-// The same in a world already built from trials.front().world.
-GroupResult run_trial_group(const World& world, const std::vector<TrialConfig>& trials, const RunControl& control = {},
+// The same in a world already built from trials.front().world, or none (null) for a trial without one.
+GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& trials, const RunControl& control = {},
                             const SourceFactory& sources = {});
+inline GroupResult run_trial_group(const World& world, const std::vector<TrialConfig>& trials,
+                                   const RunControl& control = {}, const SourceFactory& sources = {}) {
+    return run_trial_group(&world, trials, control, sources);
+}
 
 // Fingerprint of a group: what its checkpoint must match to be resumed.
 std::string group_fingerprint(const std::vector<TrialConfig>& trials);

@@ -32,6 +32,7 @@ void write_identity(hid_t f, const TrialIdentity& id) {
     h5::write_attr(f, "sample_hours", id.sample_hours);
     h5::write_attr(f, "config", id.config);
     h5::write_attr(f, "fingerprint", id.fingerprint);
+    for (const auto& [name, value] : id.data_source) h5::write_attr(f, name, value);
 }
 
 void write_array(hid_t loc, const NamedArray& a) {
@@ -274,6 +275,44 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     d.rates = r.finite<float>(s, "/samples/", "rates", rates[1]);
     d.n_place = rates[1];
     return d;
+}
+
+TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc) {
+    auto lock = h5::hdf5_lock();
+    const TrialReader r(path);
+    const auto s = r.group("samples");
+    const std::string name = bvc ? "bvc_rates" : "rates";
+    if (!h5::exists(s, name))
+        r.fail(bvc ? "has no BVC rates (samples/bvc_rates): rerun it recording them" : "has no samples/rates");
+    const auto n = r.shape(s, "/samples/", "x", 1)[0];
+    const bool has_z = h5::exists(s, "z");
+    for (const std::string k : {"y", "z", "t", "heading"})
+        if ((k != "z" || has_z) && r.shape(s, "/samples/", k, 1)[0] != n)
+            r.fail(": dataset '/samples/" + k + "' differs in length from '/samples/x'");
+    const auto dims = r.shape(s, "/samples/", name, 2);
+    if (dims[0] != n)
+        r.fail(": dataset '/samples/" + name + "' has " + std::to_string(dims[0]) + " rows for " + std::to_string(n) + " samples");
+    TrialRates out;
+    out.t = r.finite<double>(s, "/samples/", "t");
+    out.x = r.finite<double>(s, "/samples/", "x");
+    out.y = r.finite<double>(s, "/samples/", "y");
+    out.z = has_z ? r.finite<double>(s, "/samples/", "z") : std::vector<double>(n, 0.0);
+    out.heading = r.finite<double>(s, "/samples/", "heading");
+    out.rates = r.finite<float>(s, "/samples/", name, dims[1]);
+    out.n_cells = dims[1];
+    return out;
+}
+
+TrialWeights read_trial_weights(const std::filesystem::path& path) {
+    auto lock = h5::hdf5_lock();
+    const TrialReader r(path);
+    if (!h5::exists(r.file(), "weights")) r.fail("has no weights");
+    const auto dims = r.shape(r.file(), "/", "weights", 2);
+    TrialWeights w;
+    w.values = r.finite<float>(r.file(), "/", "weights", dims[1]);
+    w.n_place = dims[0];
+    w.n_bvc = dims[1];
+    return w;
 }
 
 std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, const std::string& dataset) {

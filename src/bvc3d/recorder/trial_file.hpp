@@ -32,6 +32,9 @@ struct TrialIdentity {
     double tilt_deg = NAN;  // cross arenas only
     double explore_hours = NAN, sample_hours = NAN;
     int dims = 2;  // coordinates of the analyzed positions: 2, or 3 for flying agents
+    // Where the returns came from when not from the world (a replayed recording: its name and
+    // files), written as text attributes of these names when present.
+    std::vector<std::pair<std::string, std::string>> data_source;
 };
 
 // A named array of a trial file, row-major with the given shape.
@@ -77,6 +80,21 @@ struct TrialFileData : TrialIdentity {
 };
 TrialFileData read_trial_samples(const std::filesystem::path& path);  // throws InputError
 
+// The recorded samples' positions and one kind of rates: place-cell rates (`rates`) or BVC rates
+// (`bvc_rates`, present when the trial recorded them; InputError naming the file otherwise).
+struct TrialRates {
+    std::vector<double> t, x, y, z, heading;  // z all 0 for ground trials
+    std::vector<float> rates;                 // samples × cells
+    std::size_t n_cells = 0;
+};
+TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc);
+
+// The trained weights (n_place × n_bvc, row-major) of a trial file.
+struct TrialWeights {
+    std::vector<float> values;
+    std::size_t n_place = 0, n_bvc = 0;
+};
+TrialWeights read_trial_weights(const std::filesystem::path& path);
 // Any dataset of a trial file by its path inside the file ("samples/heading", "metrics/sai",
 // "weights"), as stored: float64, float32, or int64 for integers. nullopt when the file lacks it;
 // InputError when the file is missing, broken or not a trial file, or the dataset holds neither

@@ -25,30 +25,9 @@ public:
     FileDescriptor(const FileDescriptor&) = delete;
     FileDescriptor& operator=(const FileDescriptor&) = delete;
     int get() const { return fd_; }
-    // Closes now, reporting the error: on some file systems a full disk only shows here.
-    bool close() {
-        const int fd = fd_;
-        fd_ = -1;
-        return ::close(fd) == 0;
-    }
 
 private:
     int fd_;
-};
-
-// The temporary file of an atomic write: removed unless renamed into place.
-class TemporaryFile {
-public:
-    explicit TemporaryFile(std::string path) : path_(std::move(path)) {}
-    ~TemporaryFile() {
-        if (!path_.empty()) ::unlink(path_.c_str());
-    }
-    TemporaryFile(const TemporaryFile&) = delete;
-    TemporaryFile& operator=(const TemporaryFile&) = delete;
-    void release() { path_.clear(); }
-
-private:
-    std::string path_;
 };
 
 void check_is_readable_file(const fs::path& file) {
@@ -67,16 +46,6 @@ void read_exactly(int fd, const fs::path& file, char* out, std::size_t size) {
         if (n < 0 && errno == EINTR) continue;
         if (n < 0) throw input_error(file, "cannot read: " + errno_text());
         if (n == 0) throw input_error(file, "cannot read: the file shrank while being read");
-        done += static_cast<std::size_t>(n);
-    }
-}
-
-void write_all(int fd, const fs::path& file, std::string_view bytes) {
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0) throw input_error(file, "cannot write: " + errno_text());
         done += static_cast<std::size_t>(n);
     }
 }
@@ -105,20 +74,6 @@ std::string read_file(const fs::path& file) {
     std::string bytes(static_cast<std::size_t>(info.st_size), '\0');
     read_exactly(fd.get(), file, bytes.data(), bytes.size());
     return bytes;
-}
-
-void write_file_atomically(const fs::path& file, std::string_view bytes) {
-    // mkstemp picks a fresh name beside the target (same file system, so rename is atomic).
-    std::string temp_name = file.string() + ".tmpXXXXXX";
-    FileDescriptor fd(::mkstemp(temp_name.data()));
-    if (fd.get() < 0) throw input_error(file, "cannot write: " + errno_text());
-    TemporaryFile temp(temp_name);
-    // mkstemp creates the file 0600; an output file should be readable like any other.
-    if (::fchmod(fd.get(), 0644) != 0) throw input_error(file, "cannot write: " + errno_text());
-    write_all(fd.get(), file, bytes);
-    if (!fd.close()) throw input_error(file, "cannot write: " + errno_text());
-    if (::rename(temp_name.c_str(), file.c_str()) != 0) throw input_error(file, "cannot write: " + errno_text());
-    temp.release();
 }
 
 }  // namespace bvc3d::recording::detail

@@ -1,7 +1,7 @@
 #pragma once
-// Internal to the recording stage: whole-file reads, all-or-nothing writes, and the one shape of
-// error every reader throws. Takes: paths and bytes. Gives: file contents, files on disk, and
-// InputErrors worded "<file>: <where>: <reason>" (where = "line 12", "point 7", ... or nothing).
+// Internal to the recording stage: whole-file reads and the one shape of error every reader
+// throws. Takes: paths. Gives: file contents, and InputErrors worded "<file>: <where>: <reason>"
+// (where = "line 12", "point 7", ... or nothing). Writers use core/atomic_file.hpp.
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -21,10 +21,5 @@ std::string point_ref(std::size_t point);
 // The whole file in memory. Throws InputError for a missing file, a directory, an unreadable
 // file or an empty one, naming the file and the reason.
 std::string read_file(const std::filesystem::path& file);
-
-// Writes `bytes` to a temporary file beside `file` and renames it into place, so that `file` is
-// either the old one or the complete new one. Write errors (a full disk, a missing folder) throw
-// InputError naming `file` and strerror.
-void write_file_atomically(const std::filesystem::path& file, std::string_view bytes);
 
 }  // namespace bvc3d::recording::detail

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/recording/file_io.hpp"
 #include "bvc3d/recording/parsing.hpp"
 

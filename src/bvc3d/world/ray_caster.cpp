@@ -30,8 +30,15 @@ void check_device(RTCDevice device, const char* what) {
 
 }  // namespace
 
-RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
-    if (mesh.empty()) throw InputError("world has no geometry (no triangles)");
+RayCaster::RayCaster(const TriangleMesh& mesh, const std::vector<SphereSet>& spheres)
+    : impl_(std::make_unique<Impl>()), spheres_(spheres) {
+    std::size_t n_spheres = 0;
+    for (const auto& set : spheres) {
+        if (!(set.radius > 0) || !std::isfinite(set.radius))
+            throw InputError("world: a point cloud's sphere radius must be a positive number");
+        n_spheres += set.centers.size();
+    }
+    if (mesh.empty() && n_spheres == 0) throw InputError("world has no geometry (no triangles or points)");
     impl_->device = rtcNewDevice("verbose=0");
     if (!impl_->device) throw std::runtime_error("could not create an Embree device");
     impl_->scene = rtcNewScene(impl_->device);
@@ -39,18 +46,35 @@ RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>())
     rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
 
-    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), mesh.vertices.size()));
-    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-        for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(mesh.vertices[i][k]);
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(unsigned), mesh.triangles.size()));
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-        for (int k = 0; k < 3; ++k) ib[3 * t + k] = mesh.triangles[t][k];
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(impl_->scene, geom);
-    rtcReleaseGeometry(geom);
+    unsigned next_geom = 0;
+    if (!mesh.empty()) {
+        RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), mesh.vertices.size()));
+        for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+            for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(mesh.vertices[i][k]);
+        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                  3 * sizeof(unsigned), mesh.triangles.size()));
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) ib[3 * t + k] = mesh.triangles[t][k];
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(impl_->scene, geom, next_geom++);
+        rtcReleaseGeometry(geom);
+    }
+    first_sphere_geom_ = next_geom;
+    for (const auto& set : spheres) {
+        // One geometry per set, even an empty one, so that geometry ID - first_sphere_geom_ is the set.
+        RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                               4 * sizeof(float), set.centers.size()));
+        for (std::size_t i = 0; i < set.centers.size(); ++i) {
+            for (int k = 0; k < 3; ++k) vb[4 * i + k] = static_cast<float>(set.centers[i][k]);
+            vb[4 * i + 3] = static_cast<float>(set.radius);
+        }
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(impl_->scene, geom, next_geom++);
+        rtcReleaseGeometry(geom);
+    }
     rtcCommitScene(impl_->scene);
     check_device(impl_->device, "scene build");
     if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) impl_->packet = 16;
@@ -66,12 +90,31 @@ RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>())
 
 RayCaster::~RayCaster() = default;
 
-double RayCaster::refine(unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const {
+double RayCaster::refine(unsigned geom, unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const {
+    if (geom >= first_sphere_geom_) {
+        const SphereSet& set = spheres_[geom - first_sphere_geom_];
+        return refine_sphere(set.centers[prim], set.radius, origin, dir, t_float);
+    }
     const Plane& p = planes_[prim];
     const double nd = p.normal.dot(dir);
     // Grazing rays: the plane solve is ill-conditioned, Embree's float distance is better.
     if (std::abs(nd) <= p.grazing) return t_float;
     return std::max(0.0, p.normal.dot(p.point - origin) / nd);
+}
+
+double RayCaster::refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir,
+                                float t_float) const {
+    // |origin + t·dir - center| = radius: t = b ∓ √(b² - q), b = dir·w, q = |w|² - radius², w = center - origin.
+    // Embree chose the sphere in float; a ray grazing it that misses in double (by ~1e-7 of the
+    // radius) takes its point of closest approach, and one that disagrees about the side takes
+    // Embree's float distance, as grazing rays on triangles do.
+    const Vec3 w = center - origin;
+    const double b = dir.dot(w), q = w.squaredNorm() - radius * radius;
+    const double disc = b * b - q;
+    if (q <= 0) return b + std::sqrt(std::max(0.0, disc));  // from inside the sphere: its far side
+    if (b <= 0) return t_float;
+    if (disc <= 0) return b;
+    return q / (b + std::sqrt(disc));  // the near root, without cancellation
 }
 
 double RayCaster::cast(const Vec3& origin, const Vec3& dir, double max_range) const {
@@ -120,7 +163,7 @@ void RayCaster::cast_packets(Intersect intersect, const Vec3& origin, std::span<
         for (std::size_t k = 0; k < n; ++k) {
             double r = no_hit;
             if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) {
-                r = refine(rh.hit.primID[k], origin, dirs[i + k], rh.ray.tfar[k]);
+                r = refine(rh.hit.geomID[k], rh.hit.primID[k], origin, dirs[i + k], rh.ray.tfar[k]);
                 if (r > max_range) r = no_hit;
             }
             ranges[i + k] = r;

@@ -1,19 +1,23 @@
 #pragma once
-// Ray queries against a triangle mesh, through Embree 3.
-// Embree finds the triangle a ray hits (in float); the distance is then recomputed in double
-// against that triangle's plane, so ranges are exact to ~1e-12 m rather than float's ~1e-6 m.
+// Ray queries against a triangle mesh and sets of spheres (points of a point cloud with a radius),
+// through Embree 3 (spheres as its point geometry, RTC_GEOMETRY_TYPE_SPHERE_POINT).
+// Embree finds the triangle or sphere a ray hits (in float); the distance is then recomputed in
+// double against that triangle's plane or that sphere, so ranges are exact to ~1e-12 m rather than
+// float's ~1e-6 m.
 #include <limits>
 #include <memory>
 #include <span>
 #include <vector>
 
 #include "bvc3d/world/mesh.hpp"
+#include "bvc3d/world/world.hpp"
 
 namespace bvc3d {
 
 class RayCaster {
 public:
-    explicit RayCaster(const TriangleMesh& mesh);
+    // Throws InputError when there is no geometry at all, or a sphere radius is not positive.
+    explicit RayCaster(const TriangleMesh& mesh, const std::vector<SphereSet>& spheres = {});
     ~RayCaster();
     RayCaster(const RayCaster&) = delete;
     RayCaster& operator=(const RayCaster&) = delete;
@@ -27,7 +31,8 @@ public:
     void cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range, std::span<double> ranges) const;
 
 private:
-    double refine(unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const;
+    double refine(unsigned geom, unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const;
+    double refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir, float t_float) const;
     template <int N, class RayHitN, class Intersect>
     void cast_packets(Intersect intersect, const Vec3& origin, std::span<const Vec3> dirs, double max_range,
                       std::span<double> ranges) const;
@@ -41,6 +46,9 @@ private:
         double grazing;
     };
     std::vector<Plane> planes_;
+    // Embree geometry IDs: the triangles (if any) first, then one per sphere set, in order.
+    unsigned first_sphere_geom_ = 0;
+    std::vector<SphereSet> spheres_;  // its own copy: a caster is shared by copies of a World
 };
 
 }  // namespace bvc3d

@@ -135,7 +135,26 @@ WorldDescription atrium() {
     return w;
 }
 
+bool WorldDescription::has_geometry() const {
+    if (!mesh.empty()) return true;
+    for (const auto& set : spheres)
+        if (!set.centers.empty()) return true;
+    return false;
+}
+
+Eigen::AlignedBox3d WorldDescription::bounds() const {
+    Eigen::AlignedBox3d box;
+    for (std::size_t t = 0; t < mesh.size(); ++t)
+        for (const Vec3& c : mesh.corners(t)) box.extend(c);
+    for (const auto& set : spheres)
+        for (const Vec3& c : set.centers) {
+            box.extend(c - Vec3::Constant(set.radius));
+            box.extend(c + Vec3::Constant(set.radius));
+        }
+    return box;
+}
+
 World::World(WorldDescription description)
-    : desc_(std::move(description)), caster_(std::make_shared<RayCaster>(desc_.mesh)) {}
+    : desc_(std::move(description)), caster_(std::make_shared<RayCaster>(desc_.mesh, desc_.spheres)) {}
 
 }  // namespace bvc3d

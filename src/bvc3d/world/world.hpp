@@ -1,6 +1,7 @@
 #pragma once
 // World stage: the static 3-D geometry the robot moves through and its sensors see.
-// Takes: a WorldDescription (triangles + floor regions), built in code, from YAML or meshes.
+// Takes: a WorldDescription (triangles, points drawn as small spheres, floor regions), built in
+// code, from YAML, meshes or point clouds.
 // Gives: ray casts (RayCaster, through Embree) and the geometry for body collision.
 #include <memory>
 #include <optional>
@@ -26,14 +27,25 @@ struct FlightVolume {
     Eigen::AlignedBox3d bounds() const;
 };
 
+// Points drawn as spheres of one radius: a registered point map of a building (docs/worlds.md).
+struct SphereSet {
+    std::vector<Vec3> centers;
+    double radius = 0.05;  // m
+};
+
 struct WorldDescription {
     std::string name;
     std::string file;  // the YAML file it came from (errors about its keys name it); empty for presets
     std::optional<double> tilt_deg;  // the tilt of the cross arena, when the world is (or holds) one
     TriangleMesh mesh;
+    std::vector<SphereSet> spheres;
     Polygon2 walkable;  // the robot's body stays inside this floor polygon (none in a flight-only world)
     StartRegion start;
     std::optional<FlightVolume> flight;  // where a flying agent may fly; none in a ground-only world
+
+    bool has_geometry() const;
+    // The box holding every triangle and sphere (empty for a world without geometry).
+    Eigen::AlignedBox3d bounds() const;
 };
 
 // The paper's arena (docs/model-reference.md#the-cross-arena).
@@ -72,6 +84,7 @@ public:
     const WorldDescription& description() const { return desc_; }
     const std::string& name() const { return desc_.name; }
     const TriangleMesh& mesh() const { return desc_.mesh; }
+    const std::vector<SphereSet>& spheres() const { return desc_.spheres; }
     const RayCaster& rays() const { return *caster_; }
 
 private:

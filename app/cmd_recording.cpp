@@ -1,0 +1,548 @@
+// bvc3d replay / localize / map / export-scans: real LiDAR recordings (docs/recordings.md).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <map>
+#include <sstream>
+
+#include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/experiment/pipeline.hpp"
+#include "bvc3d/experiment/replay.hpp"
+#include "bvc3d/recording/extrinsics.hpp"
+#include "bvc3d/recording/recording.hpp"
+#include "bvc3d/recording/voxel_map.hpp"
+#include "bvc3d/recording/ply.hpp"
+#include "bvc3d/recording/pcd.hpp"
+#include "cli_common.hpp"
+
+namespace bvc3d::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<std::string> split_list(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string item; std::getline(ss, item, ',');)
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+// A progress line on a terminal ("\r  what i/n"), nothing otherwise.
+class ProgressLine {
+public:
+    ProgressLine() : tty_(::isatty(STDERR_FILENO)) {}
+    ~ProgressLine() { done(); }
+    void show(const std::string& what, std::size_t i, std::size_t n) {
+        if (!tty_) return;
+        std::fprintf(stderr, "\r  %s %zu/%zu   ", what.c_str(), i, n);
+        shown_ = true;
+    }
+    void done() {
+        if (shown_) std::fprintf(stderr, "\n");
+        shown_ = false;
+    }
+
+private:
+    bool tty_;
+    bool shown_ = false;
+};
+
+// Where scans and poses are, and how to read them.
+struct RecordingOptions {
+    std::string pose_format = "auto", extrinsics;
+    double time_tolerance = 0.05;
+
+    void add_to(CLI::App& cmd) {
+        cmd.add_option("--pose-format", pose_format, "Pose file format: auto, kitti, tum or matrix (4x4 rows)")
+            ->capture_default_str();
+        cmd.add_option("--extrinsics", extrinsics,
+                       "Sensor mounting (base-from-sensor): a file, or 12 or 16 numbers; the poses are then the base's");
+        cmd.add_option("--time-tolerance", time_tolerance, "Seconds within which a scan pairs with a pose by time")
+            ->capture_default_str();
+    }
+    std::shared_ptr<const recording::Recording> open(const std::string& scans, const std::string& poses) const {
+        if (poses.empty()) throw InputError("the scans '" + scans + "' need a pose file");
+        recording::RecordingOptions o;
+        o.pose_format = recording::parse_pose_format(pose_format);
+        o.time_tolerance = time_tolerance;
+        if (!extrinsics.empty()) {
+            std::error_code ec;
+            o.base_from_sensor = fs::is_regular_file(extrinsics, ec) ? recording::read_extrinsics(extrinsics)
+                                                                     : recording::parse_extrinsics(extrinsics, "--extrinsics");
+        }
+        return std::make_shared<const recording::Recording>(recording::open_recording(scans, poses, o));
+    }
+};
+
+// The preprocessing of recorded scans.
+struct PreprocessOptions {
+    RecordedReturnParams params;
+    std::optional<double> slice_deg;
+
+    void add_to(CLI::App& cmd) {
+        cmd.add_option("--min-range", params.min_range, "m: nearer points are dropped")->capture_default_str();
+        cmd.add_option("--max-range", params.max_range, "m: farther points are dropped")->capture_default_str();
+        cmd.add_option("--slice-half-width-deg", slice_deg,
+                       "The 2-D models read the returns within this many degrees of the horizontal (default 1)");
+    }
+    RecordedReturnParams get() const {
+        RecordedReturnParams p = params;
+        if (slice_deg) p.slice_half_width = deg_to_rad(*slice_deg);
+        p.validate();
+        return p;
+    }
+};
+
+// Scans to replay: a recording (--scans, --poses), or a simulated sensor along a path in a world.
+struct SourceOptions {
+    std::string scans, poses, world, trajectory, sensor;
+    RecordingOptions recording;
+    PreprocessOptions preprocess;
+
+    void add_to(CLI::App& cmd) {
+        cmd.add_option("--scans", scans, "Scan folder, scan list file or one scan (PCD, PLY, KITTI .bin)");
+        cmd.add_option("--poses", poses, "Pose file of the scans (KITTI, TUM or 4x4 rows)");
+        recording.add_to(cmd);
+        cmd.add_option("--world", world, "Instead of a recording: a world (preset or YAML) to simulate a sensor in");
+        cmd.add_option("--trajectory", trajectory,
+                       "With --world: the sensor's path, rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
+        cmd.add_option("--sensor", sensor, "With --world: the simulated sensor (horizontal, spherical or a sensor YAML)");
+        preprocess.add_to(cmd);
+    }
+    ReplaySource get() const {
+        const bool recorded = !scans.empty() || !poses.empty();
+        const bool simulated = !world.empty() || !trajectory.empty() || !sensor.empty();
+        if (recorded == simulated)
+            throw InputError("give either a recording (--scans and --poses) or a simulation (--world, --trajectory, --sensor)");
+        if (recorded) {
+            if (scans.empty()) throw InputError("--poses needs --scans");
+            return recorded_source(recording.open(scans, poses), preprocess.get());
+        }
+        if (world.empty() || trajectory.empty() || sensor.empty())
+            throw InputError("a simulated replay needs --world, --trajectory and --sensor");
+        WorldSpec w{world, std::nullopt, "+x+y"};
+        w.resolve();  // fail early on bad worlds
+        auto path = std::make_shared<const TrajectorySpec>(TrajectorySpec::from_file(trajectory));
+        return simulated_source(w, path, config::resolve_sensor(sensor), preprocess.get());
+    }
+};
+
+std::shared_ptr<const InitialWeights> weights_from(const std::string& file) {
+    if (file.empty()) return nullptr;
+    const TrialWeights w = read_trial_weights(file);
+    auto out = std::make_shared<InitialWeights>();
+    out->source = file;
+    out->values = w.values;
+    out->n_place = static_cast<int>(w.n_place);
+    out->n_bvc = static_cast<int>(w.n_bvc);
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// replay
+
+void add_replay(CLI::App& app) {
+    auto* cmd = app.add_subcommand("replay", "Run a recording's scans through a model; write a trial file with every scan's rates");
+    struct Options {
+        SourceOptions source;
+        std::string model, weights, out;
+        bool learn = false;
+        std::uint64_t seed = 0;
+    };
+    auto o = std::make_shared<Options>();
+    o->source.add_to(*cmd);
+    cmd->add_option("--model", o->model, "Model preset or model YAML")->required();
+    cmd->add_flag("--learn", o->learn, "Place cells learn while replaying (Oja's rule); default: frozen");
+    cmd->add_option("--weights", o->weights, "Start from the trained weights of this trial file (same model)");
+    cmd->add_option("--seed", o->seed, "Seed of the initial weights when no --weights is given")->capture_default_str()
+        ->check(seed_check);
+    cmd->add_option("--out", o->out, "Trial file to write (default results/<recording>_<model>.h5)");
+    cmd->footer(
+        "Each scan is one model step at its pose: its points are rotated into the world frame (gravity-aligned),\n"
+        "kept within the range limits, and each model reads the upper half (3-D presets) or the horizontal slice\n"
+        "(2-D models). The trial file records every scan's x, y, z, heading and time (from 0; the recording's\n"
+        "first time is the attribute recording_t0), its BVC rates and place-cell rates (docs/recordings.md).");
+    cmd->callback([o] {
+        const ReplaySource source = o->source.get();
+        const TrialConfig t = replay_trial(source, config::resolve_model(o->model), o->learn, weights_from(o->weights), o->seed);
+        const fs::path out = o->out.empty() ? fs::path("results") / (t.world_label() + "_" + t.model.name + ".h5") : fs::path(o->out);
+        ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
+        const std::size_t n = source.path->steps().size();
+        ProgressLine line;
+        RunControl control;
+        control.progress_every = 1;
+        control.progress = [&](double, std::int64_t steps) { line.show("scan", static_cast<std::size_t>(steps), n); };
+        const auto start = std::chrono::steady_clock::now();
+        const GroupOutcome done = run_analyze_write({t}, {out}, control);
+        line.done();
+        const double wall = seconds_since(start);
+        std::printf("replayed %zu scans of %s through %s in %.2f s (%.1f scans/s): %s\n", done.result.t.size(),
+                    t.world_label().c_str(), t.model.name.c_str(), wall, static_cast<double>(n) / wall, out.c_str());
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// localize
+
+// One side of a localization (templates or queries): a trial file, or a recording to replay.
+struct Side {
+    std::string file;   // a trial file (may hold {model})
+    std::shared_ptr<const recording::Recording> recording;
+    std::vector<std::size_t> keep;  // scans of the recording used (all when empty)
+};
+
+struct SideRates {
+    analysis::RowMatrixXf rates;
+    analysis::Points xyz;
+    std::vector<std::size_t> index;  // scan or sample index of each row
+};
+
+std::string with_model(const std::string& pattern, const std::string& model) {
+    std::string s = pattern;
+    for (auto at = s.find("{model}"); at != std::string::npos; at = s.find("{model}", at + model.size()))
+        s.replace(at, 7, model);
+    return s;
+}
+
+SideRates rows_of(const analysis::RowMatrixXf& rates, const analysis::Points& xyz, const std::vector<std::size_t>& keep) {
+    SideRates r;
+    if (keep.empty()) {
+        r.rates = rates;
+        r.xyz = xyz;
+        for (Eigen::Index i = 0; i < rates.rows(); ++i) r.index.push_back(static_cast<std::size_t>(i));
+        return r;
+    }
+    r.rates.resize(static_cast<Eigen::Index>(keep.size()), rates.cols());
+    r.xyz.resize(static_cast<Eigen::Index>(keep.size()), 3);
+    for (std::size_t k = 0; k < keep.size(); ++k) {
+        r.rates.row(static_cast<Eigen::Index>(k)) = rates.row(static_cast<Eigen::Index>(keep[k]));
+        r.xyz.row(static_cast<Eigen::Index>(k)) = xyz.row(static_cast<Eigen::Index>(keep[k]));
+    }
+    r.index = keep;
+    return r;
+}
+
+SideRates side_from_file(const std::string& file, const ModelSpec& model, bool bvc) {
+    const TrialRates t = read_trial_rates(file, bvc);
+    const std::size_t expected = bvc ? static_cast<std::size_t>(model.bvc.n_cells()) : static_cast<std::size_t>(model.place.n_place);
+    if (t.n_cells != expected)
+        throw InputError("trial file '" + file + "' has " + std::to_string(t.n_cells) + " cells per sample; model '" +
+                         model.name + "' has " + std::to_string(expected));
+    const auto n = static_cast<Eigen::Index>(t.x.size());
+    analysis::Points xyz(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        xyz.row(i) << t.x[k], t.y[k], t.z[k];
+    }
+    return rows_of(Eigen::Map<const analysis::RowMatrixXf>(t.rates.data(), n, static_cast<Eigen::Index>(t.n_cells)), xyz, {});
+}
+
+struct LocalizeRow {
+    std::string model;
+    SideRates templates, queries;
+    analysis::LocalizationResult result;
+};
+
+std::string f3(double v) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.3f", v);
+    return s;
+}
+
+void write_localization(const fs::path& dir, const std::vector<LocalizeRow>& rows, bool bvc) {
+    const std::string rates = bvc ? "bvc" : "place";
+    std::string summary =
+        "model,rates,queries,templates,undecoded,median_m,mean_m,within_1m,within_2m,vertical_median_m,vertical_mean_m,"
+        "chance_median_m,chance_mean_m,chance_within_1m,chance_within_2m,nearest_median_m,nearest_mean_m,"
+        "nearest_within_1m,nearest_within_2m\n";
+    std::string queries = "model,query,x,y,z,decoded,decoded_x,decoded_y,decoded_z,similarity,error_m,vertical_error_m,nearest_m\n";
+    std::string templates = "model,template,x,y,z\n";
+    std::string md = "| model | rates | queries | templates | median (m) | mean (m) | ≤ 1 m | ≤ 2 m | chance median | chance ≤ 2 m | "
+                     "nearest median | nearest ≤ 1 m |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& row : rows) {
+        const auto& r = row.result;
+        const auto& s = r.decoded_summary;
+        summary += row.model + "," + rates + "," + std::to_string(row.queries.rates.rows()) + "," +
+                   std::to_string(row.templates.rates.rows()) + "," + std::to_string(r.n_undecoded) + "," + num(s.median) + "," +
+                   num(s.mean) + "," + num(s.within_1m) + "," + num(s.within_2m) + "," + num(r.vertical_median) + "," +
+                   num(r.vertical_mean) + "," + num(r.chance.median) + "," + num(r.chance.mean) + "," +
+                   num(r.chance.within_1m) + "," + num(r.chance.within_2m) + "," + num(r.nearest.median) + "," +
+                   num(r.nearest.mean) + "," + num(r.nearest.within_1m) + "," + num(r.nearest.within_2m) + "\n";
+        md += "| " + row.model + " | " + rates + " | " + std::to_string(row.queries.rates.rows()) + " | " +
+              std::to_string(row.templates.rates.rows()) + " | " + f3(s.median) + " | " + f3(s.mean) + " | " +
+              f3(s.within_1m) + " | " + f3(s.within_2m) + " | " + f3(r.chance.median) + " | " + f3(r.chance.within_2m) +
+              " | " + f3(r.nearest.median) + " | " + f3(r.nearest.within_1m) + " |\n";
+        for (std::size_t i = 0; i < r.decoded.size(); ++i) {
+            const auto q = static_cast<Eigen::Index>(i);
+            const long d = r.decoded[i];
+            queries += row.model + "," + std::to_string(row.queries.index[i]) + "," + num(row.queries.xyz(q, 0)) + "," +
+                       num(row.queries.xyz(q, 1)) + "," + num(row.queries.xyz(q, 2)) + ",";
+            if (d >= 0)
+                queries += std::to_string(row.templates.index[static_cast<std::size_t>(d)]) + "," + num(row.templates.xyz(d, 0)) +
+                           "," + num(row.templates.xyz(d, 1)) + "," + num(row.templates.xyz(d, 2)) + ",";
+            else
+                queries += ",,,,";
+            queries += num(r.similarity[i]) + "," + num(r.error[i]) + "," + num(r.vertical_error[i]) + "," +
+                       num(r.nearest_error[i]) + "\n";
+        }
+        for (Eigen::Index j = 0; j < row.templates.xyz.rows(); ++j)
+            templates += row.model + "," + std::to_string(row.templates.index[static_cast<std::size_t>(j)]) + "," +
+                         num(row.templates.xyz(j, 0)) + "," + num(row.templates.xyz(j, 1)) + "," + num(row.templates.xyz(j, 2)) +
+                         "\n";
+    }
+    write_file_atomically(dir / "localization.csv", summary);
+    write_file_atomically(dir / "queries.csv", queries);
+    write_file_atomically(dir / "templates.csv", templates);
+    write_file_atomically(dir / "localization.md", md);
+}
+
+void add_localize(CLI::App& app) {
+    auto* cmd = app.add_subcommand("localize", "Localize query scans against template scans (a table and a figure)");
+    struct Options {
+        std::string templates, template_poses, queries, query_poses, scans, poses, models, rates = "bvc", weights;
+        std::string out = "results/localization";
+        int split = 0;
+        bool no_figure = false;
+        RecordingOptions recording;
+        PreprocessOptions preprocess;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--templates", o->templates, "Templates: a trial file ({model} stands for each model's name) or a scan folder/list");
+    cmd->add_option("--template-poses", o->template_poses, "Pose file of the template scans");
+    cmd->add_option("--queries", o->queries, "Queries: a trial file (may contain {model}) or a scan folder/list");
+    cmd->add_option("--query-poses", o->query_poses, "Pose file of the query scans");
+    cmd->add_option("--scans", o->scans, "One recording for both, split by --split (instead of --templates/--queries)");
+    cmd->add_option("--poses", o->poses, "Pose file of --scans");
+    cmd->add_option("--split", o->split, "With --scans: scan i is a query when i mod N = 1, else a template")
+        ->capture_default_str();
+    cmd->add_option("--model", o->models, "Model presets or YAML files, comma-separated")->required();
+    cmd->add_option("--rates", o->rates, "Decode on 'bvc' rates (default) or 'place' rates")->capture_default_str();
+    cmd->add_option("--weights", o->weights,
+                    "With --rates place: trained weights for replayed recordings, a trial file (may contain {model})");
+    o->recording.add_to(*cmd);
+    o->preprocess.add_to(*cmd);
+    cmd->add_option("--out", o->out, "Folder for localization.csv/.md, queries.csv, templates.csv, localization.png")
+        ->capture_default_str();
+    cmd->add_flag("--no-figure", o->no_figure, "Skip the figure");
+    cmd->footer(
+        "Each query is decoded to the template whose population vector is most cosine-similar; the error is the\n"
+        "horizontal distance between their positions (and, apart, the vertical one). Chance: a uniformly random\n"
+        "template; nearest: the template nearest to each query (the best possible). Recordings are replayed in\n"
+        "memory with each model (frozen place cells: --weights, or the seed-0 draw); trial files are read as they\n"
+        "are (docs/recordings.md#localize).");
+    cmd->callback([o] {
+        if (o->rates != "bvc" && o->rates != "place") throw InputError("--rates must be 'bvc' or 'place'");
+        const bool bvc = o->rates == "bvc";
+        const auto models = split_list(o->models);
+        if (models.empty()) throw InputError("--model lists no model");
+        const RecordedReturnParams pre = o->preprocess.get();
+
+        Side templates, queries;
+        if (!o->scans.empty()) {
+            if (!o->templates.empty() || !o->queries.empty())
+                throw InputError("give either --scans with --split, or --templates and --queries");
+            if (o->split < 2) throw InputError("--scans needs --split N (N >= 2): scan i is a query when i mod N = 1");
+            const auto rec = o->recording.open(o->scans, o->poses);
+            templates.recording = queries.recording = rec;
+            for (std::size_t i = 0; i < rec->size(); ++i)
+                (i % static_cast<std::size_t>(o->split) == 1 ? queries : templates).keep.push_back(i);
+        } else {
+            if (o->templates.empty() || o->queries.empty()) throw InputError("give --templates and --queries (or --scans with --split)");
+            auto side = [&](const std::string& what, const std::string& poses) {
+                Side s;
+                if (fs::path(what).extension() == ".h5") {
+                    if (!poses.empty()) throw InputError("'" + what + "' is a trial file: it needs no pose file");
+                    s.file = what;
+                } else {
+                    s.recording = o->recording.open(what, poses);
+                }
+                return s;
+            };
+            templates = side(o->templates, o->template_poses);
+            queries = side(o->queries, o->query_poses);
+        }
+        ensure_writable_directory(o->out);
+
+        // Every model on each recording at once: one replay per recording, its scans read once.
+        std::vector<ModelSpec> specs;
+        for (const auto& m : models) specs.push_back(config::resolve_model(m));
+        ProgressLine line;
+        std::map<const recording::Recording*, GroupResult> replays;
+        for (const Side* s : {&templates, &queries}) {
+            if (!s->recording || replays.count(s->recording.get())) continue;
+            const ReplaySource source = recorded_source(s->recording, pre);
+            std::vector<TrialConfig> trials;
+            for (std::size_t k = 0; k < specs.size(); ++k)
+                trials.push_back(replay_trial(source, specs[k], false,
+                                              bvc ? nullptr : weights_from(with_model(o->weights, specs[k].name))));
+            if (!bvc && o->weights.empty())
+                std::fprintf(stderr, "bvc3d: warning: place-cell rates without --weights come from untrained (seed 0) weights\n");
+            RunControl control;
+            control.progress_every = 1;
+            const std::string what = s->recording->name + " scan";
+            const std::size_t n = s->recording->size();
+            control.progress = [&](double, std::int64_t steps) { line.show(what, static_cast<std::size_t>(steps), n); };
+            replays[s->recording.get()] = run_replay(trials, control);
+            line.done();
+        }
+        std::vector<LocalizeRow> rows;
+        for (std::size_t k = 0; k < specs.size(); ++k) {
+            auto rates_of = [&](const Side& s) {
+                if (!s.file.empty()) return side_from_file(with_model(s.file, specs[k].name), specs[k], bvc);
+                const ReplayRates r = replay_rates(replays.at(s.recording.get()), k, bvc);
+                return rows_of(r.rates, r.xyz, s.keep);
+            };
+            LocalizeRow row;
+            row.model = specs[k].name;
+            row.templates = rates_of(templates);
+            row.queries = rates_of(queries);
+            row.result = analysis::localize(row.templates.rates, row.templates.xyz, row.queries.rates, row.queries.xyz);
+            rows.push_back(std::move(row));
+        }
+        write_localization(o->out, rows, bvc);
+        std::printf("%-12s %7s %9s %8s %8s %6s %6s | %14s %12s | %14s %13s\n", "model", "queries", "templates", "median_m",
+                    "mean_m", "<=1m", "<=2m", "chance_median", "chance_<=2m", "nearest_median", "nearest_<=1m");
+        for (const auto& row : rows) {
+            const auto& r = row.result;
+            std::printf("%-12s %7ld %9ld %8.3f %8.3f %6.3f %6.3f | %14.3f %12.3f | %14.3f %13.3f\n", row.model.c_str(),
+                        static_cast<long>(row.queries.rates.rows()), static_cast<long>(row.templates.rates.rows()),
+                        r.decoded_summary.median, r.decoded_summary.mean, r.decoded_summary.within_1m,
+                        r.decoded_summary.within_2m, r.chance.median, r.chance.within_2m, r.nearest.median,
+                        r.nearest.within_1m);
+            if (r.n_undecoded) std::printf("  %s: %zu queries undecoded (no positive similarity)\n", row.model.c_str(), r.n_undecoded);
+        }
+        if (!o->no_figure && run_python_module("bvc3d.localization_figure", {o->out}) != 0)
+            throw InputError("the figure failed; the tables are in '" + o->out +
+                             "'; rerun with: python3 -m bvc3d.localization_figure " + o->out);
+        std::printf("tables: %s/localization.md, localization.csv, queries.csv%s\n", o->out.c_str(),
+                    o->no_figure ? "" : ", figure: localization.png");
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// map
+
+void add_map(CLI::App& app) {
+    auto* cmd = app.add_subcommand("map", "Build a point map from a recording: its scans in the world frame, voxel-downsampled");
+    struct Options {
+        std::string scans, poses, out;
+        recording::VoxelMapParams params;
+        RecordingOptions recording;
+    };
+    auto o = std::make_shared<Options>();
+    o->params.min_range = 0.3;
+    cmd->add_option("--scans", o->scans, "Scan folder, scan list file or one scan")->required();
+    cmd->add_option("--poses", o->poses, "Pose file of the scans")->required();
+    o->recording.add_to(*cmd);
+    cmd->add_option("--voxel", o->params.voxel, "m, voxel edge: one point (the mean) per occupied voxel")->capture_default_str();
+    cmd->add_option("--min-range", o->params.min_range, "m: nearer points are left out (the carrier)")->capture_default_str();
+    cmd->add_option("--max-range", o->params.max_range, "m: farther points are left out (0: no limit)")->capture_default_str();
+    cmd->add_option("--min-points", o->params.min_points, "Voxels with fewer points are left out")->capture_default_str();
+    cmd->add_option("--out", o->out, "Map to write: .ply (binary, float) or .pcd (binary, float)")->required();
+    cmd->footer(
+        "The map is a point cloud in the recording's world frame; a world YAML draws it as spheres with a\n"
+        "point_cloud object (docs/worlds.md#point-clouds), so that a simulated robot or sensor can use it.");
+    cmd->callback([o] {
+        const auto ext = fs::path(o->out).extension().string();
+        if (ext != ".ply" && ext != ".pcd") throw InputError("--out must end in .ply or .pcd");
+        const auto rec = o->recording.open(o->scans, o->poses);
+        recording::VoxelMap map(o->params);
+        ProgressLine line;
+        const auto start = std::chrono::steady_clock::now();
+        for (std::size_t i = 0; i < rec->size(); ++i) {
+            line.show(rec->name + " scan", i + 1, rec->size());
+            map.add(rec->load(i), rec->poses[i].world_from_sensor);
+        }
+        line.done();
+        const recording::PointCloud cloud = map.cloud();
+        if (cloud.size() == 0) throw InputError("the map is empty: no point passed the range limits and --min-points");
+        if (ext == ".ply") recording::write_ply(o->out, cloud);
+        else recording::write_pcd(o->out, cloud);
+        std::printf("%zu scans, %zu points -> %zu voxels of %g m in %.1f s: %s\n", rec->size(), map.points_added(),
+                    cloud.size(), o->params.voxel, seconds_since(start), o->out.c_str());
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// export-scans
+
+void add_export_scans(CLI::App& app) {
+    auto* cmd = app.add_subcommand("export-scans", "Write simulated scans along a path as a recording (scans + poses)");
+    struct Options {
+        std::string world = "cross", trajectory, sensor = "spherical", format = "pcd-f8", out;
+        std::optional<double> tilt, hours;
+        std::uint64_t seed = 0;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--world", o->world, "Preset or world YAML")->capture_default_str();
+    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
+    cmd->add_option("--trajectory", o->trajectory, "Path: rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
+    cmd->add_option("--hours", o->hours, "Instead of --trajectory: this many hours of the seeded random walk");
+    cmd->add_option("--seed", o->seed, "Seed of the random walk and of the sensor's noise")->capture_default_str()->check(seed_check);
+    cmd->add_option("--sensor", o->sensor, "horizontal, spherical (upper half) or a sensor YAML")->capture_default_str();
+    cmd->add_option("--format", o->format, "pcd (float32), pcd-f8 (float64), ply or kitti (.bin)")->capture_default_str();
+    cmd->add_option("--out", o->out, "Folder to write: 000000.<ext> ..., poses.txt, scans.txt")->required();
+    cmd->footer(
+        "Each scan holds the hits in the sensor's own frame (x forward, z up; tilted with the pose's pitch and\n"
+        "roll); poses.txt holds each sensor's world-from-sensor pose (4x4 rows with the time). Replaying the\n"
+        "folder gives the simulation's returns back (docs/recordings.md#export-scans).");
+    cmd->callback([o] {
+        const auto format = recording::parse_scan_write_format(o->format);
+        if (o->trajectory.empty() == !o->hours.has_value()) throw InputError("give --trajectory or --hours, not both");
+        if (o->hours && !(*o->hours > 0)) throw InputError("--hours must be positive");
+        const World world(config::resolve_world(o->world, o->tilt, "+x+y"));
+        const Lidar lidar(config::resolve_sensor(o->sensor));
+        const std::vector<ModelStep> steps =
+            o->hours ? random_walk(world, *o->hours, o->seed) : TrajectorySpec::from_file(o->trajectory).steps();
+        const std::uint64_t noise_seed = hash_u64(o->seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
+        std::vector<recording::PointCloud> clouds;
+        std::vector<recording::PoseRecord> poses;
+        ProgressLine line;
+        Scan scan;
+        for (std::size_t i = 0; i < steps.size(); ++i) {
+            line.show("scan", i + 1, steps.size());
+            const Pose& p = steps[i].pose;
+            lidar.scan(world, p, scan, NoiseKey{noise_seed, i});
+            recording::PoseRecord pose;
+            pose.world_from_sensor = sensor_pose(p, lidar.spec().height);
+            pose.time = steps[i].t;
+            recording::PointCloud cloud = points_from_returns(scan, pose.world_from_sensor.linear());
+            if (cloud.size() == 0)
+                throw InputError("step " + std::to_string(i) + " at (" + num(p.x) + ", " + num(p.y) +
+                                 "): the sensor sees nothing, and a recording's scan cannot be empty");
+            clouds.push_back(std::move(cloud));
+            poses.push_back(pose);
+        }
+        line.done();
+        recording::write_recording(o->out, clouds, poses, format);
+        std::printf("wrote %zu scans and their poses to %s\n", clouds.size(), o->out.c_str());
+    });
+}
+
+}  // namespace
+
+void add_recording_commands(CLI::App& app) {
+    add_replay(app);
+    add_localize(app);
+    add_map(app);
+    add_export_scans(app);
+}
+
+}  // namespace bvc3d::cli

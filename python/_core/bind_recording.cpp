@@ -1,0 +1,284 @@
+// Recordings: Recording (scans + poses), replays through models, localization.
+#include "bindings.hpp"
+
+#include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/analysis/localization.hpp"
+#include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/experiment/replay.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
+#include "bvc3d/recording/extrinsics.hpp"
+#include "bvc3d/recording/recording.hpp"
+
+namespace bvc3d::py {
+
+namespace {
+
+using RecordingPtr = std::shared_ptr<recording::Recording>;  // pybind11 holders are non-const
+using ArrayF = pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast>;
+
+RecordedReturnParams preprocess_of(const pyb::kwargs& kwargs, const std::vector<std::string>& skip) {
+    RecordedReturnParams p;
+    apply_kwargs(p, RecordedReturnParams::table(), kwargs, skip);
+    return p;
+}
+
+pyb::array_t<double> matrix4(const Eigen::Isometry3d& m) {
+    const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> r = m.matrix();
+    return to_numpy(r.data(), {4, 4});
+}
+
+pyb::array_t<double> points_of(const recording::PointCloud& c) {
+    return to_numpy(c.xyz.data(), {static_cast<pyb::ssize_t>(c.size()), 3});
+}
+
+std::shared_ptr<const InitialWeights> weights_of(const pyb::object& obj) {
+    if (obj.is_none()) return nullptr;
+    auto w = std::make_shared<InitialWeights>();
+    if (pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__")) {
+        const std::string file = pyb::str(obj);
+        const TrialWeights t = read_trial_weights(file);
+        w->source = file;
+        w->values = t.values;
+        w->n_place = static_cast<int>(t.n_place);
+        w->n_bvc = static_cast<int>(t.n_bvc);
+        return w;
+    }
+    const auto a = obj.cast<ArrayF>();
+    if (a.ndim() != 2) throw InputError("weights must be a trial file or an (n_place, n_bvc) array");
+    w->source = "array";
+    w->values.assign(a.data(), a.data() + a.size());
+    w->n_place = static_cast<int>(a.shape(0));
+    w->n_bvc = static_cast<int>(a.shape(1));
+    return w;
+}
+
+pyb::dict replay_dict(const GroupResult& r) {
+    const auto n = static_cast<pyb::ssize_t>(r.t.size());
+    const auto& rec = r.models[0];
+    pyb::dict out;
+    out["t"] = to_numpy(r.t.data(), {n});
+    out["x"] = to_numpy(r.x.data(), {n});
+    out["y"] = to_numpy(r.y.data(), {n});
+    out["z"] = to_numpy(r.z.data(), {n});
+    out["heading"] = to_numpy(r.heading.data(), {n});
+    out["bvc_rates"] = to_numpy(rec.bvc.data(), {n, rec.n_bvc});
+    out["rates"] = to_numpy(rec.rates.data(), {n, rec.n_place});
+    out["weights"] = to_numpy(rec.weights.data(), {rec.n_place, rec.n_bvc});
+    return out;
+}
+
+pyb::dict run(const ReplaySource& source, const std::string& model, bool learn, const pyb::object& weights,
+              std::uint64_t seed) {
+    const TrialConfig t = replay_trial(source, config::resolve_model(model), learn, weights_of(weights), seed);
+    GroupResult r;
+    {
+        pyb::gil_scoped_release release;
+        r = run_replay({t});
+    }
+    return replay_dict(r);
+}
+
+const char* preprocess_doc = "Preprocessing keywords (docs/recordings.md):\n";
+
+void bind_recording_class(pyb::module_& m) {
+    pyb::class_<recording::Recording, RecordingPtr>(m, "Recording", R"doc(
+A recording: scans (PCD, PLY, KITTI .bin) in order, each with its pose (world_from_sensor, 4×4) and
+time. Recording.open(scans, poses) reads a scan folder or list file and a pose file (KITTI, TUM or
+4×4 rows) and pairs them (in order, or by time). Iterating gives (pose, points) pairs: a (4, 4)
+array and the scan's (N, 3) points in the sensor frame (docs/recordings.md).)doc")
+        .def_static(
+            "open",
+            [](const std::filesystem::path& scans, const std::filesystem::path& poses, const std::string& pose_format,
+               const pyb::object& extrinsics, double time_tolerance) {
+                recording::RecordingOptions o;
+                o.pose_format = recording::parse_pose_format(pose_format);
+                o.time_tolerance = time_tolerance;
+                if (!extrinsics.is_none()) {
+                    if (pyb::isinstance<pyb::str>(extrinsics) || pyb::hasattr(extrinsics, "__fspath__")) {
+                        o.base_from_sensor = recording::read_extrinsics(pyb::str(extrinsics).cast<std::string>());
+                    } else {
+                        // Python's repr of each float is its shortest exact text: the parser reads what numpy holds.
+                        const auto a = extrinsics.cast<ArrayD>();
+                        std::string text;
+                        for (pyb::ssize_t i = 0; i < a.size(); ++i)
+                            text += pyb::repr(pyb::float_(a.data()[i])).cast<std::string>() + " ";
+                        o.base_from_sensor = recording::parse_extrinsics(text, "extrinsics");
+                    }
+                }
+                return std::make_shared<recording::Recording>(recording::open_recording(scans, poses, o));
+            },
+            pyb::arg("scans"), pyb::arg("poses"), pyb::arg("pose_format") = "auto", pyb::arg("extrinsics") = pyb::none(),
+            pyb::arg("time_tolerance") = recording::RecordingOptions{}.time_tolerance,
+            "extrinsics: base_from_sensor as a file or 12/16 numbers; the poses are then the base's")
+        .def_property_readonly("name", [](const recording::Recording& r) { return r.name; })
+        .def("__len__", &recording::Recording::size)
+        .def_property_readonly("poses",
+                               [](const recording::Recording& r) {
+                                   pyb::array_t<double> a({static_cast<pyb::ssize_t>(r.size()), pyb::ssize_t{4}, pyb::ssize_t{4}});
+                                   auto v = a.mutable_unchecked<3>();
+                                   for (std::size_t i = 0; i < r.size(); ++i) {
+                                       const Eigen::Matrix4d mm = r.poses[i].world_from_sensor.matrix();
+                                       for (int j = 0; j < 4; ++j)
+                                           for (int k = 0; k < 4; ++k) v(i, j, k) = mm(j, k);
+                                   }
+                                   return a;
+                               },
+                               "(n, 4, 4) world_from_sensor poses")
+        .def_property_readonly("times",
+                               [](const recording::Recording& r) {
+                                   std::vector<double> t;
+                                   for (std::size_t i = 0; i < r.size(); ++i) t.push_back(r.time(i).value_or(NAN));
+                                   return to_numpy(t.data(), {static_cast<pyb::ssize_t>(t.size())});
+                               },
+                               "(n,) scan times in seconds (NaN where the recording has none)")
+        .def_property_readonly("scan_paths",
+                               [](const recording::Recording& r) {
+                                   std::vector<std::string> p;
+                                   for (const auto& s : r.scans) p.push_back(s.path.string());
+                                   return p;
+                               })
+        .def(
+            "points",
+            [](const recording::Recording& r, std::size_t i) {
+                recording::PointCloud c;
+                {
+                    pyb::gil_scoped_release release;
+                    c = r.load(i);
+                }
+                return points_of(c);
+            },
+            pyb::arg("i"), "Scan i's (N, 3) points in the sensor frame (NaN points dropped)")
+        .def("__getitem__",
+             [](const recording::Recording& r, long i) {
+                 const long n = static_cast<long>(r.size());
+                 if (i < 0) i += n;
+                 if (i < 0 || i >= n) throw pyb::index_error("scan index out of range");
+                 const auto k = static_cast<std::size_t>(i);
+                 return pyb::make_tuple(matrix4(r.poses[k].world_from_sensor), points_of(r.load(k)));
+             })
+        .def(
+            "returns",
+            [](const RecordingPtr& r, std::size_t i, const std::string& model, const pyb::kwargs& kwargs) {
+                const ModelSpec spec = config::resolve_model(model);
+                const RecordedReturnParams p = preprocess_of(kwargs, {});
+                Scan s;
+                returns_from_points(r->load(i).xyz, r->poses.at(i).world_from_sensor.linear(), p,
+                                    selection_for(spec.sensor, spec.bvc.elevations.empty()), s);
+                static_assert(sizeof(LidarReturn) == 3 * sizeof(double));
+                return to_numpy(reinterpret_cast<const double*>(s.data()), {static_cast<pyb::ssize_t>(s.size()), 3});
+            },
+            pyb::arg("i"), pyb::arg("model") = "3d-0.2",
+            (std::string(R"doc(Scan i's returns as `model` reads them: an (N, 3) array of range, allocentric azimuth,
+elevation (gravity-aligned by the scan's pose; the 3-D presets keep the upper half, 2-D models the
+horizontal slice). )doc") + preprocess_doc + describe(RecordedReturnParams::table(), RecordedReturnParams{}))
+                .c_str())
+        .def(
+            "replay",
+            [](const RecordingPtr& r, const std::string& model, bool learn, const pyb::object& weights, std::uint64_t seed,
+               const pyb::kwargs& kwargs) {
+                return run(recorded_source(r, preprocess_of(kwargs, {})), model, learn, weights, seed);
+            },
+            pyb::arg("model") = "3d-0.2", pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(), pyb::arg("seed") = 0,
+            (std::string(R"doc(Every scan through `model`, as `bvc3d replay` does it: a dict of arrays t, x, y, z, heading
+(n,), bvc_rates (n, n_bvc), rates (n, n_place) and the final weights. learn: place cells learn
+(online); weights: a trial file or an array to start from (default: the seed's draw). )doc") +
+             preprocess_doc + describe(RecordedReturnParams::table(), RecordedReturnParams{}))
+                .c_str())
+        .def("__repr__", [](const recording::Recording& r) {
+            return "Recording('" + r.name + "', " + std::to_string(r.size()) + " scans)";
+        });
+}
+
+}  // namespace
+
+void bind_recording(pyb::module_& m) {
+    bind_recording_class(m);
+    m.def(
+        "replay_simulated",
+        [](const std::string& world, const pyb::object& trajectory, const pyb::object& sensor, const std::string& model,
+           bool learn, const pyb::object& weights, std::uint64_t seed, const pyb::kwargs& kwargs) {
+            std::shared_ptr<const TrajectorySpec> path;
+            if (pyb::isinstance<pyb::str>(trajectory) || pyb::hasattr(trajectory, "__fspath__")) {
+                path = std::make_shared<const TrajectorySpec>(TrajectorySpec::from_file(pyb::str(trajectory).cast<std::string>()));
+            } else {
+                const auto d = trajectory.cast<pyb::dict>();
+                auto column = [&](const char* key) {
+                    if (!d.contains(key)) return std::vector<double>{};
+                    return pyb::cast<std::vector<double>>(
+                        pyb::module_::import("numpy").attr("asarray")(d[key], "float64").attr("ravel")());
+                };
+                for (const char* key : {"t", "x", "y", "heading"})
+                    if (!d.contains(key)) throw InputError(std::string("trajectory: the dict lacks '") + key + "'");
+                path = std::make_shared<const TrajectorySpec>(
+                    trajectory_steps(column("t"), column("x"), column("y"), column("z"), column("heading"),
+                                     "trajectory arrays", column("pitch"), column("roll")),
+                    "arrays");
+            }
+            const LidarSpec s = pyb::isinstance<pyb::str>(sensor) ? config::resolve_sensor(sensor.cast<std::string>())
+                                                                   : sensor.cast<LidarSpec>();
+            return run(simulated_source(WorldSpec{world, std::nullopt, "+x+y"}, path, s, preprocess_of(kwargs, {})), model,
+                       learn, weights, seed);
+        },
+        pyb::arg("world"), pyb::arg("trajectory"), pyb::arg("sensor"), pyb::arg("model") = "3d-0.2",
+        pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(), pyb::arg("seed") = 0,
+        R"doc(A simulated sensor along a path in a world, its scans preprocessed as a recording's, through `model`
+(as `bvc3d replay --world --trajectory --sensor`): the dict Recording.replay gives. trajectory: a
+file or a dict of arrays t, x, y, heading[, z, pitch, roll]; sensor: a name, a YAML file or a
+Sensor. Preprocessing keywords as Recording.replay.)doc");
+    m.def(
+        "localize",
+        [](const ArrayF& templates, const ArrayD& template_xyz, const ArrayF& queries, const ArrayD& query_xyz) {
+            auto matrix = [](const auto& a, const char* name) {
+                if (a.ndim() != 2) throw InputError(std::string(name) + " must be a 2-D array");
+                return a;
+            };
+            matrix(templates, "templates");
+            matrix(queries, "queries");
+            matrix(template_xyz, "template_positions");
+            matrix(query_xyz, "query_positions");
+            using namespace analysis;
+            const Eigen::Map<const RowMatrixXf> t(templates.data(), templates.shape(0), templates.shape(1));
+            const Eigen::Map<const RowMatrixXf> q(queries.data(), queries.shape(0), queries.shape(1));
+            const Eigen::Map<const Points> tp(template_xyz.data(), template_xyz.shape(0), template_xyz.shape(1));
+            const Eigen::Map<const Points> qp(query_xyz.data(), query_xyz.shape(0), query_xyz.shape(1));
+            LocalizationResult r;
+            {
+                pyb::gil_scoped_release release;
+                r = analysis::localize(t, tp, q, qp);
+            }
+            auto summary = [](const ErrorSummary& s) {
+                pyb::dict d;
+                d["median_m"] = s.median;
+                d["mean_m"] = s.mean;
+                d["within_1m"] = s.within_1m;
+                d["within_2m"] = s.within_2m;
+                return d;
+            };
+            const auto n = static_cast<pyb::ssize_t>(r.decoded.size());
+            pyb::dict out;
+            std::vector<std::int64_t> decoded(r.decoded.begin(), r.decoded.end());
+            out["decoded"] = to_numpy(decoded.data(), {n});
+            out["similarity"] = to_numpy(r.similarity.data(), {n});
+            out["error"] = to_numpy(r.error.data(), {n});
+            out["vertical_error"] = to_numpy(r.vertical_error.data(), {n});
+            out["nearest_error"] = to_numpy(r.nearest_error.data(), {n});
+            out["n_undecoded"] = r.n_undecoded;
+            out["decoded_summary"] = summary(r.decoded_summary);
+            out["chance"] = summary(r.chance);
+            out["nearest"] = summary(r.nearest);
+            out["vertical_median_m"] = r.vertical_median;
+            out["vertical_mean_m"] = r.vertical_mean;
+            return out;
+        },
+        pyb::arg("templates"), pyb::arg("template_positions"), pyb::arg("queries"), pyb::arg("query_positions"),
+        R"doc(Localization on recordings (docs/analysis.md#localization-on-recordings): templates (T, C) and
+queries (Q, C) population vectors (float32), positions (T, 3) and (Q, 3) as x, y, z. Each query is
+decoded to the most cosine-similar template (ties: the lowest index; no positive similarity:
+undecoded, index -1, left out of the summaries). Returns per query: decoded, similarity, error
+(horizontal, m), vertical_error, nearest_error (to the nearest template); and summaries
+decoded_summary, chance (a uniformly random template), nearest (the best possible): dicts of
+median_m, mean_m, within_1m, within_2m.)doc");
+}
+
+}  // namespace bvc3d::py
