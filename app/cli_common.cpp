@@ -103,13 +103,39 @@ Pose parse_pose(const std::string& text) {
 
 std::string num(double v) { return format_number(v); }
 
-int run_python_module(const std::string& module, const std::vector<std::string>& args) {
+namespace {
+
+// Text as one shell word: as it is when safe, else single-quoted.
+std::string shell_word(const std::string& s) {
+    const bool safe = !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                                         "_-./:=+,@%") == std::string::npos;
+    if (safe) return s;
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+}  // namespace
+
+std::string PythonCommand::shell_line(const std::string& module, const std::vector<std::string>& args) const {
+    std::string line = "PYTHONPATH=" + shell_word(pythonpath) + " " + shell_word(python) + " -m " + module;
+    for (const auto& a : args) line += " " + shell_word(a);
+    return line;
+}
+
+PythonCommand python_command() {
     const char* py_env = std::getenv("BVC3D_PYTHON");
-    const std::string python = py_env && *py_env ? py_env : BVC3D_PYTHON;
     const char* path_env = std::getenv("BVC3D_PYTHONPATH");
-    std::string pythonpath = path_env && *path_env ? path_env : BVC3D_PYTHON_DIR;
-    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && pythonpath != existing)
-        pythonpath += std::string(":") + existing;  // as the report's command (cmd_experiment.cpp) does
+    PythonCommand c{py_env && *py_env ? py_env : BVC3D_PYTHON, path_env && *path_env ? path_env : BVC3D_PYTHON_DIR};
+    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && c.pythonpath != existing)
+        c.pythonpath += std::string(":") + existing;
+    return c;
+}
+
+int run_python_module(const std::string& module, const std::vector<std::string>& args) {
+    const PythonCommand command = python_command();
+    const std::string& python = command.python;
+    const std::string& pythonpath = command.pythonpath;
     std::vector<std::string> argv_text{python, "-m", module};
     argv_text.insert(argv_text.end(), args.begin(), args.end());
     std::vector<char*> argv;

@@ -18,8 +18,18 @@ namespace bvc3d::cli {
 // "X,Y,HEADING": meters and radians, a pose on the floor; the heading may end in "deg" for degrees.
 Pose parse_pose(const std::string& text);
 
+// How a module of the Python package runs: the interpreter (BVC3D_PYTHON, else the one found at
+// build time) and the PYTHONPATH that finds the package (BVC3D_PYTHONPATH, else the build's python
+// folder, then any PYTHONPATH already set).
+struct PythonCommand {
+    std::string python, pythonpath;
+    // The command as a shell line that works as printed: `PYTHONPATH=... /usr/bin/python3 -m MODULE ARGS`.
+    std::string shell_line(const std::string& module, const std::vector<std::string>& args) const;
+};
+PythonCommand python_command();
+
 // Runs `python3 -m MODULE ARGS...` (the package's figure modules) as a child process, no shell;
-// returns its exit status. BVC3D_PYTHON and BVC3D_PYTHONPATH override the interpreter and path.
+// returns its exit status.
 int run_python_module(const std::string& module, const std::vector<std::string>& args);
 
 // Full-precision decimal text for numbers written to CSV.

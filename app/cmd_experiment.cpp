@@ -55,40 +55,9 @@ struct ReportRun {
     std::string error_text, last_error_line;  // all it wrote to standard error, and its last line
 };
 
-// Text as one shell word: as it is when safe, else single-quoted.
-std::string shell_word(const std::string& s) {
-    const bool safe = !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-                                                         "_-./:=+,@%") == std::string::npos;
-    if (safe) return s;
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-// How the report module runs: the interpreter (BVC3D_PYTHON, else the one found at build time) and
-// the PYTHONPATH that finds the package (BVC3D_PYTHONPATH, else the build's python folder, then any
-// PYTHONPATH already set).
-struct ReportCommand {
-    std::string python, pythonpath;
-    // The command as a shell line that works as printed: `PYTHONPATH=... /usr/bin/python3 -m bvc3d.report DIR`.
-    std::string shell_line(const std::filesystem::path& dir) const {
-        return "PYTHONPATH=" + shell_word(pythonpath) + " " + shell_word(python) + " -m bvc3d.report " +
-               shell_word(dir.string());
-    }
-};
-
-ReportCommand report_command() {
-    const char* py_env = std::getenv("BVC3D_PYTHON");
-    const char* path_env = std::getenv("BVC3D_PYTHONPATH");
-    ReportCommand c{py_env && *py_env ? py_env : BVC3D_PYTHON, path_env && *path_env ? path_env : BVC3D_PYTHON_DIR};
-    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && c.pythonpath != existing)
-        c.pythonpath += std::string(":") + existing;
-    return c;
-}
-
 // Runs the report module as a child process (no shell). Its standard error is kept, to say why it
 // failed (report_failure); the caller decides what of it to show.
-ReportRun run_report(const ReportCommand& command, const std::filesystem::path& dir) {
+ReportRun run_report(const PythonCommand& command, const std::filesystem::path& dir) {
     std::fflush(stdout);  // our lines first, then the report's
     std::fflush(stderr);
     int pipe_fds[2];
@@ -247,7 +216,7 @@ void summarize(const std::filesystem::path& out, const std::vector<std::filesyst
     write_summary_csv(out / "summary.csv", rows);
     write_summary_markdown(out / "summary.md", rows);
     if (!report) return;
-    const ReportCommand command = report_command();
+    const PythonCommand command = python_command();
     const ReportRun run = run_report(command, out);
     if (run.status == 0) {
         std::fputs(run.error_text.c_str(), stderr);  // the report's own warnings
@@ -258,7 +227,7 @@ void summarize(const std::filesystem::path& out, const std::vector<std::filesyst
     const std::string why = report_failure(run, removed, os_error);
     if (!os_error) std::fputs(run.error_text.c_str(), stderr);  // a bug's traceback is worth showing
     throw InputError("the report (figures) failed: " + why + "; the trial files and summary are in '" + out.string() +
-                     "'; rerun it with:\n  " + command.shell_line(out));
+                     "'; rerun it with:\n  " + command.shell_line("bvc3d.report", {out.string()}));
 }
 
 namespace {

@@ -69,7 +69,17 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
 }
 
 pyb::dict outcome_to_dict(const TrialConfig& t, const GroupOutcome& done) {
-    const auto& r = done.result;
+    pyb::dict out = samples_to_dict(done.result, t.protocol.record_bvc);
+    pyb::dict scalars;
+    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics)) scalars[name.c_str()] = v;
+    out["metrics"] = scalars;
+    out["name"] = t.name();
+    return out;
+}
+
+}  // namespace
+
+pyb::dict samples_to_dict(const GroupResult& r, bool with_bvc) {
     const auto n = static_cast<pyb::ssize_t>(r.t.size());
     const auto& rec = r.models[0];
     pyb::dict out;
@@ -79,16 +89,10 @@ pyb::dict outcome_to_dict(const TrialConfig& t, const GroupOutcome& done) {
     out["z"] = to_numpy(r.z.data(), {n});
     out["heading"] = to_numpy(r.heading.data(), {n});
     out["rates"] = to_numpy(rec.rates.data(), {n, rec.n_place});
-    if (t.protocol.record_bvc) out["bvc_rates"] = to_numpy(rec.bvc.data(), {n, rec.n_bvc});
+    if (with_bvc) out["bvc_rates"] = to_numpy(rec.bvc.data(), {n, rec.n_bvc});
     out["weights"] = to_numpy(rec.weights.data(), {rec.n_place, rec.n_bvc});
-    pyb::dict scalars;
-    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics)) scalars[name.c_str()] = v;
-    out["metrics"] = scalars;
-    out["name"] = t.name();
     return out;
 }
-
-}  // namespace
 
 void bind_experiment(pyb::module_& m) {
     m.def(

@@ -53,21 +53,6 @@ std::shared_ptr<const InitialWeights> weights_of(const pyb::object& obj) {
     return w;
 }
 
-pyb::dict replay_dict(const GroupResult& r) {
-    const auto n = static_cast<pyb::ssize_t>(r.t.size());
-    const auto& rec = r.models[0];
-    pyb::dict out;
-    out["t"] = to_numpy(r.t.data(), {n});
-    out["x"] = to_numpy(r.x.data(), {n});
-    out["y"] = to_numpy(r.y.data(), {n});
-    out["z"] = to_numpy(r.z.data(), {n});
-    out["heading"] = to_numpy(r.heading.data(), {n});
-    out["bvc_rates"] = to_numpy(rec.bvc.data(), {n, rec.n_bvc});
-    out["rates"] = to_numpy(rec.rates.data(), {n, rec.n_place});
-    out["weights"] = to_numpy(rec.weights.data(), {rec.n_place, rec.n_bvc});
-    return out;
-}
-
 pyb::dict run(const ReplaySource& source, const std::string& model, bool learn, const pyb::object& weights,
               std::uint64_t seed) {
     const TrialConfig t = replay_trial(source, config::resolve_model(model), learn, weights_of(weights), seed);
@@ -76,7 +61,7 @@ pyb::dict run(const ReplaySource& source, const std::string& model, bool learn, 
         pyb::gil_scoped_release release;
         r = run_replay({t});
     }
-    return replay_dict(r);
+    return samples_to_dict(r, true);  // a replay records the BVC rates
 }
 
 const char* preprocess_doc = "Preprocessing keywords (docs/recordings.md):\n";

@@ -22,6 +22,7 @@
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/params.hpp"
+#include "bvc3d/recorder/trial_record.hpp"
 
 namespace bvc3d::py {
 
@@ -37,6 +38,10 @@ pyb::array_t<T> to_numpy(const T* data, std::vector<pyb::ssize_t> shape) {
     if (n) std::memcpy(a.mutable_data(), data, n * sizeof(T));
     return a;
 }
+
+// A run's samples of its first model as arrays: t, x, y, z, heading, rates, weights, and bvc_rates
+// when `with_bvc` (run_trial's and replay's dicts start from this).
+pyb::dict samples_to_dict(const GroupResult& r, bool with_bvc);
 
 // An array of real numbers as float64, C order. Integers and floats convert; complex, object, text
 // and boolean arrays are refused (a cast would drop imaginary parts or invent numbers).

@@ -7,7 +7,6 @@ DIR holds localization.csv, queries.csv and templates.csv (as `bvc3d localize` w
 figure is DIR/localization.png.
 """
 import argparse
-import csv
 import math
 import os
 import sys
@@ -17,19 +16,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from .report import num, read_csv  # noqa: E402
+
 DPI = 120
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
-def num(s):
-    try:
-        return float(s)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def figure(directory, out=None):
