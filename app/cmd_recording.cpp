@@ -429,8 +429,8 @@ void add_localize(CLI::App& app) {
             if (r.n_undecoded) std::printf("  %s: %zu queries undecoded (no positive similarity)\n", row.model.c_str(), r.n_undecoded);
         }
         if (!o->no_figure && run_python_module("bvc3d.localization_figure", {o->out}) != 0)
-            throw InputError("the figure failed; the tables are in '" + o->out +
-                             "'; rerun with: python3 -m bvc3d.localization_figure " + o->out);
+            throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
+                             python_command().shell_line("bvc3d.localization_figure", {o->out}));
         std::printf("tables: %s/localization.md, localization.csv, queries.csv%s\n", o->out.c_str(),
                     o->no_figure ? "" : ", figure: localization.png");
     });
