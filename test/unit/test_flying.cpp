@@ -10,6 +10,7 @@
 #include <set>
 #include <tuple>
 
+#include "../support/ks_test.hpp"
 #include "../support/sphere_oracle.hpp"
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
@@ -42,20 +43,9 @@ double inside_margin(const FlightVolume& v, const Vec3& p) {
     return m;
 }
 
-double normal_cdf(double x, double sd) { return 0.5 * std::erfc(-x / (sd * std::sqrt(2.0))); }
-
-template <class Cdf>
-double ks_statistic(std::vector<double> xs, Cdf cdf) {
-    std::sort(xs.begin(), xs.end());
-    const double n = static_cast<double>(xs.size());
-    double d = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i) {
-        const double f = cdf(xs[i]);
-        d = std::max({d, (i + 1) / n - f, f - i / n});
-    }
-    return d;
-}
-double ks_critical_1pct(std::size_t n) { return 1.628 / std::sqrt(static_cast<double>(n)); }
+using reference::ks_critical_1pct;
+using reference::ks_statistic;
+using reference::normal_cdf;
 
 FlightParams body_head() {
     FlightParams p;

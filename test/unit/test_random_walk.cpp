@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 
+#include "../support/ks_test.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/agent/random_walk.hpp"
@@ -33,21 +34,9 @@ double oracle_clearance(double x, double y, double tilt_deg) {
     return d - R;
 }
 
-double normal_cdf(double x, double sd) { return 0.5 * std::erfc(-x / (sd * std::sqrt(2.0))); }
-
-// Kolmogorov-Smirnov statistic of a sample against a continuous CDF.
-template <class Cdf>
-double ks_statistic(std::vector<double> xs, Cdf cdf) {
-    std::sort(xs.begin(), xs.end());
-    const double n = static_cast<double>(xs.size());
-    double d = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i) {
-        const double f = cdf(xs[i]);
-        d = std::max({d, (i + 1) / n - f, f - i / n});
-    }
-    return d;
-}
-double ks_critical_1pct(std::size_t n) { return 1.628 / std::sqrt(static_cast<double>(n)); }
+using reference::ks_critical_1pct;
+using reference::ks_statistic;
+using reference::normal_cdf;
 
 class PaperWorldWalk : public ::testing::TestWithParam<double> {};
 
