@@ -96,6 +96,24 @@ pyb::dict stats_dict(const an::CellStats& s) {
     return r;
 }
 
+// A trial's analysis as a dict: maps and their bins, modality, aliasing, decoding and cell
+// statistics; the bin's size under `measure_key` (hexagon area or voxel volume).
+pyb::dict trial_analysis_dict(const an::TrialMetrics& m, const char* measure_key, pyb::dict decoding) {
+    pyb::dict d;
+    d["centers"] = numpy_of(m.maps.bins.centers);
+    d["counts"] = numpy_of(m.maps.bins.counts);
+    d["mean_maps"] = numpy_of(m.maps.mean);
+    d["maps"] = numpy_of(m.maps.map);
+    d[measure_key] = m.maps.grid->bin_measure();
+    d["modality"] = numpy_of(m.modality);
+    d["modality_summary"] = summary_dict(m.modality_summary);
+    d["sai"] = to_numpy(m.aliasing.sai.data(), {m.aliasing.sai.size()});
+    d["msai"] = m.aliasing.msai;
+    d["decoding"] = std::move(decoding);
+    d["cells"] = stats_dict(m.cells);
+    return d;
+}
+
 // Functions over per-sample values exist for float32 (taken as is) and float64 (anything else).
 template <class T>
 void bind_sample_functions(pyb::module_& a) {
@@ -182,18 +200,7 @@ void bind_sample_functions(pyb::module_& a) {
             interruptible([&](const std::atomic<bool>&) {
                 m = an::analyze_trial<T>(xs, ys, r, params);
             });
-            pyb::dict d;
-            d["centers"] = numpy_of(m.maps.bins.centers);
-            d["counts"] = numpy_of(m.maps.bins.counts);
-            d["mean_maps"] = numpy_of(m.maps.mean);
-            d["maps"] = numpy_of(m.maps.map);
-            d["bin_area_m2"] = m.maps.grid->bin_measure();
-            d["modality"] = numpy_of(m.modality);
-            d["modality_summary"] = summary_dict(m.modality_summary);
-            d["sai"] = to_numpy(m.aliasing.sai.data(), {m.aliasing.sai.size()});
-            d["msai"] = m.aliasing.msai;
-            d["decoding"] = decoding_dict(m.decoding);
-            d["cells"] = stats_dict(m.cells);
+            pyb::dict d = trial_analysis_dict(m, "bin_area_m2", decoding_dict(m.decoding));
             return d;
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
@@ -241,18 +248,7 @@ void bind_voxel_functions(pyb::module_& a) {
                 pyb::gil_scoped_release release;
                 m = an::analyze_trial<T>(p, r, params);
             }
-            pyb::dict d;
-            d["centers"] = numpy_of(m.maps.bins.centers);
-            d["counts"] = numpy_of(m.maps.bins.counts);
-            d["mean_maps"] = numpy_of(m.maps.mean);
-            d["maps"] = numpy_of(m.maps.map);
-            d["voxel_volume_m3"] = m.maps.grid->bin_measure();
-            d["modality"] = numpy_of(m.modality);
-            d["modality_summary"] = summary_dict(m.modality_summary);
-            d["sai"] = to_numpy(m.aliasing.sai.data(), {m.aliasing.sai.size()});
-            d["msai"] = m.aliasing.msai;
-            d["decoding"] = decoding_dict_3d(m.decoding);
-            d["cells"] = stats_dict(m.cells);
+            pyb::dict d = trial_analysis_dict(m, "voxel_volume_m3", decoding_dict_3d(m.decoding));
             d["isotropy"] = numpy_of(m.isotropy);
             pyb::dict scalars;
             for (const auto& [name, v] : an::scalar_metrics(m)) scalars[name.c_str()] = v;
