@@ -4,6 +4,7 @@ import math
 
 import matplotlib
 import numpy as np
+from numpy_oracles import numpy_rate_maps
 import pytest
 
 matplotlib.use("Agg")
@@ -189,16 +190,6 @@ def test_hexbin_one_column_shapes_and_counts():
 
 # ---------------------------------------------------------------------------------------------
 # rate maps
-
-
-def numpy_rate_maps(means, quantile):
-    maps = means.copy()
-    for c in range(maps.shape[1]):
-        col = maps[:, c]
-        col[col < np.percentile(col, 100 * quantile)] = 0
-        top = col.max()
-        maps[:, c] = col / top if top > 0 else 0.0
-    return maps
 
 
 def test_percentile_is_numpys_bit_for_bit():
@@ -397,18 +388,6 @@ def test_sai_random_maps_with_zero_rows_and_negative_entries():
 
 # ---------------------------------------------------------------------------------------------
 # decoding
-
-
-def numpy_rate_maps(means, quantile):
-    """docs/model-reference.md#analysis maps from per-bin means, written out in numpy: per cell, values below
-    numpy.percentile(cell, 100 q) set to 0, then divided by the cell's maximum (silent: zeros)."""
-    maps = means.copy()
-    for k in range(maps.shape[1]):
-        col = maps[:, k]
-        col[col < np.percentile(col, 100 * quantile)] = 0
-        top = col.max()
-        maps[:, k] = col / top if top > 0 else 0.0
-    return maps
 
 
 def dense_decoder(x, y, rates, templates="rate_maps", quantile=0.1, gridsize=50):

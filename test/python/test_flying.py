@@ -2,6 +2,7 @@
 synthetic 3-D fields, isotropy on hand-made ellipsoidal fields, and the flying walk and trials from
 Python (issue 12)."""
 import numpy as np
+from numpy_oracles import numpy_rate_maps
 import pytest
 from sklearn.cluster import DBSCAN
 
@@ -50,16 +51,6 @@ def numpy_voxel_means(p, rates, side, volume):
     i, j, k = bins // (n[1] * n[2]), (bins // n[2]) % n[1], bins % n[2]
     centers = lo + side * (np.column_stack([i, j, k]) + 0.5)
     return centers, means, counts
-
-
-def numpy_rate_maps(means, quantile):
-    maps = means.copy()
-    for c in range(maps.shape[1]):
-        col = maps[:, c]
-        col[col < np.percentile(col, 100 * quantile)] = 0
-        top = col.max()
-        maps[:, c] = col / top if top > 0 else 0.0
-    return maps
 
 
 # ---------------------------------------------------------------------------------------------
