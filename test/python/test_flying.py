@@ -277,6 +277,40 @@ def test_flying_trial_reports_3d_metrics_and_errors_for_mismatches():
 # bvc3d flight: trial files with z and a format version, summary, figures
 
 
+def check_flight_tables_script(folder, out):
+    """scripts/flight_tables.py (the tables of docs/flying.md) against the trial files read directly:
+    stored metrics, the share of column fields, and the field pairs of multimodal cells by sklearn."""
+    import csv
+    import os
+    import subprocess
+    import sys
+
+    import h5py
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.dirname(os.path.dirname(bvc3d.__file__))] + sys.path))
+    subprocess.run([sys.executable, str(SOURCE_DIR / "scripts" / "flight_tables.py"), str(folder), str(out)],
+                   check=True, env=env, capture_output=True, text=True)
+    rows = {(r["model"], int(r["seed"])): r for r in csv.DictReader(open(out / "trials.csv"))}
+    stacked = {(r["model"], int(r["seed"])): r for r in csv.DictReader(open(out / "stacked.csv"))}
+    assert set(rows) == {("fly-up", 0), ("fly-5l", 0)}
+    for (model, seed), row in rows.items():
+        with h5py.File(folder / f"flight-room_{model}_seed{seed}.h5", "r") as f:
+            m = f["metrics"].attrs
+            for key in ("frac_unimodal", "frac_multimodal", "isotropy_median", "frac_undecoded"):
+                assert float(row[key]) == pytest.approx(float(m[key]), rel=1e-12, nan_ok=True)
+            iso = f["metrics/isotropy"][:]
+            iso = iso[np.isfinite(iso)]
+            assert int(row["single_fields"]) == len(iso)
+            if len(iso):
+                assert float(row["frac_columns"]) == pytest.approx(np.count_nonzero(iso > 1.5) / len(iso))
+            c, maps, mi = f["metrics/bin_centers"][:], f["metrics/rate_maps"][:], f["metrics/modality"][:]
+        pairs = 0
+        for k in np.flatnonzero(mi > 1):
+            n = len(set(DBSCAN(eps=1.0, min_samples=10).fit(c[maps[:, k] > 0]).labels_) - {-1})
+            pairs += n * (n - 1) // 2
+        assert int(stacked[(model, seed)]["pairs"]) == pairs
+
+
 def test_flight_command_writes_3d_trials_summary_and_figures(tmp_path):
     import h5py
 
@@ -296,6 +330,7 @@ def test_flight_command_writes_3d_trials_summary_and_figures(tmp_path):
     figures = {p.name for p in (out / "figures").iterdir()}
     assert {"worlds.png", "trajectory3d.png", "isotropy.png", "decoding_vertical.png", "frac_unimodal.png"} <= figures
     assert "decoding_vertical.png" in (out / "report.md").read_text()
+    check_flight_tables_script(out, tmp_path / "tables")
     # A file of a format version this bvc3d does not know is refused by name, not misread.
     newer = out / "flight-room_fly-up_seed0.h5"
     with h5py.File(newer, "r+") as f:
@@ -315,3 +350,28 @@ def test_flight_command_refuses_ground_models_and_worlds(tmp_path):
     r = run_cli("flight", "--out", tmp_path / "b", "--models", "fly-up", "--worlds", world, "--hours", "0.01")
     assert r.returncode == 2 and "no flight volume" in r.stderr
     assert not (tmp_path / "a").exists() or not any((tmp_path / "a").glob("*.h5"))
+
+
+def test_flight_tables_field_pairs_of_a_stacked_cell():
+    """A cell with two round fields, one above the other (4 m apart in z, 0.5 m in x): the script's
+    field pairs give the distances between the fields' weighted centroids."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("flight_tables", SOURCE_DIR / "scripts" / "flight_tables.py")
+    ft = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ft)
+    g = np.arange(-2.25, 2.26, 0.5)
+    zs = np.arange(0.25, 5.8, 0.5)
+    centers = np.array([(x, y, z) for x in g for y in g for z in zs])
+    lower, upper = np.array([0.25, -0.25, 0.75]), np.array([-0.25, -0.25, 4.75])
+    rate = sum(np.exp(-np.sum((centers - c) ** 2, axis=1) / (2 * 0.6 ** 2)) for c in (lower, upper))
+    maps = np.where(rate > 0.05, rate, 0.0)[:, None]
+    pairs = ft.field_pairs(centers, maps, np.array([2]), eps=1.0, min_samples=10)
+    assert pairs.shape == (1, 4)
+    on = maps[:, 0] > 0
+    lab = DBSCAN(eps=1.0, min_samples=10).fit(centers[on]).labels_
+    cents = sorted((np.average(centers[on][lab == k], axis=0, weights=maps[on, 0][lab == k]) for k in (0, 1)),
+                   key=lambda q: q[2])
+    np.testing.assert_allclose(pairs[0], [np.hypot(*(cents[1][:2] - cents[0][:2])), cents[1][2] - cents[0][2],
+                                          cents[0][2], cents[1][2]], rtol=1e-12)
+    assert pairs[0, 0] == pytest.approx(0.5, abs=0.1) and pairs[0, 1] == pytest.approx(4.0, abs=0.15)

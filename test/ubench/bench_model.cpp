@@ -108,7 +108,7 @@ void BM_DenseReferenceStep(benchmark::State& state, std::string preset) {
     }
 }
 
-// A flying agent's model step in the flight room: the full spherical scan (all 8 100 rays, every row
+// A flying agent's model step in the flight room: the full spherical scan (all 16 200 rays, every row
 // cast whatever the model needs), the BVC layer and 250 place cells learning (docs/flying.md#speed).
 void BM_FlyingFullScanStep(benchmark::State& state, std::string preset) {
     const ModelSpec model = model_preset(preset);
@@ -127,8 +127,48 @@ void BM_FlyingFullScanStep(benchmark::State& state, std::string preset) {
     }
 }
 
+// What a flying trial does per model step with the default level head: cast the rows the model
+// needs (the plan), BVC rates, 250 place cells learning.
+void BM_FlyingStep(benchmark::State& state, std::string preset) {
+    const ModelSpec model = model_preset(preset);
+    const World world(flight_room());
+    const Lidar lidar(model.sensor);
+    const BoundaryVectorLayer layer(model.bvc);
+    const auto plan = layer.plan(model.sensor);
+    PlaceCellNetwork net(model.bvc.n_cells(), model.place, 1);
+    const auto walk = flying_walk(world, 0.1, 1);
+    std::vector<double> rates(layer.n_cells());
+    Scan scan;
+    std::size_t i = 0, rows = 0;
+    for (char r : plan.rows) rows += r != 0;
+    for (auto _ : state) {
+        lidar.scan(world, walk[i++ % walk.size()].pose, scan, {}, plan.rows);
+        if (!layer.rates_pruned(scan, plan, rates)) layer.rates(lidar.scan(world, walk[(i - 1) % walk.size()].pose), rates);
+        benchmark::DoNotOptimize(net.step(rates, true).data());
+    }
+    state.counters["rays"] = static_cast<double>(rows * static_cast<std::size_t>(model.sensor.azimuth_count));
+}
+
+// The full spherical scan alone (16 200 rays in the flight room): the ray-casting share of the above.
+void BM_FlyingFullScanOnly(benchmark::State& state) {
+    const World world(flight_room());
+    const Lidar lidar(LidarSpec::spherical_full());
+    const auto walk = flying_walk(world, 0.1, 1);
+    Scan scan;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        lidar.scan(world, walk[i++ % walk.size()].pose, scan);
+        benchmark::DoNotOptimize(scan.data());
+    }
+    state.counters["rays/s"] = benchmark::Counter(16200.0 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 }  // namespace
 
+BENCHMARK(BM_FlyingFullScanOnly)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FlyingStep, fly_up, std::string("fly-up"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FlyingStep, fly_5l, std::string("fly-5l"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FlyingStep, fly_9l, std::string("fly-9l"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_FlyingFullScanStep, fly_5l, std::string("fly-5l"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 2d, std::string("2d"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ModelStep, 3d_0_1, std::string("3d-0.1"))->Unit(benchmark::kMicrosecond);
