@@ -12,8 +12,11 @@ under RESULTS (each written by `bvc3d paper`, see the doc), and writes to OUT:
 - comparison.csv: per model, tilt and metric the authors' published value (published.csv), bvc3d's
   authors configuration (mean, sd, min, max over seeds; whether the published value lies within
   mean ± 2 sd) and the paper's configuration as specified;
-- ablation.csv: per step, model, tilt and metric the mean and sd over the seeds every step has;
-- samples.csv: recorded samples per trial, per configuration.
+- ablation.csv: per step, model, tilt and metric the mean and sd over the seeds every step has, and
+  the change from the step above with that change in standard errors (change_z);
+- samples.csv: recorded samples per trial, per configuration;
+- thinned.csv: the authors' configuration's trials thinned evenly to the paper's 30 000 samples and
+  analyzed with the authors' conventions (MSAI and mean MI as run and thinned).
 
 Then prints the doc's tables as Markdown.
 """
@@ -68,6 +71,24 @@ def trial_row(path, reanalyze=False):
 
 def reanalyzed(path):
     return trial_row(path, reanalyze=True)
+
+
+THINNED_SAMPLES = 30000  # what the paper reports per 4-hour trial
+
+
+def thinned(path):
+    """A trial's samples thinned evenly (by index) to THINNED_SAMPLES, analyzed with the authors'
+    conventions as stored in the trial file: does the sample count move MSAI?"""
+    with h5py.File(path, "r") as f:
+        row = {"name": f.attrs["name"], "model": f.attrs["model"], "tilt_deg": int(round(float(f.attrs["tilt_deg"]))),
+               "seed": int(f.attrs["seed"]), "samples": int(f["walk"].attrs["sample_steps"]),
+               "msai": float(f["metrics"].attrs["msai"]), "mean_mi_active": float(f["metrics"].attrs["mean_mi_active"])}
+        x, y, rates = f["samples/x"][:], f["samples/y"][:], f["samples/rates"][:]
+    keep = np.unique(np.round(np.linspace(0, len(x) - 1, min(THINNED_SAMPLES, len(x)))).astype(int))
+    out = an.analyze(x[keep], y[keep], rates[keep], mi_quantile=0.2, skip_samples=1, msai_bins=2662)
+    row.update({"thinned_samples": len(keep), "thinned_msai": out["msai"],
+                "thinned_mean_mi_active": out["modality_summary"]["mean_mi_active"]})
+    return row
 
 
 def write_csv(path, rows, fields):
@@ -139,6 +160,26 @@ def main():
         comparison(args.out, published, trials)
     ablation(args.out, trials)
     samples(args.out, trials)
+    folder = os.path.join(args.results, "authors")
+    if os.path.isdir(folder):
+        with Pool(args.jobs) as pool:
+            thin_rows = pool.map(thinned, sorted(os.path.join(folder, n) for n in os.listdir(folder) if n.endswith(".h5")))
+        thin(args.out, thin_rows)
+
+
+def thin(out, rows):
+    rows = sorted(rows, key=lambda r: (r["seed"], r["tilt_deg"], r["model"]))
+    write_csv(os.path.join(out, "thinned.csv"), rows, list(rows[0]))
+    print(f"\n## the authors' configuration thinned to {THINNED_SAMPLES} samples: MSAI as run → thinned\n")
+    print("| model | " + " | ".join(f"{t}°" for t in TILTS) + " |")
+    print("|---|" + "---|" * len(TILTS))
+    for fam in FAMILIES:
+        cells = []
+        for t in TILTS:
+            g = [r for r in rows if family(r["model"]) == fam and r["tilt_deg"] == t]
+            full, few = np.mean([r["msai"] for r in g]), np.mean([r["thinned_msai"] for r in g])
+            cells.append(f"{full:.4f} → {few:.4f} ({100 * (few / full - 1):+.1f} %)")
+        print(f"| {fam} | " + " | ".join(cells) + " |")
 
 
 def comparison(out, published, trials):
@@ -189,7 +230,9 @@ def ablation(out, trials):
                     mean, sd, _, _, n = stats([float(r[m]) for r in g.get((fam, t), [])])
                     rows.append({"step": step, "model": fam, "tilt_deg": t, "metric": m, "mean": mean, "sd": sd,
                                  "seeds": n})
+    add_changes(rows)
     write_csv(os.path.join(out, "ablation.csv"), rows, list(rows[0]))
+    print_effects(rows)
     print(f"\n## ablation (seeds {sorted(seeds)}): mean over seeds, 0° / 30° / 45° / 60°\n")
     for m in ["mean_mi_active", "frac_multimodal", "msai", "frac_active", "frac_undecoded", "decode_median_m",
               "decode_mean_all_m"]:
@@ -205,6 +248,40 @@ def ablation(out, trials):
                               and r["metric"] == m), math.nan) for t in TILTS]
                 cells.append(" / ".join(fmt(v, DIGITS[m]) for v in vals))
             print(f"| {STEP_TEXT[step]} | " + " | ".join(cells) + " |")
+
+
+def add_changes(rows):
+    """Each row's change from the step above it (same model, tilt and metric) and that change in
+    standard errors of the difference of two means over independent seeds, sqrt(sd1²/n1 + sd2²/n2)."""
+    previous = {}
+    for r in rows:
+        key = (r["model"], r["tilt_deg"], r["metric"])
+        before = previous.get(key)
+        r["change"], r["change_z"] = math.nan, math.nan
+        if before is not None and r["seeds"] > 1 and before["seeds"] > 1 and not math.isnan(r["mean"] - before["mean"]):
+            r["change"] = r["mean"] - before["mean"]
+            se = math.sqrt(r["sd"] ** 2 / r["seeds"] + before["sd"] ** 2 / before["seeds"])
+            r["change_z"] = r["change"] / se if se > 0 else (0.0 if r["change"] == 0 else math.inf)
+        if r["seeds"]:
+            previous[key] = r
+
+
+def print_effects(rows):
+    """Per step and metric: in how many (model, tilt) cells the step moved the metric by more than
+    3 standard errors, and the median change there."""
+    metrics = ["mean_mi_active", "frac_multimodal", "msai", "frac_undecoded", "decode_median_m"]
+    print("\n## which step moves what: cells (of model × tilt) changed by > 3 standard errors, median change\n")
+    print("| step | " + " | ".join(metrics) + " |")
+    print("|---|" + "---|" * len(metrics))
+    for step in STEPS[1:]:
+        cells = []
+        for m in metrics:
+            moved = [r for r in rows if r["step"] == step and r["metric"] == m and abs(r["change_z"]) > 3]
+            tested = [r for r in rows if r["step"] == step and r["metric"] == m and not math.isnan(r["change_z"])
+                      and r["change"] != 0]
+            med = fmt(float(np.median([r["change"] for r in moved])), DIGITS[m] + 1) if moved else "–"
+            cells.append(f"{len(moved)}/{len(tested)} ({med})" if tested else "–")
+        print(f"| {STEP_TEXT[step]} | " + " | ".join(cells) + " |")
 
 
 def samples(out, trials):
