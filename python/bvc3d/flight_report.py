@@ -200,7 +200,7 @@ def bar_positions(folder):
 def isotropy_bars(folder):
     fig = report.bars_figure(folder, "isotropy_median")
     ax = fig.axes[0]
-    ax.axhline(1.0, color="k", ls="--", lw=1, label=f"1: round ({BATS})")
+    ax.axhline(1.0, color="k", ls="--", lw=1, label="1: round (bats)")
     report.legend_outside(ax, "model")
     fig.tight_layout()
     return fig

@@ -483,6 +483,8 @@ def make_sweep_report(folder, figdir):
     keys = swept_keys(folder.summary)
     figures = []
     for metric in METRICS:
+        if not any(math.isfinite(num(r.get(metric + "_mean"))) for r in folder.summary):
+            continue  # a metric of other trials (e.g. 3-D only): nothing to draw
         name = f"sweep_{metric}.png"
         fig_sweep(folder, keys, metric, os.path.join(figdir, name))
         shown = [k[6:] for k in keys]
