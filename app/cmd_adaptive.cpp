@@ -21,10 +21,18 @@ namespace bvc3d::cli {
 namespace {
 
 struct ChooseOptions {
-    std::string world = "cross", lean = "+x+y", sensor = "spherical", agent = "ground", layers = "1-4", sets, out;
-    std::optional<double> tilt;
+    std::string world = "cross", lean = "+x+y", sensor, agent = "ground", layers = "1-4", sets, out;
+    std::optional<double> tilt, elevation_min;
     ChooserParams params;
 };
+
+std::shared_ptr<const AgentSpec> named_agent(const std::string& name) {
+    try {
+        return agent_by_name(name);
+    } catch (const InputError& e) {
+        throw InputError(std::string("--agent: ") + e.what());
+    }
+}
 
 // "2", "1-4": the fewest and most layers.
 std::pair<int, int> parse_layers(const std::string& text) {
@@ -60,18 +68,21 @@ std::vector<std::vector<double>> parse_sets(const std::string& text) {
 }
 
 void choose(const ChooseOptions& o) {
-    if (o.agent != "ground")
-        throw InputError("--agent: '" + o.agent + "' is not an agent this build has (ground: the paper's random walk)");
+    const auto agent = named_agent(o.agent);
+    const ChooserDefaults defaults = chooser_defaults(*agent);
     ChooserParams p = o.params;
     std::tie(p.min_layers, p.max_layers) = parse_layers(o.layers);
-    ModelSpec base = model_preset("3d-0.2");
-    base.sensor = config::resolve_sensor(o.sensor);
+    p.elevation_min = o.elevation_min.value_or(defaults.symmetric_range ? -p.elevation_max : p.elevation_min);
+    ModelSpec base = model_preset(defaults.model);
+    const std::string sensor = o.sensor.empty() ? defaults.sensor : o.sensor;
+    base.sensor = config::resolve_sensor(sensor);
     p.validate(base.bvc.n_dir);
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
     // Fail before minutes of work, not after.
     if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty()) ensure_writable_directory(folder);
     const World world(config::resolve_world(o.world, o.tilt, o.lean));
-    const RandomWalkSpec agent;
+    agent->check_world(world.description());
+    const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
     InterruptGuard guard;
     p.stop = &stop_flag();
     std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n", o.world.c_str(),
@@ -79,7 +90,8 @@ void choose(const ChooseOptions& o) {
                 elevations_text(p.candidate_elevations()).c_str());
     ElevationChoice c;
     try {
-        c = o.sets.empty() ? choose_elevations(world, base, agent, p) : choose_from_sets(world, base, agent, parse_sets(o.sets), p);
+        c = o.sets.empty() ? choose_elevations(world, base, *agent, p, analysis)
+                           : choose_from_sets(world, base, *agent, parse_sets(o.sets), p, analysis);
     } catch (const Interrupted&) {
         std::fprintf(stderr, "\nbvc3d: interrupted; nothing was written.\n");
         std::exit(130);
@@ -93,7 +105,7 @@ void choose(const ChooseOptions& o) {
                 c.chosen.msai);
     AtomicFile file(o.out);
     file.stream() << "# chosen by bvc3d choose-elevations: world " << o.world << (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "")
-                  << ", sensor " << o.sensor << ", " << format_number(p.explore_minutes) << " min walk, seed " << p.seed
+                  << ", agent " << o.agent << ", sensor " << sensor << ", " << format_number(p.explore_minutes) << " min walk, seed " << p.seed
                   << ", budget " << p.budget << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai)
                   << "\n"
                   << config::model_to_yaml(c.model);
@@ -110,11 +122,16 @@ void add_adaptive_command(CLI::App& app) {
     cmd->add_option("--world", o->world, "World preset or YAML file")->capture_default_str();
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
-    cmd->add_option("--sensor", o->sensor, "Sensor preset or YAML file")->capture_default_str();
-    cmd->add_option("--agent", o->agent, "Who explores: ground (the paper's random walk)")->capture_default_str();
+    cmd->add_option("--sensor", o->sensor,
+                    "Sensor preset or YAML file (default: spherical on the ground, spherical-full when flying)");
+    cmd->add_option("--agent", o->agent,
+                    "Who explores: ground (the paper's random walk) or flying (the flying agent; the world needs a "
+                    "flight volume)")
+        ->capture_default_str();
     cmd->add_option("--budget", o->params.budget, "BVCs shared by the layers")->capture_default_str();
     cmd->add_option("--layers", o->layers, "Number of layers: N or MIN-MAX")->capture_default_str();
-    cmd->add_option("--min-elevation", o->params.elevation_min, "Lowest candidate elevation, rad")->capture_default_str();
+    cmd->add_option("--min-elevation", o->elevation_min,
+                    "Lowest candidate elevation, rad (default: 0 on the ground, -(max elevation) when flying)");
     cmd->add_option("--max-elevation", o->params.elevation_max, "Highest candidate elevation, rad")->capture_default_str();
     cmd->add_option("--elevation-step", o->params.elevation_step, "Spacing of the candidate elevations, rad")->capture_default_str();
     cmd->add_option("--explore-minutes", o->params.explore_minutes, "Simulated minutes of the exploratory walk")

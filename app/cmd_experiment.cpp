@@ -248,9 +248,7 @@ TrialConfig run_config(const RunOptions& o) {
     if (!o.lean.empty()) t.world.lean = o.lean;
     if (!o.model.empty()) t.model = config::resolve_model(o.model);
     if (!o.agent.empty()) {
-        if (o.agent == "flight") t.set_agent(std::make_shared<FlightSpec>());
-        else if (o.agent == "random_walk") t.set_agent(std::make_shared<RandomWalkSpec>());
-        else throw InputError("--agent must be 'random_walk' or 'flight', got '" + o.agent + "'");
+        t.set_agent(agent_by_name(o.agent));
         if (!o.trajectory.empty()) throw InputError("give --agent or --trajectory, not both");
     }
     if (!o.trajectory.empty()) t.set_agent(std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory)));
@@ -317,7 +315,7 @@ void add_run(CLI::App& app) {
     cmd->add_option("--trajectory", o->trajectory,
                     "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
     cmd->add_option("--agent", o->agent,
-                    "random_walk (the ground robot, default) or flight (the flying agent; docs/flying.md)");
+                    "random_walk or ground (the ground robot, default), flight or flying (the flying agent; docs/flying.md)");
     cmd->add_option("--seed", o->seed, "Random seed, 0 .. 2^64 - 1 (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");

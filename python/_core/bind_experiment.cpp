@@ -40,12 +40,7 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     t.model = config::resolve_model(model);
     t.world = WorldSpec{world, tilt_deg, t.world.lean};
     t.seed = seed_of(seed, "seed");
-    const bool flying = kwargs.contains("agent") && pyb::str(kwargs["agent"]).cast<std::string>() == "flight";
-    if (kwargs.contains("agent")) {
-        const std::string agent = pyb::str(kwargs["agent"]);
-        if (agent != "flight" && agent != "random_walk")
-            throw InputError("agent must be 'random_walk' or 'flight', got '" + agent + "'");
-    }
+    const bool flying = kwargs.contains("agent") && agent_by_name(pyb::str(kwargs["agent"]))->kind() == "flight";
     if (kwargs.contains("flight") && !flying) throw InputError("flight= (the flying agent's parameters) needs agent='flight'");
     if (flying) {
         FlightParams flight;
@@ -122,19 +117,25 @@ Protocol keywords and their defaults:
             .c_str());
     m.def(
         "choose_elevations",
-        [](const std::string& world, std::optional<double> tilt_deg, const std::string& sensor, std::uint64_t seed,
+        [](const std::string& world, std::optional<double> tilt_deg, const std::string& agent_name,
+           const std::optional<std::string>& sensor, std::uint64_t seed,
            std::optional<std::vector<std::vector<double>>> sets, int jobs, const pyb::kwargs& kwargs) {
+            const auto agent = agent_by_name(agent_name);
+            const ChooserDefaults defaults = chooser_defaults(*agent);
             ChooserParams p;
             apply_kwargs(p, ChooserParams::table(), kwargs);
+            if (defaults.symmetric_range && !kwargs.contains("elevation_min")) p.elevation_min = -p.elevation_max;
             p.seed = seed;
             p.jobs = jobs;
-            ModelSpec base = model_preset("3d-0.2");
-            base.sensor = config::resolve_sensor(sensor);
+            ModelSpec base = model_preset(defaults.model);
+            base.sensor = config::resolve_sensor(sensor.value_or(defaults.sensor));
+            const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
             const ElevationChoice c = interruptible([&](const std::atomic<bool>& stop) {
                 p.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
                 const World w(config::resolve_world(world, tilt_deg));
-                return sets ? choose_from_sets(w, base, RandomWalkSpec{}, *sets, p)
-                            : choose_elevations(w, base, RandomWalkSpec{}, p);
+                agent->check_world(w.description());
+                return sets ? choose_from_sets(w, base, *agent, *sets, p, analysis)
+                            : choose_elevations(w, base, *agent, p, analysis);
             });
             pyb::list candidates;
             for (const auto& s : c.candidates)
@@ -145,14 +146,17 @@ Protocol keywords and their defaults:
                              pyb::arg("msai") = c.chosen.msai, pyb::arg("candidates") = candidates,
                              pyb::arg("walk_steps") = c.walk_steps, pyb::arg("model_yaml") = config::model_to_yaml(c.model));
         },
-        pyb::arg("world") = WorldSpec{}.source, pyb::arg("tilt_deg") = pyb::none(), pyb::arg("sensor") = "spherical",
-        pyb::arg("seed") = 0, pyb::arg("sets") = pyb::none(), pyb::arg("jobs") = ChooserParams{}.jobs,
+        pyb::arg("world") = WorldSpec{}.source, pyb::arg("tilt_deg") = pyb::none(), pyb::arg("agent") = "ground",
+        pyb::arg("sensor") = pyb::none(), pyb::arg("seed") = 0, pyb::arg("sets") = pyb::none(), pyb::arg("jobs") = ChooserParams{}.jobs,
         (R"doc(The agent's choice of BVC elevations from its own exploratory walk, as `bvc3d choose-elevations`
 does it: the criterion (MSAI of the place-cell network on the walk, lower is better) of each
 candidate set of the greedy search, or of the given `sets` (lists of elevations, rad). Returns a
 dict: elevations, n_per_axis, msai (of the chosen set), candidates (a list of dicts: elevations,
-n_per_axis, round, msai, frac_multimodal), walk_steps, model_yaml. seed: the walk's; jobs: threads
-(0: every core). Keywords and their defaults:
+n_per_axis, round, msai, frac_multimodal), walk_steps, model_yaml. agent: "ground" (the paper's robot,
+sensor "spherical", 3d-0.2's cells) or "flying" (the flying agent, sensor "spherical-full", fly-5l's
+cells, candidates from -elevation_max unless elevation_min is given; 3-D analysis); sensor: another
+sensor preset or YAML; seed: the walk's; jobs: threads (0: every core). Keywords and their defaults
+(elevation_min: on the ground):
 )doc" + describe(ChooserParams::table(), ChooserParams{}))
             .c_str());
     pyb::list metrics;

@@ -120,3 +120,42 @@ def test_python_bad_input_raises_input_error():
     with pytest.raises(bvc3d.InputError, match="unknown argument"):
         bvc3d.choose_elevations("cross", 30.0, elevations_max=0.1)
     assert math.isfinite(bvc3d.choose_elevations("cross", 30.0, sets=[[0.0]], explore_minutes=3, jobs=1)["msai"])
+
+
+def test_flying_criterion_against_numpy_voxels_on_the_flight_run_as_a_trial(tmp_path):
+    """A flying agent's chooser scores each set on the flight volume's 0.5 m voxels: the chosen model
+    run on the chooser's own flight (twice, as a trajectory) and its MSAI computed here in numpy."""
+    from numpy_oracles import numpy_rate_maps
+    from test_flying import VOLUME, numpy_voxel_means, sai_brute3
+
+    res = bvc3d.choose_elevations("flight-room", agent="flying", seed=2, sets=[[-0.2, 0.2]], jobs=1,
+                                  explore_minutes=3)
+    assert yaml.safe_load(res["model_yaml"])["sensor"]["name"] == "spherical-full"
+    walk = bvc3d.flying_walk(bvc3d.World.preset("flight-room"), 3 / 60, 2)
+    assert len(walk["x"]) == res["walk_steps"] and np.ptp(walk["z"]) > 0.5
+    t = np.asarray(walk["t"]) - walk["t"][0]
+    period = t[-1] + (t[-1] - t[-2])
+    both = {k: np.concatenate([np.asarray(walk[k])] * 2) for k in ("x", "y", "z", "heading")}
+    both["t"] = np.concatenate([t, t + period])
+    model = tmp_path / "chosen.yaml"
+    model.write_text(res["model_yaml"])
+    trial = bvc3d.run_trial(str(model), "flight-room", seed=2, trajectory=both,
+                            explore_hours=0.5 * (t[-1] + t[-2]) / 3600, sample_hours=2 * (t[-1] + 1) / 3600)
+    np.testing.assert_array_equal(trial["z"], walk["z"])
+    p = np.column_stack([walk["x"], walk["y"], walk["z"]])
+    centers, means, _ = numpy_voxel_means(p, trial["rates"], 0.5, VOLUME)
+    maps = numpy_rate_maps(means, 0.1)
+    assert np.mean(sai_brute3(centers, maps, 2.0)) == pytest.approx(res["msai"], rel=1e-9, abs=1e-12)
+    # The ground robot cannot explore a flight-only world.
+    with pytest.raises(bvc3d.InputError, match="flight-only"):
+        bvc3d.choose_elevations("flight-room", sets=[[0.0]], explore_minutes=3)
+
+
+def test_cli_flying_candidates_look_down_as_far_as_up(cli, tmp_path):
+    out = tmp_path / "fly.yaml"
+    res = cli("choose-elevations", "--agent", "flying", "--world", "flight-room", "--sets", "-0.2,0.2;0",
+              "--explore-minutes", 3, "--jobs", 1, "--out", out, check=True)
+    assert "candidate elevations -0.4, -0.35," in res.stdout and ", 0.35, 0.4 rad" in res.stdout
+    assert set(printed_table(res.stdout)) == {(-0.2, 0.2), (0.0,)}
+    assert "agent flying, sensor spherical-full" in out.read_text()
+    cli("config", "--model", out, check=True)

@@ -4,10 +4,12 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
@@ -26,7 +28,7 @@ ModelSpec spherical_base() { return model_preset("3d-0.2"); }
 // uses one step's gap), learning through the first pass, analyzed by the trial pipeline, each
 // elevation set alone in its own trial.
 double msai_by_trial(const World& world, const std::vector<ModelStep>& walk, const std::vector<double>& elevations,
-                     std::uint64_t seed) {
+                     std::uint64_t seed, const ModelSpec& base = spherical_base(), int dims = 2) {
     std::vector<ModelStep> steps;
     const double t0 = walk.front().t, last = walk.back().t - t0;
     for (int pass = 0; pass < 2; ++pass)
@@ -35,10 +37,11 @@ double msai_by_trial(const World& world, const std::vector<ModelStep>& walk, con
             steps.push_back(s);
         }
     TrialConfig t;
-    t.model = spherical_base();
+    t.model = base;
     t.model.bvc.elevations = elevations;
     t.model.bvc.n_per_axis = 960 / (8 * static_cast<int>(elevations.size()));
-    t.agent = std::make_shared<TrajectorySpec>(steps, "oracle");
+    t.agent = std::make_shared<TrajectorySpec>(steps, "oracle", dims);
+    t.analysis = analysis::AnalysisParams::defaults(dims);
     t.protocol.explore_hours = (last - 0.01) / 3600.0;  // ends between the first pass's last two steps
     t.protocol.sample_hours = 1.0;
     t.seed = seed;
@@ -61,8 +64,33 @@ TEST(Adaptive, CriterionIsTheTrialPipelinesMsaiOnTheWalkTwice) {
         EXPECT_EQ(scores[i].elevations, sets[i]);
         EXPECT_EQ(scores[i].n_per_axis, 960 / (8 * static_cast<int>(sets[i].size())));
         ASSERT_TRUE(std::isfinite(scores[i].msai));
-        EXPECT_DOUBLE_EQ(scores[i].msai, msai_by_trial(world, walk, sets[i], 3)) << "set " << i;
+        EXPECT_DOUBLE_EQ(scores[i].msai, msai_by_trial(world, walk.steps, sets[i], 3)) << "set " << i;
     }
+}
+
+TEST(Adaptive, FlyingCriterionIsThe3dTrialPipelinesMsaiOnTheFlightTwice) {
+    // A flying agent explores the flight room; candidates look down as well as up, and each is
+    // scored on the flight volume's voxels (3-D analysis, DBSCAN min_samples 10) as its trials are.
+    const World world(config::resolve_world("flight-room"));
+    const FlightSpec agent;
+    const auto defaults = chooser_defaults(agent);
+    EXPECT_STREQ(defaults.sensor, "spherical-full");
+    const ModelSpec base = model_preset(defaults.model);
+    const auto walk = exploration_walk(world, agent, 4, 4.0, 2.0);
+    ASSERT_EQ(walk.dims, 3);
+    double z_lo = 1e9, z_hi = -1e9;
+    for (const auto& s : walk.steps) z_lo = std::min(z_lo, s.pose.z), z_hi = std::max(z_hi, s.pose.z);
+    EXPECT_GT(z_hi - z_lo, 0.5);  // it flies
+    const std::vector<std::vector<double>> sets{{-0.2, 0.2}, {0.0}};
+    const auto analysis = analysis::AnalysisParams::defaults(3);
+    const auto scores = score_elevation_sets(world, base, walk, sets, 960, 4, analysis, 2);
+    for (std::size_t i = 0; i < sets.size(); ++i) {
+        ASSERT_TRUE(std::isfinite(scores[i].msai));
+        EXPECT_DOUBLE_EQ(scores[i].msai, msai_by_trial(world, walk.steps, sets[i], 4, base, 3)) << "set " << i;
+    }
+    // The same walk analyzed in the plane gives another criterion: the voxels are what is scored.
+    const auto flat = score_elevation_sets(world, base, ExplorationWalk{walk.steps, 2}, {sets[0]}, 960, 4, {}, 1);
+    EXPECT_NE(flat[0].msai, scores[0].msai);
 }
 
 TEST(Adaptive, ChoosesALayerThatSeesTheShelf) {
@@ -98,8 +126,8 @@ TEST(Adaptive, TheShelfChangesTheCriterionOnlyOfLayersThatSeeIt) {
     std::filesystem::remove(tmp);
     const auto walk = exploration_walk(with_shelf, RandomWalkSpec{}, 5, 10.0, 2.0);
     const auto walk_bare = exploration_walk(no_shelf, RandomWalkSpec{}, 5, 10.0, 2.0);
-    ASSERT_EQ(walk.size(), walk_bare.size());
-    EXPECT_EQ(walk.back().pose.x, walk_bare.back().pose.x);
+    ASSERT_EQ(walk.steps.size(), walk_bare.steps.size());
+    EXPECT_EQ(walk.steps.back().pose.x, walk_bare.steps.back().pose.x);
     const std::vector<std::vector<double>> sets{{0.0}, {0.6}};
     const auto a = score_elevation_sets(with_shelf, spherical_base(), walk, sets, 960, 5, {}, 2);
     const auto b = score_elevation_sets(no_shelf, spherical_base(), walk, sets, 960, 5, {}, 2);

@@ -166,9 +166,11 @@ std::uint64_t hash_steps(const std::vector<ModelStep>& steps) {
 
 }  // namespace
 
-TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source)
+TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source, int dims)
     : steps_(std::make_shared<const std::vector<ModelStep>>(std::move(steps))), source_(std::move(source)),
-      hash_(hash_steps(*steps_)) {}
+      hash_(hash_steps(*steps_)), dims_(dims) {
+    if (dims != 2 && dims != 3) throw InputError("a trajectory's positions are analyzed in 2 or 3 dimensions, not " + std::to_string(dims));
+}
 
 TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
     TrajectorySpec spec(read_trajectory_file(path), path.string());
@@ -203,6 +205,7 @@ std::string TrajectorySpec::key() const {
     std::ostringstream os;
     os << "trajectory:\n  source: " << std::filesystem::path(source_).filename().string() << "\n  rows: " << steps_->size()
        << "\n  hash: " << std::hex << hash_ << "\n";
+    if (dims_ == 3) os << "  dims: 3\n";  // 2-D keys stay as they were
     return os.str();
 }
 

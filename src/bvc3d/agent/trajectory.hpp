@@ -47,11 +47,13 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path);
 class TrajectorySpec : public AgentSpec {
 public:
     static TrajectorySpec from_file(const std::filesystem::path& path);
-    TrajectorySpec(std::vector<ModelStep> steps, std::string source);
+    // dims 3: positions are analyzed in 3-D (voxels), as a flying agent's; 2 (the default): in the plane.
+    TrajectorySpec(std::vector<ModelStep> steps, std::string source, int dims = 2);
 
     const std::string& source() const { return source_; }
     const std::vector<ModelStep>& steps() const { return *steps_; }
     std::string kind() const override { return "trajectory"; }
+    int dims() const override { return dims_; }
     void validate() const override {}
     // Every pose lies within the world's geometry (a path in another frame is a mistake).
     void check_world(const WorldDescription& world) const override;
@@ -67,6 +69,7 @@ private:
     std::string source_;
     std::uint64_t hash_ = 0;  // of the rows, for the key
     std::filesystem::path file_;  // the file it was read from (absolute), empty for arrays
+    int dims_ = 2;
 };
 
 }  // namespace bvc3d

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
@@ -84,6 +85,12 @@ Protocol::Kind parse_protocol(const std::string& name) {
     if (name == "explore_then_sample" || name == "paper") return Protocol::Kind::explore_then_sample;
     if (name == "online") return Protocol::Kind::online;
     throw InputError("protocol '" + name + "' is not one of explore_then_sample, online");
+}
+
+std::shared_ptr<const AgentSpec> agent_by_name(const std::string& name) {
+    if (name == "random_walk" || name == "ground") return std::make_shared<RandomWalkSpec>();
+    if (name == "flight" || name == "flying") return std::make_shared<FlightSpec>();
+    throw InputError("agent '" + name + "' is not one of random_walk (or ground: the paper's robot), flight (or flying)");
 }
 
 void TrialConfig::set_agent(std::shared_ptr<const AgentSpec> a) {

@@ -13,6 +13,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
+#include "bvc3d/experiment/pipeline.hpp"
 
 namespace bvc3d {
 
@@ -55,7 +56,7 @@ SourceFactory replay_factory(const SourceFactory& inner, std::uint64_t walk_step
 }
 
 // The walk, then the walk again: the agent the candidates' trials run on.
-std::shared_ptr<const AgentSpec> two_passes(const std::vector<ModelStep>& walk) {
+std::shared_ptr<const AgentSpec> two_passes(const std::vector<ModelStep>& walk, int dims) {
     std::vector<ModelStep> steps;
     steps.reserve(2 * walk.size());
     const double t0 = walk.front().t;
@@ -65,7 +66,7 @@ std::shared_ptr<const AgentSpec> two_passes(const std::vector<ModelStep>& walk) 
             s.t = s.t - t0 + pass * period;
             steps.push_back(s);
         }
-    return std::make_shared<TrajectorySpec>(std::move(steps), "exploratory walk, two passes");
+    return std::make_shared<TrajectorySpec>(std::move(steps), "exploratory walk, two passes", dims);
 }
 
 // Learning through the first pass exactly: the runner hands out a step while the last one ended
@@ -79,14 +80,12 @@ Protocol two_pass_protocol(const std::vector<ModelStep>& walk) {
     return p;
 }
 
-CandidateScore score(const GroupResult& r, std::size_t model, const ModelSpec& spec,
-                     const analysis::AnalysisParams& analysis) {
-    const auto& rec = r.models.at(model);
-    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()), rec.n_place);
-    const auto m = analysis::analyze_trial<float>(r.x, r.y, rates, analysis);
+// A candidate's trial analyzed as any trial is (2-D bins or, for a flying agent, the flight volume's voxels).
+CandidateScore score(const World& world, const GroupResult& r, std::size_t model, const TrialConfig& trial) {
+    const auto m = analyze(trial, world.description(), r, model).metrics;
     CandidateScore s;
-    s.elevations = spec.bvc.elevations;
-    s.n_per_axis = spec.bvc.n_per_axis;
+    s.elevations = trial.model.bvc.elevations;
+    s.n_per_axis = trial.model.bvc.n_per_axis;
     s.msai = m.aliasing.msai;
     s.frac_multimodal = m.modality_summary.frac_multimodal;
     return s;
@@ -149,6 +148,11 @@ void ChooserParams::validate(int n_dir) const {
                          std::to_string(2 * n_dir * layers) + ")");
 }
 
+ChooserDefaults chooser_defaults(const AgentSpec& agent) {
+    if (agent.dims() == 3) return {"fly-5l", "spherical-full", true};
+    return {"3d-0.2", "spherical", false};
+}
+
 std::string elevations_text(const std::vector<double>& elevations) {
     std::string s;
     for (double e : elevations) s += (s.empty() ? "" : ", ") + format_number(e);
@@ -169,17 +173,20 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
     return m;
 }
 
-std::vector<ModelStep> exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
-                                        double d_th) {
+ExplorationWalk exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
+                                 double d_th) {
     agent.validate();
     const auto walker = agent.make(&world, seed);
-    std::vector<ModelStep> steps;
+    ExplorationWalk walk{{}, agent.dims()};
+    auto& steps = walk.steps;
     while (const auto s = walker->next(minutes * 60.0)) steps.push_back(*s);
     // A pair farther apart than d_th, or aliasing has nothing to compare.
+    const double z_weight = walk.dims == 3 ? 1.0 : 0.0;
     for (std::size_t i = 0; i < steps.size(); ++i)
         for (std::size_t j = i + 1; j < steps.size(); ++j) {
             const double dx = steps[i].pose.x - steps[j].pose.x, dy = steps[i].pose.y - steps[j].pose.y;
-            if (dx * dx + dy * dy > d_th * d_th) return steps;
+            const double dz = z_weight * (steps[i].pose.z - steps[j].pose.z);
+            if (dx * dx + dy * dy + dz * dz > d_th * d_th) return walk;
         }
     throw InputError("the exploratory walk (" + format_number(minutes) + " min, " + std::to_string(steps.size()) +
                      " steps) never gets two positions more than d_th = " + format_number(d_th) +
@@ -187,15 +194,15 @@ std::vector<ModelStep> exploration_walk(const World& world, const AgentSpec& age
 }
 
 std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
-                                                 const std::vector<ModelStep>& walk,
+                                                 const ExplorationWalk& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
                                                  int jobs, const SourceFactory& sources, const std::atomic<bool>* stop) {
     if (jobs < 0) throw InputError("jobs must be >= 0");
-    if (walk.size() < 2) throw InputError("the exploratory walk needs at least 2 steps");
+    if (walk.steps.size() < 2) throw InputError("the exploratory walk needs at least 2 steps");
     std::vector<TrialConfig> trials;
-    const auto agent = two_passes(walk);
-    const Protocol protocol = two_pass_protocol(walk);
+    const auto agent = two_passes(walk.steps, walk.dims);
+    const Protocol protocol = two_pass_protocol(walk.steps);
     for (const auto& set : sets) {
         TrialConfig t;
         t.model = model_with_elevations(base, set, budget);
@@ -221,8 +228,8 @@ std::vector<CandidateScore> score_elevation_sets(const World& world, const Model
             if (mine.empty()) return;
             RunControl control;
             control.stop = stop;
-            const GroupResult r = run_trial_group(world, mine, control, replay_factory(sources, walk.size(), noise_seed));
-            for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(r, m, mine[m].model, analysis);
+            const GroupResult r = run_trial_group(world, mine, control, replay_factory(sources, walk.steps.size(), noise_seed));
+            for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(world, r, m, mine[m]);
         } catch (...) {
             errors[k] = std::current_exception();
         }
@@ -248,7 +255,7 @@ ElevationChoice choose_elevations(const World& world, const ModelSpec& base, con
     const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
 
     ElevationChoice choice;
-    choice.walk_steps = walk.size();
+    choice.walk_steps = walk.steps.size();
     std::vector<double> best_set;
     const int max_layers = std::min<int>(params.max_layers, static_cast<int>(pool.size()));
     for (int round = 1; round <= max_layers; ++round) {
@@ -283,7 +290,7 @@ ElevationChoice choose_from_sets(const World& world, const ModelSpec& base, cons
     for (const auto& set : sets) model_with_elevations(base, set, params.budget);  // fail before the walk
     const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
     ElevationChoice c;
-    c.walk_steps = walk.size();
+    c.walk_steps = walk.steps.size();
     c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
                                            params.stop);
     for (auto& s : c.candidates) s.round = static_cast<int>(s.elevations.size());

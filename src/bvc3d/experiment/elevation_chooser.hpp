@@ -37,6 +37,16 @@ struct ChooserParams {
     std::vector<double> candidate_elevations() const;
 };
 
+// What an agent explores with unless told otherwise: the ground robot the paper's spherical scanner
+// and the 0.2-rad model's cells (3d-0.2), candidates from 0 up; a flying agent its full spherical
+// scanner at the body's center and fly-5l's cells, candidates looking down as far as up.
+struct ChooserDefaults {
+    const char* model;
+    const char* sensor;
+    bool symmetric_range;  // elevation_min = -elevation_max
+};
+ChooserDefaults chooser_defaults(const AgentSpec& agent);
+
 struct CandidateScore {
     std::vector<double> elevations;
     int n_per_axis = 0;
@@ -52,10 +62,17 @@ struct ElevationChoice {
     std::size_t walk_steps = 0;
 };
 
+// The exploratory walk: the agent's model steps, and whether its positions are analyzed in the
+// plane (2, the ground robot) or in space (3, a flying agent: voxels, as its trials are).
+struct ExplorationWalk {
+    std::vector<ModelStep> steps;
+    int dims = 2;
+};
+
 // The agent's model steps over `minutes` of its time (one walk, its own seed). InputError if no two
-// positions lie farther apart than d_th (nothing to measure aliasing on).
-std::vector<ModelStep> exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed,
-                                        double minutes, double d_th);
+// positions lie farther apart than d_th (in the agent's dimensions; nothing to measure aliasing on).
+ExplorationWalk exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
+                                 double d_th);
 
 // The base model with these layers and the budget's n_per_axis (InputError if fewer than 2).
 ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>& elevations, int budget);
@@ -65,7 +82,7 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
 // threads); the second pass reads the same steps again. `jobs` threads share the sets (0: every core).
 // `stop`, when set, ends the runs with Interrupted.
 std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
-                                                 const std::vector<ModelStep>& walk,
+                                                 const ExplorationWalk& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
                                                  int jobs = 0, const SourceFactory& sources = {},
