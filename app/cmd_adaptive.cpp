@@ -15,15 +15,18 @@
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/experiment/elevation_chooser.hpp"
 #include "cli_common.hpp"
+#include "recording_options.hpp"
 
 namespace bvc3d::cli {
 
 namespace {
 
 struct ChooseOptions {
-    std::string world = "cross", lean = "+x+y", sensor, agent = "ground", layers = "1-4", sets, out;
+    std::string world, lean = "+x+y", sensor, agent, layers = "1-4", sets, out, scans, poses;
     std::optional<double> tilt, elevation_min;
     ChooserParams params;
+    RecordingOptions recording;
+    PreprocessOptions preprocess;
 };
 
 std::shared_ptr<const AgentSpec> named_agent(const std::string& name) {
@@ -67,8 +70,32 @@ std::vector<std::vector<double>> parse_sets(const std::string& text) {
     return sets;
 }
 
+// Where the chooser's walk and scans come from: an agent exploring a world, or a recording.
+struct Exploration {
+    std::shared_ptr<const AgentSpec> agent;
+    std::optional<ReplaySource> recorded;
+    std::string text;  // for the model file's comment
+};
+
+Exploration exploration_of(const ChooseOptions& o) {
+    if (o.scans.empty() && o.poses.empty()) {
+        const auto agent = named_agent(o.agent.empty() ? "ground" : o.agent);
+        const std::string world = o.world.empty() ? "cross" : o.world;
+        return {agent, std::nullopt,
+                "world " + world + (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "") + ", agent " +
+                    (o.agent.empty() ? "ground" : o.agent)};
+    }
+    if (o.scans.empty()) throw InputError("--poses needs --scans");
+    if (!o.world.empty() || o.tilt || !o.agent.empty())
+        throw InputError("a recording is its own walk: give --scans and --poses, or --world (and --agent), not both");
+    const ReplaySource source = recorded_source(o.recording.open(o.scans, o.poses), o.preprocess.get());
+    return {std::make_shared<RandomWalkSpec>(), source,
+            "recording " + o.scans + " (" + std::to_string(source.path->steps().size()) + " scans)"};
+}
+
 void choose(const ChooseOptions& o) {
-    const auto agent = named_agent(o.agent);
+    const Exploration exploration = exploration_of(o);
+    const auto& agent = exploration.agent;
     const ChooserDefaults defaults = chooser_defaults(*agent);
     ChooserParams p = o.params;
     std::tie(p.min_layers, p.max_layers) = parse_layers(o.layers);
@@ -80,18 +107,26 @@ void choose(const ChooseOptions& o) {
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
     // Fail before minutes of work, not after.
     if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty()) ensure_writable_directory(folder);
-    const World world(config::resolve_world(o.world, o.tilt, o.lean));
-    agent->check_world(world.description());
     const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
+    const auto sets = o.sets.empty() ? std::vector<std::vector<double>>{} : parse_sets(o.sets);
     InterruptGuard guard;
     p.stop = &stop_flag();
-    std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n", o.world.c_str(),
-                format_number(p.explore_minutes).c_str(), static_cast<unsigned long long>(p.seed),
-                elevations_text(p.candidate_elevations()).c_str());
     ElevationChoice c;
     try {
-        c = o.sets.empty() ? choose_elevations(world, base, *agent, p, analysis)
-                           : choose_from_sets(world, base, *agent, parse_sets(o.sets), p, analysis);
+        if (exploration.recorded) {
+            std::printf("replaying %s twice per candidate (seed %llu); candidate elevations %s rad\n",
+                        exploration.text.c_str(), static_cast<unsigned long long>(p.seed),
+                        elevations_text(p.candidate_elevations()).c_str());
+            c = choose_elevations_on(*exploration.recorded, base, p, analysis, sets);
+        } else {
+            const std::string name = o.world.empty() ? "cross" : o.world;
+            const World world(config::resolve_world(name, o.tilt, o.lean));
+            agent->check_world(world.description());
+            std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n", name.c_str(), format_number(p.explore_minutes).c_str(),
+                        static_cast<unsigned long long>(p.seed), elevations_text(p.candidate_elevations()).c_str());
+            c = sets.empty() ? choose_elevations(world, base, *agent, p, analysis)
+                             : choose_from_sets(world, base, *agent, sets, p, analysis);
+        }
     } catch (const Interrupted&) {
         std::fprintf(stderr, "\nbvc3d: interrupted; nothing was written.\n");
         std::exit(130);
@@ -104,9 +139,9 @@ void choose(const ChooseOptions& o) {
     std::printf("chosen: %s rad, %d per axis (MSAI %.4f)\n", elevations_text(c.chosen.elevations).c_str(), c.chosen.n_per_axis,
                 c.chosen.msai);
     AtomicFile file(o.out);
-    file.stream() << "# chosen by bvc3d choose-elevations: world " << o.world << (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "")
-                  << ", agent " << o.agent << ", sensor " << sensor << ", " << format_number(p.explore_minutes) << " min walk, seed " << p.seed
-                  << ", budget " << p.budget << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai)
+    file.stream() << "# chosen by bvc3d choose-elevations: " << exploration.text << ", sensor " << sensor << ", "
+                  << (exploration.recorded ? std::string("recorded walk") : format_number(p.explore_minutes) + " min walk")
+                  << ", seed " << p.seed << ", budget " << p.budget << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai)
                   << "\n"
                   << config::model_to_yaml(c.model);
     file.commit();
@@ -119,15 +154,20 @@ void add_adaptive_command(CLI::App& app) {
     auto o = std::make_shared<ChooseOptions>();
     auto* cmd = app.add_subcommand("choose-elevations",
                                    "Choose the BVC layers' elevations from a short exploratory walk; write the model YAML");
-    cmd->add_option("--world", o->world, "World preset or YAML file")->capture_default_str();
+    cmd->add_option("--world", o->world, "World preset or YAML file (default: cross)");
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
     cmd->add_option("--sensor", o->sensor,
                     "Sensor preset or YAML file (default: spherical on the ground, spherical-full when flying)");
     cmd->add_option("--agent", o->agent,
-                    "Who explores: ground (the paper's random walk) or flying (the flying agent; the world needs a "
-                    "flight volume)")
-        ->capture_default_str();
+                    "Who explores: ground (the paper's random walk, default) or flying (the flying agent; the world "
+                    "needs a flight volume)");
+    cmd->add_option("--scans", o->scans,
+                    "Instead of a world: a recording's scans (folder, list or file); its poses are the walk, its scans "
+                    "the returns");
+    cmd->add_option("--poses", o->poses, "With --scans: the recording's pose file (KITTI, TUM or 4x4 rows)");
+    o->recording.add_to(*cmd);
+    o->preprocess.add_to(*cmd);
     cmd->add_option("--budget", o->params.budget, "BVCs shared by the layers")->capture_default_str();
     cmd->add_option("--layers", o->layers, "Number of layers: N or MIN-MAX")->capture_default_str();
     cmd->add_option("--min-elevation", o->elevation_min,

@@ -25,6 +25,7 @@
 #include "bvc3d/recording/ply.hpp"
 #include "bvc3d/recording/pcd.hpp"
 #include "cli_common.hpp"
+#include "recording_options.hpp"
 
 namespace bvc3d::cli {
 
@@ -62,52 +63,6 @@ public:
 private:
     bool tty_;
     bool shown_ = false;
-};
-
-// Where scans and poses are, and how to read them.
-struct RecordingOptions {
-    std::string pose_format = "auto", extrinsics;
-    double time_tolerance = 0.05;
-
-    void add_to(CLI::App& cmd) {
-        cmd.add_option("--pose-format", pose_format, "Pose file format: auto, kitti, tum or matrix (4x4 rows)")
-            ->capture_default_str();
-        cmd.add_option("--extrinsics", extrinsics,
-                       "Sensor mounting (base-from-sensor): a file, or 12 or 16 numbers; the poses are then the base's");
-        cmd.add_option("--time-tolerance", time_tolerance, "Seconds within which a scan pairs with a pose by time")
-            ->capture_default_str();
-    }
-    std::shared_ptr<const recording::Recording> open(const std::string& scans, const std::string& poses) const {
-        if (poses.empty()) throw InputError("the scans '" + scans + "' need a pose file");
-        recording::RecordingOptions o;
-        o.pose_format = recording::parse_pose_format(pose_format);
-        o.time_tolerance = time_tolerance;
-        if (!extrinsics.empty()) {
-            std::error_code ec;
-            o.base_from_sensor = fs::is_regular_file(extrinsics, ec) ? recording::read_extrinsics(extrinsics)
-                                                                     : recording::parse_extrinsics(extrinsics, "--extrinsics");
-        }
-        return std::make_shared<const recording::Recording>(recording::open_recording(scans, poses, o));
-    }
-};
-
-// The preprocessing of recorded scans.
-struct PreprocessOptions {
-    RecordedReturnParams params;
-    std::optional<double> slice_deg;
-
-    void add_to(CLI::App& cmd) {
-        cmd.add_option("--min-range", params.min_range, "m: nearer points are dropped")->capture_default_str();
-        cmd.add_option("--max-range", params.max_range, "m: farther points are dropped")->capture_default_str();
-        cmd.add_option("--slice-half-width-deg", slice_deg,
-                       "The 2-D models read the returns within this many degrees of the horizontal (default 1)");
-    }
-    RecordedReturnParams get() const {
-        RecordedReturnParams p = params;
-        if (slice_deg) p.slice_half_width = deg_to_rad(*slice_deg);
-        p.validate();
-        return p;
-    }
 };
 
 // Scans to replay: a recording (--scans, --poses), or a simulated sensor along a path in a world.

@@ -12,6 +12,7 @@ import pytest
 import yaml
 
 import bvc3d
+from conftest import SOURCE_DIR
 
 SETS = "0,0.2;0.1"
 ROW = re.compile(r"^\s*(\d+)\s+([-\d., ]+?)\s+(\d+)\s+([-\d.]+|nan)\s+([-\d.]+|nan)\s*$")
@@ -159,3 +160,40 @@ def test_cli_flying_candidates_look_down_as_far_as_up(cli, tmp_path):
     assert set(printed_table(res.stdout)) == {(-0.2, 0.2), (0.0,)}
     assert "agent flying, sensor spherical-full" in out.read_text()
     cli("config", "--model", out, check=True)
+
+
+HALL = SOURCE_DIR.parent / "shared" / "data" / "hall-lidar"
+
+
+@pytest.mark.skipif(not (HALL / "poses.csv").exists(), reason=f"the hall-lidar recording is not at {HALL}")
+def test_choice_on_a_recording_against_its_replay(cli, tmp_path):
+    """On recorded scans the recording is the walk: the criterion of a set is the MSAI of the network
+    replayed over the scans learning, then frozen. Oracle: `bvc3d replay --learn`, then a frozen
+    `bvc3d replay` from those weights, MSAI in numpy. Not bit-equal: in the chooser the network's
+    activity carries over from the first pass into the second, while the frozen replay starts at rest."""
+    rec = ["--scans", HALL, "--poses", HALL / "poses.csv"]
+    out = tmp_path / "hall.yaml"
+    res = cli("choose-elevations", *rec, "--sets", "0,0.2;0.1", "--jobs", 2, "--out", out, check=True)
+    table = printed_table(res.stdout)
+    assert set(table) == {(0.0, 0.2), (0.1,)}
+    assert "recording" in out.read_text() and "(60 scans)" in out.read_text()
+    # Threads do not change the result (each has its own reader of the scans).
+    again = cli("choose-elevations", *rec, "--sets", "0,0.2;0.1", "--jobs", 1, "--out", tmp_path / "b.yaml", check=True)
+    assert printed_table(again.stdout) == table
+
+    one = tmp_path / "one.yaml"
+    cli("choose-elevations", *rec, "--sets", "0,0.2", "--out", one, check=True)
+    cli("replay", *rec, "--model", one, "--learn", "--out", tmp_path / "learn.h5", check=True)
+    cli("replay", *rec, "--model", one, "--weights", tmp_path / "learn.h5", "--out", tmp_path / "frozen.h5", check=True)
+    import h5py
+    with h5py.File(tmp_path / "frozen.h5", "r") as f:
+        x, y, rates = f["samples/x"][:], f["samples/y"][:], f["samples/rates"][:]
+    crit = float(one.read_text().split("criterion (MSAI of the network on the walk): ")[1].split()[0])
+    assert crit == pytest.approx(table[(0.0, 0.2)], abs=5e-5)  # the table prints 4 decimals
+    assert numpy_msai(x, y, rates) == pytest.approx(crit, rel=2e-3)
+
+    # A recording is its own walk: no world or agent beside it, and poses need scans.
+    for args, words in ((rec + ["--world", "cross"], "not both"), (["--poses", HALL / "poses.csv"], "--poses needs --scans")):
+        bad = tmp_path / "bad.yaml"
+        r = cli("choose-elevations", *args, "--out", bad)
+        assert r.returncode == 2 and words in r.stderr and not bad.exists()

@@ -5,7 +5,9 @@
 #include <exception>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <numbers>
+#include <optional>
 #include <thread>
 
 #include "bvc3d/agent/trajectory.hpp"
@@ -21,9 +23,9 @@ namespace {
 
 // A source read twice over: step n of the second pass reads walk step n again, so both passes see
 // the same scans (and the same sensor noise).
-class ReplaySource : public ReturnSource {
+class TwoPassSource : public ReturnSource {
 public:
-    ReplaySource(std::shared_ptr<ReturnSource> inner, std::uint64_t walk_steps)
+    TwoPassSource(std::shared_ptr<ReturnSource> inner, std::uint64_t walk_steps)
         : inner_(std::move(inner)), walk_steps_(walk_steps) {}
     const LidarSpec* beam_table() const override { return inner_->beam_table(); }
     void returns(std::uint64_t step, const Pose& pose, const std::vector<char>& rows, Scan& out) override {
@@ -49,7 +51,7 @@ SourceFactory replay_factory(const SourceFactory& inner, std::uint64_t walk_step
             if (!world) throw InputError("choosing elevations needs a world to cast rays in");
             made = std::make_shared<RayCastSource>(*world, model.sensor, noise_seed);
         }
-        auto replay = std::make_shared<ReplaySource>(made, walk_steps);
+        auto replay = std::make_shared<TwoPassSource>(made, walk_steps);
         wrapped->emplace_back(made, replay);
         return replay;
     };
@@ -81,8 +83,9 @@ Protocol two_pass_protocol(const std::vector<ModelStep>& walk) {
 }
 
 // A candidate's trial analyzed as any trial is (2-D bins or, for a flying agent, the flight volume's voxels).
-CandidateScore score(const World& world, const GroupResult& r, std::size_t model, const TrialConfig& trial) {
-    const auto m = analyze(trial, world.description(), r, model).metrics;
+CandidateScore score(const World* world, const GroupResult& r, std::size_t model, const TrialConfig& trial) {
+    static const WorldDescription none;
+    const auto m = analyze(trial, world ? world->description() : none, r, model).metrics;
     CandidateScore s;
     s.elevations = trial.model.bvc.elevations;
     s.n_per_axis = trial.model.bvc.n_per_axis;
@@ -173,27 +176,36 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
     return m;
 }
 
-ExplorationWalk exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
-                                 double d_th) {
-    agent.validate();
-    const auto walker = agent.make(&world, seed);
-    ExplorationWalk walk{{}, agent.dims()};
-    auto& steps = walk.steps;
-    while (const auto s = walker->next(minutes * 60.0)) steps.push_back(*s);
-    // A pair farther apart than d_th, or aliasing has nothing to compare.
+namespace {
+
+// Whether two of the walk's positions lie farther apart than d_th (else aliasing has nothing to compare).
+bool spreads_beyond(const ExplorationWalk& walk, double d_th) {
+    const auto& steps = walk.steps;
     const double z_weight = walk.dims == 3 ? 1.0 : 0.0;
     for (std::size_t i = 0; i < steps.size(); ++i)
         for (std::size_t j = i + 1; j < steps.size(); ++j) {
             const double dx = steps[i].pose.x - steps[j].pose.x, dy = steps[i].pose.y - steps[j].pose.y;
             const double dz = z_weight * (steps[i].pose.z - steps[j].pose.z);
-            if (dx * dx + dy * dy + dz * dz > d_th * d_th) return walk;
+            if (dx * dx + dy * dy + dz * dz > d_th * d_th) return true;
         }
-    throw InputError("the exploratory walk (" + format_number(minutes) + " min, " + std::to_string(steps.size()) +
+    return false;
+}
+
+}  // namespace
+
+ExplorationWalk exploration_walk(const World& world, const AgentSpec& agent, std::uint64_t seed, double minutes,
+                                 double d_th) {
+    agent.validate();
+    const auto walker = agent.make(&world, seed);
+    ExplorationWalk walk{{}, agent.dims()};
+    while (const auto s = walker->next(minutes * 60.0)) walk.steps.push_back(*s);
+    if (spreads_beyond(walk, d_th)) return walk;
+    throw InputError("the exploratory walk (" + format_number(minutes) + " min, " + std::to_string(walk.steps.size()) +
                      " steps) never gets two positions more than d_th = " + format_number(d_th) +
                      " m apart: explore longer");
 }
 
-std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
+std::vector<CandidateScore> score_elevation_sets(const World* world, const ModelSpec& base,
                                                  const ExplorationWalk& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
@@ -246,14 +258,13 @@ std::vector<CandidateScore> score_elevation_sets(const World& world, const Model
     return out;
 }
 
-ElevationChoice choose_elevations(const World& world, const ModelSpec& base, const AgentSpec& agent,
-                                  const ChooserParams& params, const analysis::AnalysisParams& analysis,
-                                  const SourceFactory& sources) {
-    params.validate(base.bvc.n_dir);
-    analysis.validate();
-    const std::vector<double> pool = params.candidate_elevations();
-    const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
+namespace {
 
+// The greedy search on a walk already taken (world null: returns from `sources` alone).
+ElevationChoice greedy_search(const World* world, const ModelSpec& base, const ExplorationWalk& walk,
+                              const ChooserParams& params, const analysis::AnalysisParams& analysis,
+                              const SourceFactory& sources) {
+    const std::vector<double> pool = params.candidate_elevations();
     ElevationChoice choice;
     choice.walk_steps = walk.steps.size();
     std::vector<double> best_set;
@@ -281,23 +292,83 @@ ElevationChoice choose_elevations(const World& world, const ModelSpec& base, con
     return choice;
 }
 
-ElevationChoice choose_from_sets(const World& world, const ModelSpec& base, const AgentSpec& agent,
-                                 const std::vector<std::vector<double>>& sets, const ChooserParams& params,
-                                 const analysis::AnalysisParams& analysis, const SourceFactory& sources) {
-    if (sets.empty()) throw InputError("no elevation sets to choose from");
-    ChooserParams::table().check(params);
-    analysis.validate();
-    for (const auto& set : sets) model_with_elevations(base, set, params.budget);  // fail before the walk
-    const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
+// The best of given sets on a walk already taken.
+ElevationChoice best_of_sets(const World* world, const ModelSpec& base, const ExplorationWalk& walk,
+                             const std::vector<std::vector<double>>& sets, const ChooserParams& params,
+                             const analysis::AnalysisParams& analysis, const SourceFactory& sources) {
     ElevationChoice c;
     c.walk_steps = walk.steps.size();
     c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
-                                           params.stop);
+                                        params.stop);
     for (auto& s : c.candidates) s.round = static_cast<int>(s.elevations.size());
     c.chosen = c.candidates[best_of(c.candidates)];
     if (std::isnan(c.chosen.msai)) throw InputError("the exploratory walk gave no bins to measure aliasing on");
     c.model = model_with_elevations(base, c.chosen.elevations, params.budget);
     return c;
+}
+
+// A returns spec's factory serves one run (its sources cache scans): one per worker thread.
+SourceFactory factory_per_thread(std::shared_ptr<const ReturnsSpec> spec, std::uint64_t seed) {
+    struct Factories {
+        std::mutex mutex;
+        std::map<std::thread::id, SourceFactory> of_thread;
+    };
+    auto all = std::make_shared<Factories>();
+    return [spec, seed, all](const ModelSpec& model, const World* world) {
+        SourceFactory mine;
+        {
+            const std::lock_guard lock(all->mutex);
+            auto& slot = all->of_thread[std::this_thread::get_id()];
+            if (!slot) slot = spec->factory(seed);
+            mine = slot;
+        }
+        return mine(model, world);
+    };
+}
+
+// Checks before any work: the parameters, and every given set against the budget.
+void check_choice(const ModelSpec& base, const std::vector<std::vector<double>>& sets, const ChooserParams& params,
+                  const analysis::AnalysisParams& analysis) {
+    if (sets.empty()) params.validate(base.bvc.n_dir);
+    else ChooserParams::table().check(params);
+    analysis.validate();
+    for (const auto& set : sets) model_with_elevations(base, set, params.budget);
+}
+
+}  // namespace
+
+ElevationChoice choose_elevations(const World& world, const ModelSpec& base, const AgentSpec& agent,
+                                  const ChooserParams& params, const analysis::AnalysisParams& analysis,
+                                  const SourceFactory& sources) {
+    check_choice(base, {}, params, analysis);
+    const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
+    return greedy_search(&world, base, walk, params, analysis, sources);
+}
+
+ElevationChoice choose_from_sets(const World& world, const ModelSpec& base, const AgentSpec& agent,
+                                 const std::vector<std::vector<double>>& sets, const ChooserParams& params,
+                                 const analysis::AnalysisParams& analysis, const SourceFactory& sources) {
+    if (sets.empty()) throw InputError("no elevation sets to choose from");
+    check_choice(base, sets, params, analysis);
+    const auto walk = exploration_walk(world, agent, params.seed, params.explore_minutes, analysis.d_th);
+    return best_of_sets(&world, base, walk, sets, params, analysis, sources);
+}
+
+ElevationChoice choose_elevations_on(const ReplaySource& source, const ModelSpec& base, const ChooserParams& params,
+                                     const analysis::AnalysisParams& analysis,
+                                     const std::vector<std::vector<double>>& sets) {
+    check_choice(base, sets, params, analysis);
+    if (!source.path || !source.returns) throw InputError("choosing elevations on recorded scans needs their poses and scans");
+    const ExplorationWalk walk{source.path->steps(), source.path->dims()};
+    if (walk.steps.size() < 2 || !spreads_beyond(walk, analysis.d_th))
+        throw InputError("the recording's " + std::to_string(walk.steps.size()) + " poses never lie more than d_th = " +
+                         format_number(analysis.d_th) + " m apart: nothing to measure aliasing on");
+    const std::optional<World> world =
+        source.world.is_none() ? std::nullopt : std::optional<World>(World(source.world.resolve()));
+    const World* w = world ? &*world : nullptr;
+    const SourceFactory sources = factory_per_thread(source.returns, params.seed);
+    return sets.empty() ? greedy_search(w, base, walk, params, analysis, sources)
+                        : best_of_sets(w, base, walk, sets, params, analysis, sources);
 }
 
 }  // namespace bvc3d

@@ -14,6 +14,7 @@
 #include "bvc3d/agent/agent.hpp"
 #include "bvc3d/config/trial_config.hpp"
 #include "bvc3d/core/params.hpp"
+#include "bvc3d/experiment/replay.hpp"
 #include "bvc3d/experiment/trial_runner.hpp"
 #include "bvc3d/world/world.hpp"
 
@@ -81,12 +82,20 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
 // step (e.g. recorded scans; default: the model's sensor ray-cast in `world`; called from worker
 // threads); the second pass reads the same steps again. `jobs` threads share the sets (0: every core).
 // `stop`, when set, ends the runs with Interrupted.
-std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
+std::vector<CandidateScore> score_elevation_sets(const World* world, const ModelSpec& base,
                                                  const ExplorationWalk& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
                                                  int jobs = 0, const SourceFactory& sources = {},
                                                  const std::atomic<bool>* stop = nullptr);
+inline std::vector<CandidateScore> score_elevation_sets(const World& world, const ModelSpec& base,
+                                                        const ExplorationWalk& walk,
+                                                        const std::vector<std::vector<double>>& sets, int budget,
+                                                        std::uint64_t seed, const analysis::AnalysisParams& analysis,
+                                                        int jobs = 0, const SourceFactory& sources = {},
+                                                        const std::atomic<bool>* stop = nullptr) {
+    return score_elevation_sets(&world, base, walk, sets, budget, seed, analysis, jobs, sources, stop);
+}
 
 // The greedy search: round 1 scores each candidate elevation alone; each later round adds one
 // elevation (not yet in the set) to the round's best. Deterministic: ties go to the set considered first.
@@ -102,5 +111,13 @@ ElevationChoice choose_from_sets(const World& world, const ModelSpec& base, cons
 
 // "0, 0.25" — elevations as a model YAML and tables show them.
 std::string elevations_text(const std::vector<double>& elevations);
+
+// The choice on recorded scans (or a simulated stand-in, replay.hpp): the source's path is the
+// exploratory walk and its scans the returns (step i reads scan i), so no world is needed and
+// nothing is cast. `sets` empty: the greedy search; else the best of these sets. params'
+// explore_minutes does not apply (the recording is the walk); its seed draws the initial weights.
+ElevationChoice choose_elevations_on(const ReplaySource& source, const ModelSpec& base, const ChooserParams& params,
+                                     const analysis::AnalysisParams& analysis = {},
+                                     const std::vector<std::vector<double>>& sets = {});
 
 }  // namespace bvc3d
