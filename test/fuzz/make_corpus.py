@@ -4,6 +4,7 @@ each, for libFuzzer to mutate. The outputs are committed; rerun after changing t
 
     /usr/bin/python3 test/fuzz/make_corpus.py
 """
+import base64
 import pathlib
 import shutil
 import struct
@@ -99,6 +100,11 @@ SEEDS = {
         "mesh.obj": b"\x01" + CUBE_OBJ,
         "binary.stl": b"\x02" + STL_BINARY,
         "ascii.stl": b"\x02" + STL_ASCII,
+        # A regression seed found by the fuzzer: an element with a huge count and no properties
+        # (once walked instance by instance: a timeout).
+        "timeout-element-without-properties.ply": base64.b64decode(
+            "AHBseQpmb3JtYXQgYXNjaWkgMS4wCmNvbW1lbnQgYSB0cmlhbmdsZQplbGVtZW50IHZlcnRleAAAAAAAAAAAAAAAAXVpbnQ4AAD//wLo"
+            "AAAAACAzNzc3Nzc3Nzc3NzdlbmRfaGVhZGVyCjAgMCAwCjEgMCAwCjAgMSAw9szfz9/O38sK"),
     },
 }
 

@@ -240,7 +240,7 @@ void check_ply(std::string_view bytes) {
     }
     PlyData data(bytes.substr(data_at), format);
     for (const auto& e : elements)
-        for (std::uint64_t i = 0; i < e.count; ++i)
+        for (std::uint64_t i = 0; i < e.count && !e.properties.empty(); ++i)  // no properties: no data to walk
             for (const auto& p : e.properties) {
                 const auto short_of = [&] {
                     bad("is truncated: the header declares " + declared(elements) + ", but the data ends in " + e.name +
