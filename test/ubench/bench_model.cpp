@@ -39,24 +39,34 @@ void BM_ModelStep(benchmark::State& state, std::string preset) {
     }
 }
 
-// What a trial does per model step: cast the rows the model needs, BVC rates, place cells learning.
-void BM_FullStep(benchmark::State& state, std::string preset) {
-    const ModelSpec model = model_preset(preset);
-    const World world = World::cross({.tilt_deg = 45});
+// What a trial does per model step on `walk`: cast the rows the model needs, BVC rates, place cells
+// learning. When the pruning bound fails (almost nothing in view) the scan is read again in full, as
+// the trial runner does, if `fallback`; otherwise the benchmark stops with an error.
+void planned_steps(benchmark::State& state, const ModelSpec& model, const World& world,
+                   const std::vector<ModelStep>& walk, bool fallback) {
     const Lidar lidar(model.sensor);
     const BoundaryVectorLayer layer(model.bvc);
     const auto plan = layer.plan(model.sensor);
     PlaceCellNetwork net(model.bvc.n_cells(), model.place, 1);
-    const auto walk = random_walk(world, 0.1, 1);
     std::vector<double> rates(layer.n_cells());
     Scan scan;
-    std::size_t i = 0;
+    std::size_t i = 0, rows = 0;
+    for (char r : plan.rows) rows += r != 0;
     for (auto _ : state) {
         const auto& s = walk[i++ % walk.size()];
         lidar.scan(world, s.pose, scan, {}, plan.rows);
-        if (!layer.rates_pruned(scan, plan, rates)) state.SkipWithError("pruning bound failed");
+        if (!layer.rates_pruned(scan, plan, rates)) {
+            if (!fallback) state.SkipWithError("pruning bound failed");
+            else layer.rates(lidar.scan(world, s.pose), rates);
+        }
         benchmark::DoNotOptimize(net.step(rates, true).data());
     }
+    state.counters["rays"] = static_cast<double>(rows * static_cast<std::size_t>(model.sensor.azimuth_count));
+}
+
+void BM_FullStep(benchmark::State& state, std::string preset) {
+    const World world = World::cross({.tilt_deg = 45});
+    planned_steps(state, model_preset(preset), world, random_walk(world, 0.1, 1), false);
 }
 
 void BM_BvcOnly(benchmark::State& state, std::string preset) {
@@ -130,23 +140,8 @@ void BM_FlyingFullScanStep(benchmark::State& state, std::string preset) {
 // What a flying trial does per model step with the default level head: cast the rows the model
 // needs (the plan), BVC rates, 250 place cells learning.
 void BM_FlyingStep(benchmark::State& state, std::string preset) {
-    const ModelSpec model = model_preset(preset);
     const World world(flight_room());
-    const Lidar lidar(model.sensor);
-    const BoundaryVectorLayer layer(model.bvc);
-    const auto plan = layer.plan(model.sensor);
-    PlaceCellNetwork net(model.bvc.n_cells(), model.place, 1);
-    const auto walk = flying_walk(world, 0.1, 1);
-    std::vector<double> rates(layer.n_cells());
-    Scan scan;
-    std::size_t i = 0, rows = 0;
-    for (char r : plan.rows) rows += r != 0;
-    for (auto _ : state) {
-        lidar.scan(world, walk[i++ % walk.size()].pose, scan, {}, plan.rows);
-        if (!layer.rates_pruned(scan, plan, rates)) layer.rates(lidar.scan(world, walk[(i - 1) % walk.size()].pose), rates);
-        benchmark::DoNotOptimize(net.step(rates, true).data());
-    }
-    state.counters["rays"] = static_cast<double>(rows * static_cast<std::size_t>(model.sensor.azimuth_count));
+    planned_steps(state, model_preset(preset), world, flying_walk(world, 0.1, 1), true);
 }
 
 // The full spherical scan alone (16 200 rays in the flight room): the ray-casting share of the above.
