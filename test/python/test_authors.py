@@ -20,6 +20,7 @@ from sklearn.cluster import DBSCAN
 import bvc3d
 import bvc3d.analysis as A
 from conftest import SOURCE_DIR, run_cli
+from numpy_oracles import numpy_rate_maps
 from test_regression import file_digests
 
 matplotlib.use("Agg")
@@ -130,20 +131,11 @@ def authors_metrics(x, y, rates, mi_quantile=0.2, sai_quantile=0.1, fixed_n=2662
         centers, m = mpl_hexbin(x, y, rates[:, k])
         means = m[:, None] if means is None else np.column_stack([means, m])
 
-    def maps_at(q):
-        maps = means.copy()
-        for k in range(maps.shape[1]):
-            col = maps[:, k]
-            col[col < np.percentile(col, 100 * q)] = 0
-            top = col.max()
-            maps[:, k] = col / top if top > 0 else 0.0
-        return maps
-
-    mi_maps = maps_at(mi_quantile)
+    mi_maps = numpy_rate_maps(means, mi_quantile)
     mi = np.array([0 if not np.any(mi_maps[:, k] > 0) else
                    len(set(DBSCAN(eps=1.0, min_samples=min_samples).fit(centers[mi_maps[:, k] > 0]).labels_) - {-1})
                    for k in range(mi_maps.shape[1])])
-    sai_maps = maps_at(sai_quantile)
+    sai_maps = numpy_rate_maps(means, sai_quantile)
     norms = np.linalg.norm(sai_maps, axis=1, keepdims=True)
     unit = np.divide(sai_maps, norms, out=np.zeros_like(sai_maps), where=norms > 0)
     cos = unit @ unit.T
