@@ -132,10 +132,10 @@ void choose(const ChooseOptions& o) {
         std::exit(130);
     }
     std::printf("%zu walk steps; criterion = MSAI of the network on the walk (lower is better)\n", c.walk_steps);
-    std::printf("%5s  %-28s %10s %8s %10s\n", "round", "elevations (rad)", "n_per_axis", "MSAI", "MI>1 frac");
+    std::printf("%5s  %-28s %10s %8s %10s %9s\n", "round", "elevations (rad)", "n_per_axis", "MSAI", "MI>1 frac", "BVC MSAI");
     for (const auto& s : c.candidates)
-        std::printf("%5d  %-28s %10d %8.4f %10.3f\n", s.round, elevations_text(s.elevations).c_str(), s.n_per_axis, s.msai,
-                    s.frac_multimodal);
+        std::printf("%5d  %-28s %10d %8.4f %10.3f %9.4f\n", s.round, elevations_text(s.elevations).c_str(), s.n_per_axis, s.msai,
+                    s.frac_multimodal, s.bvc_msai);
     std::printf("chosen: %s rad, %d per axis (MSAI %.4f)\n", elevations_text(c.chosen.elevations).c_str(), c.chosen.n_per_axis,
                 c.chosen.msai);
     AtomicFile file(o.out);

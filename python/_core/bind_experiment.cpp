@@ -9,6 +9,7 @@
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/experiment/elevation_chooser.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
+#include "bvc3d/recording/recording.hpp"
 
 namespace bvc3d::py {
 
@@ -89,6 +90,22 @@ pyb::dict samples_to_dict(const GroupResult& r, bool with_bvc) {
     return out;
 }
 
+namespace {
+
+// The chooser's result as bvc3d.choose_elevations returns it.
+pyb::dict choice_to_dict(const ElevationChoice& c) {
+    pyb::list candidates;
+    for (const auto& s : c.candidates)
+        candidates.append(pyb::dict(pyb::arg("elevations") = s.elevations, pyb::arg("n_per_axis") = s.n_per_axis,
+                                    pyb::arg("round") = s.round, pyb::arg("msai") = s.msai,
+                                    pyb::arg("frac_multimodal") = s.frac_multimodal, pyb::arg("bvc_msai") = s.bvc_msai));
+    return pyb::dict(pyb::arg("elevations") = c.chosen.elevations, pyb::arg("n_per_axis") = c.chosen.n_per_axis,
+                     pyb::arg("msai") = c.chosen.msai, pyb::arg("candidates") = candidates,
+                     pyb::arg("walk_steps") = c.walk_steps, pyb::arg("model_yaml") = config::model_to_yaml(c.model));
+}
+
+}  // namespace
+
 void bind_experiment(pyb::module_& m) {
     m.def(
         "run_trial",
@@ -117,46 +134,68 @@ Protocol keywords and their defaults:
             .c_str());
     m.def(
         "choose_elevations",
-        [](const std::string& world, std::optional<double> tilt_deg, const std::string& agent_name,
+        [](const std::optional<std::string>& world, std::optional<double> tilt_deg, const std::string& agent_name,
            const std::optional<std::string>& sensor, std::uint64_t seed,
-           std::optional<std::vector<std::vector<double>>> sets, int jobs, const pyb::kwargs& kwargs) {
+           std::optional<std::vector<std::vector<double>>> sets, int jobs,
+           const std::shared_ptr<recording::Recording>& recorded, const pyb::kwargs& kwargs) {
+            if (recorded && (world || tilt_deg || agent_name != "ground"))
+                throw InputError("a recording is its own walk: give recording or world (and agent), not both");
             const auto agent = agent_by_name(agent_name);
             const ChooserDefaults defaults = chooser_defaults(*agent);
+            const auto preprocess_keys = RecordedReturnParams::table().keys();
+            const auto listed = [](const std::vector<std::string>& keys) {
+                std::string out;
+                for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;
+                return out;
+            };
+            if (recorded)
+                for (const auto& [k, v] : kwargs) {
+                    const std::string key = pyb::str(k);
+                    if (!ChooserParams::table().find(key) && !RecordedReturnParams::table().find(key))
+                        throw InputError("choose_elevations: unknown argument '" + key + "' (accepted: " +
+                                         listed(ChooserParams::table().keys()) + ", and on a recording " +
+                                         listed(preprocess_keys) + ")");
+                }
             ChooserParams p;
-            apply_kwargs(p, ChooserParams::table(), kwargs);
+            apply_kwargs(p, ChooserParams::table(), kwargs, recorded ? preprocess_keys : std::vector<std::string>{});
             if (defaults.symmetric_range && !kwargs.contains("elevation_min")) p.elevation_min = -p.elevation_max;
             p.seed = seed;
             p.jobs = jobs;
             ModelSpec base = model_preset(defaults.model);
             base.sensor = config::resolve_sensor(sensor.value_or(defaults.sensor));
             const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
+            std::optional<ReplaySource> source;
+            if (recorded) {
+                RecordedReturnParams preprocess;
+                apply_kwargs(preprocess, RecordedReturnParams::table(), kwargs, ChooserParams::table().keys());
+                source = recorded_source(recorded, preprocess);
+            }
             const ElevationChoice c = interruptible([&](const std::atomic<bool>& stop) {
                 p.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
-                const World w(config::resolve_world(world, tilt_deg));
+                if (source) return choose_elevations_on(*source, base, p, analysis, sets.value_or(std::vector<std::vector<double>>{}));
+                const World w(config::resolve_world(world.value_or(WorldSpec{}.source), tilt_deg));
                 agent->check_world(w.description());
                 return sets ? choose_from_sets(w, base, *agent, *sets, p, analysis)
                             : choose_elevations(w, base, *agent, p, analysis);
             });
-            pyb::list candidates;
-            for (const auto& s : c.candidates)
-                candidates.append(pyb::dict(pyb::arg("elevations") = s.elevations, pyb::arg("n_per_axis") = s.n_per_axis,
-                                            pyb::arg("round") = s.round, pyb::arg("msai") = s.msai,
-                                            pyb::arg("frac_multimodal") = s.frac_multimodal));
-            return pyb::dict(pyb::arg("elevations") = c.chosen.elevations, pyb::arg("n_per_axis") = c.chosen.n_per_axis,
-                             pyb::arg("msai") = c.chosen.msai, pyb::arg("candidates") = candidates,
-                             pyb::arg("walk_steps") = c.walk_steps, pyb::arg("model_yaml") = config::model_to_yaml(c.model));
+            return choice_to_dict(c);
         },
-        pyb::arg("world") = WorldSpec{}.source, pyb::arg("tilt_deg") = pyb::none(), pyb::arg("agent") = "ground",
+        pyb::arg("world") = pyb::none(), pyb::arg("tilt_deg") = pyb::none(), pyb::arg("agent") = "ground",
         pyb::arg("sensor") = pyb::none(), pyb::arg("seed") = 0, pyb::arg("sets") = pyb::none(), pyb::arg("jobs") = ChooserParams{}.jobs,
+        pyb::arg("recording") = pyb::none(),
         (R"doc(The agent's choice of BVC elevations from its own exploratory walk, as `bvc3d choose-elevations`
 does it: the criterion (MSAI of the place-cell network on the walk, lower is better) of each
 candidate set of the greedy search, or of the given `sets` (lists of elevations, rad). Returns a
 dict: elevations, n_per_axis, msai (of the chosen set), candidates (a list of dicts: elevations,
-n_per_axis, round, msai, frac_multimodal), walk_steps, model_yaml. agent: "ground" (the paper's robot,
-sensor "spherical", 3d-0.2's cells) or "flying" (the flying agent, sensor "spherical-full", fly-5l's
-cells, candidates from -elevation_max unless elevation_min is given; 3-D analysis); sensor: another
-sensor preset or YAML; seed: the walk's; jobs: threads (0: every core). Keywords and their defaults
-(elevation_min: on the ground):
+n_per_axis, round, msai, frac_multimodal, bvc_msai: the same MSAI over the BVC population's
+rate maps, shown, not used), walk_steps, model_yaml. world: a preset or world YAML (default: the
+cross arena); agent: "ground" (the paper's robot, sensor "spherical", 3d-0.2's cells) or "flying"
+(the flying agent, sensor "spherical-full", fly-5l's cells, candidates from -elevation_max unless
+elevation_min is given; 3-D analysis); sensor: another sensor preset or YAML; seed: the walk's (on a
+recording: the initial weights'); jobs: threads (0: every core). recording: a Recording instead of a
+world: its poses are the walk and its scans the returns (the ground robot's cells; preprocessing
+keywords as Recording.replay, e.g. min_range, max_range). Keywords and their defaults (elevation_min:
+on the ground):
 )doc" + describe(ChooserParams::table(), ChooserParams{}))
             .c_str());
     pyb::list metrics;

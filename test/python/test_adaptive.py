@@ -12,10 +12,10 @@ import pytest
 import yaml
 
 import bvc3d
-from conftest import SOURCE_DIR
+from conftest import CLI, SOURCE_DIR
 
 SETS = "0,0.2;0.1"
-ROW = re.compile(r"^\s*(\d+)\s+([-\d., ]+?)\s+(\d+)\s+([-\d.]+|nan)\s+([-\d.]+|nan)\s*$")
+ROW = re.compile(r"^\s*(\d+)\s+([-\d., ]+?)\s+(\d+)\s+([-\d.]+|nan)\s+([-\d.]+|nan)\s+([-\d.]+|nan)\s*$")
 
 
 def printed_table(stdout):
@@ -55,6 +55,25 @@ def test_python_binding_matches_the_program(cli, tmp_path):
     assert yaml.safe_load(res["model_yaml"])["bvc"]["elevations"] == res["elevations"]
 
 
+def test_validation_script_reads_what_the_program_prints():
+    """scripts/adaptive_validation.py (docs/adaptive.md's validation tables and scatter) reads the
+    criterion and the BVC population's MSAI of each set from the program's table: the same values
+    the Python binding returns, to the 4 printed decimals."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("adaptive_validation", SOURCE_DIR / "scripts" / "adaptive_validation.py")
+    av = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(av)
+    sets = [(0.0, 0.2), (0.1,)]
+    read = av.criterion(CLI, 45.0, sets, 3, 4, 1)
+    res = bvc3d.choose_elevations("cross", 45.0, seed=3, sets=[list(s) for s in sets], jobs=1, explore_minutes=4)
+    assert set(read) == set(sets)
+    for c in res["candidates"]:
+        crit, bvc_msai = read[tuple(c["elevations"])]
+        assert crit == pytest.approx(c["msai"], abs=5e-5) and bvc_msai == pytest.approx(c["bvc_msai"], abs=5e-5)
+        assert 0 < c["bvc_msai"] < 1
+
+
 def numpy_msai(x, y, rates, gridsize=50, q=10.0, d_th=2.0):
     """MSAI as docs/analysis.md defines it, from matplotlib's hexbin and numpy alone."""
     import matplotlib
@@ -90,10 +109,14 @@ def test_criterion_against_numpy_on_the_walk_run_as_a_trial(tmp_path):
     last, before = t[-1], t[-2]
     model = tmp_path / "chosen.yaml"
     model.write_text(res["model_yaml"])
-    trial = bvc3d.run_trial(str(model), "cross", 60.0, seed=2, trajectory=both,
+    trial = bvc3d.run_trial(str(model), "cross", 60.0, seed=2, trajectory=both, record_bvc=True,
                             explore_hours=0.5 * (last + before) / 3600, sample_hours=2 * (last + 1) / 3600)
     assert len(trial["x"]) == len(t)
     assert numpy_msai(trial["x"], trial["y"], trial["rates"]) == pytest.approx(res["msai"], rel=1e-9, abs=1e-12)
+    # Beside it, the BVC population's aliasing: the same index over the BVCs' rate maps.
+    bvc_msai = res["candidates"][0]["bvc_msai"]
+    assert numpy_msai(trial["x"], trial["y"], trial["bvc_rates"]) == pytest.approx(bvc_msai, rel=1e-9, abs=1e-12)
+    assert bvc_msai > res["msai"]  # BVCs fire along every wall at their distance: they alias more
 
 
 @pytest.mark.parametrize("args, words", [
@@ -191,6 +214,16 @@ def test_choice_on_a_recording_against_its_replay(cli, tmp_path):
     crit = float(one.read_text().split("criterion (MSAI of the network on the walk): ")[1].split()[0])
     assert crit == pytest.approx(table[(0.0, 0.2)], abs=5e-5)  # the table prints 4 decimals
     assert numpy_msai(x, y, rates) == pytest.approx(crit, rel=2e-3)
+
+    # Python: the same choice on the same recording.
+    py = bvc3d.choose_elevations(recording=bvc3d.Recording.open(HALL, HALL / "poses.csv"), sets=[[0.0, 0.2], [0.1]],
+                                 jobs=1, max_range=20.0)
+    assert {tuple(c["elevations"]): c["msai"] for c in py["candidates"]} == pytest.approx(table, abs=5e-5)
+    assert py["walk_steps"] == 60
+    with pytest.raises(bvc3d.InputError, match="not both"):
+        bvc3d.choose_elevations("cross", recording=bvc3d.Recording.open(HALL, HALL / "poses.csv"))
+    with pytest.raises(bvc3d.InputError, match="unknown argument 'max_rnage'"):
+        bvc3d.choose_elevations(recording=bvc3d.Recording.open(HALL, HALL / "poses.csv"), max_rnage=3.0)
 
     # A recording is its own walk: no world or agent beside it, and poses need scans.
     for args, words in ((rec + ["--world", "cross"], "not both"), (["--poses", HALL / "poses.csv"], "--poses needs --scans")):

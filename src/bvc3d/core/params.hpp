@@ -92,6 +92,11 @@ public:
 
     const std::string& what() const { return what_; }
     const std::vector<Field<S>>& fields() const { return fields_; }
+    std::vector<std::string> keys() const {
+        std::vector<std::string> out;
+        for (const auto& f : fields_) out.push_back(f.key);
+        return out;
+    }
     const Field<S>* find(std::string_view key) const {
         for (const auto& f : fields_)
             if (f.key == key) return &f;

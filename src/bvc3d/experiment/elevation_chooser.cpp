@@ -82,15 +82,27 @@ Protocol two_pass_protocol(const std::vector<ModelStep>& walk) {
     return p;
 }
 
+// MSAI of the BVC population: its rate maps on the place cells' bins, thresholded and normalized as
+// theirs are, then the same aliasing index.
+double bvc_aliasing(const GroupResult& r, std::size_t model, int dims, const analysis::TrialMetrics& m,
+                    const analysis::AnalysisParams& p) {
+    const auto& rec = r.models.at(model);
+    const Eigen::Map<const analysis::RowMatrixXf> bvc(rec.bvc.data(), static_cast<Eigen::Index>(r.x.size()), rec.n_bvc);
+    const auto maps = analysis::rate_maps<float>(m.maps.grid, sample_positions(r, dims), bvc, p.quantile);
+    return analysis::spatial_aliasing(maps.bins.centers, maps.map, p.d_th, static_cast<std::size_t>(p.msai_bins)).msai;
+}
+
 // A candidate's trial analyzed as any trial is (2-D bins or, for a flying agent, the flight volume's voxels).
 CandidateScore score(const World* world, const GroupResult& r, std::size_t model, const TrialConfig& trial) {
     static const WorldDescription none;
-    const auto m = analyze(trial, world ? world->description() : none, r, model).metrics;
+    const auto analyzed = analyze(trial, world ? world->description() : none, r, model);
+    const auto& m = analyzed.metrics;
     CandidateScore s;
     s.elevations = trial.model.bvc.elevations;
     s.n_per_axis = trial.model.bvc.n_per_axis;
     s.msai = m.aliasing.msai;
     s.frac_multimodal = m.modality_summary.frac_multimodal;
+    s.bvc_msai = bvc_aliasing(r, model, trial.agent->dims(), m, analyzed.params);
     return s;
 }
 
@@ -219,6 +231,7 @@ std::vector<CandidateScore> score_elevation_sets(const World* world, const Model
         TrialConfig t;
         t.model = model_with_elevations(base, set, budget);
         t.protocol = protocol;
+        t.protocol.record_bvc = true;  // for the BVC population's aliasing beside the criterion
         t.agent = agent;
         t.analysis = analysis;
         t.seed = seed;

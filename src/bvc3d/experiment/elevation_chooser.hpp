@@ -54,6 +54,8 @@ struct CandidateScore {
     int round = 0;                  // the greedy round (= number of layers) that considered it
     double msai = 0;                // the criterion: lower is better
     double frac_multimodal = 0;     // shown beside it, not used to choose
+    double bvc_msai = 0;            // the same MSAI over the BVC population's rate maps on the same
+                                    // bins: the input's aliasing, shown, not used (docs/adaptive.md)
 };
 
 struct ElevationChoice {
