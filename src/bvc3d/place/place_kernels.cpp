@@ -14,6 +14,8 @@ inline float reduce8(const f8& acc) {
 // Rows i .. i+R-1 at once: R independent accumulator chains share each load of v, so the loop runs
 // at the machine's load and multiply-add throughput instead of one add's latency per 8 columns.
 // Each row's sum is the same sequence of operations as a one-row loop: the bits do not change.
+// Eight rows: two FP ports × an add's 3–4 cycles of latency need 6–8 chains in flight (4 left the
+// ports idle half the time: 0.8× the time at 8 on AVX2 and AVX-512; 16 spills registers).
 template <int R>
 inline void rows_times(const float* W, std::size_t stride, const float* v, std::size_t n, float* out) {
     f8 acc[R];
@@ -34,6 +36,7 @@ inline void rows_times(const float* W, std::size_t stride, const float* v, std::
 BVC3D_DISPATCH
 void matvec8(const float* W, std::size_t stride, const float* v, std::size_t n, int rows, float* out) {
     int i = 0;
+    for (; i + 8 <= rows; i += 8) rows_times<8>(W + static_cast<std::size_t>(i) * stride, stride, v, n, out + i);
     for (; i + 4 <= rows; i += 4) rows_times<4>(W + static_cast<std::size_t>(i) * stride, stride, v, n, out + i);
     for (; i < rows; ++i) rows_times<1>(W + static_cast<std::size_t>(i) * stride, stride, v, n, out + i);
 }
