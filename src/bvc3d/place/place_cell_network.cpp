@@ -40,14 +40,15 @@ PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::ui
     p_.validate();
     if (n_bvc < 1) throw InputError("place cells: need at least one BVC input");
     stride_ = (static_cast<std::size_t>(n_bvc) + 7) / 8 * 8;
-    w_.assign(static_cast<std::size_t>(p_.n_place) * stride_, 0.0f);
+    w_.assign(static_cast<std::size_t>(pairs()) * pair_stride(), 0.0f);
     Rng rng(seed, Stream::weights);
     for (int i = 0; i < p_.n_place; ++i)
-        for (int j = 0; j < n_bvc; ++j) row(i)[j] = rng.bernoulli(p_.p_connect) ? 1.0f : 0.0f;
+        for (int j = 0; j < n_bvc; ++j) row(i)[kernels::paired_column(j)] = rng.bernoulli(p_.p_connect) ? 1.0f : 0.0f;
     s_.assign(p_.n_place, 0.0f);
     v_.assign(p_.n_place, 0.0f);
-    drive_.assign(p_.n_place, 0.0f);
+    drive_.assign(2 * static_cast<std::size_t>(pairs()), 0.0f);
     vb_.assign(stride_, 0.0f);
+    vb2_.assign(2 * stride_, 0.0f);
 }
 
 std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates, bool learn) {
@@ -57,6 +58,7 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
     for (int j = 0; j < n_bvc_; ++j) {
         if (!std::isfinite(bvc_rates[j])) throw InputError("place cells: BVC rate " + std::to_string(j) + " is not finite");
         vb_[j] = flush_tiny(static_cast<float>(bvc_rates[j]));
+        vb2_[kernels::paired_column(j)] = vb2_[kernels::paired_column(j) + 8] = vb_[j];
     }
     const float k = static_cast<float>(p_.dt_over_tau);
     // Inhibition uses the BVC total and the place cells' previous rates.
@@ -67,7 +69,7 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
                                  return s;
                              }();
     const float gain = static_cast<float>(p_.gain);
-    kernels::matvec8(w_.data(), stride_, vb_.data(), stride_, p_.n_place, drive_.data());
+    kernels::paired_matvec(w_.data(), pair_stride(), vb2_.data(), stride_, pairs(), drive_.data());
     for (int i = 0; i < p_.n_place; ++i) {
         s_[i] = s_[i] + k * (-s_[i] + drive_[i] - inhibition);
         v_[i] = std::tanh(gain * std::max(s_[i], 0.0f));
@@ -90,7 +92,8 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
 
 std::vector<float> PlaceCellNetwork::weights() const {
     std::vector<float> out(static_cast<std::size_t>(p_.n_place) * n_bvc_);
-    for (int i = 0; i < p_.n_place; ++i) std::copy(row(i), row(i) + n_bvc_, out.data() + static_cast<std::size_t>(i) * n_bvc_);
+    for (int i = 0; i < p_.n_place; ++i)
+        for (int j = 0; j < n_bvc_; ++j) out[static_cast<std::size_t>(i) * n_bvc_ + j] = row(i)[kernels::paired_column(j)];
     return out;
 }
 
@@ -100,8 +103,7 @@ void PlaceCellNetwork::set_weights(std::span<const float> w) {
     for (float x : w)
         if (!std::isfinite(x)) throw InputError("place cells: weights must be finite");
     for (int i = 0; i < p_.n_place; ++i)
-        std::transform(w.data() + static_cast<std::size_t>(i) * n_bvc_, w.data() + static_cast<std::size_t>(i + 1) * n_bvc_,
-                       row(i), flush_tiny);
+        for (int j = 0; j < n_bvc_; ++j) row(i)[kernels::paired_column(j)] = flush_tiny(w[static_cast<std::size_t>(i) * n_bvc_ + j]);
 }
 
 void PlaceCellNetwork::reset() {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bvc3d/core/params.hpp"
+#include "bvc3d/core/simd.hpp"
 
 namespace bvc3d {
 
@@ -52,13 +53,18 @@ public:
     void set_state(std::span<const float> membrane, std::span<const float> rates);
 
 private:
-    float* row(int i) { return w_.data() + static_cast<std::size_t>(i) * stride_; }
-    const float* row(int i) const { return w_.data() + static_cast<std::size_t>(i) * stride_; }
+    // Weights in the kernels' paired layout (place_kernels.hpp): rows 2p and 2p+1 interleaved by
+    // blocks of 8 columns; row(i) is row i's first block, column j at row(i)[paired_column(j)].
+    std::size_t pair_stride() const { return 2 * stride_; }
+    float* row(int i) { return w_.data() + static_cast<std::size_t>(i / 2) * pair_stride() + 8 * (i % 2); }
+    const float* row(int i) const { return w_.data() + static_cast<std::size_t>(i / 2) * pair_stride() + 8 * (i % 2); }
+    int pairs() const { return (p_.n_place + 1) / 2; }
 
     int n_bvc_;
-    std::size_t stride_;  // n_bvc rounded up to a multiple of 8; padding stays 0
+    std::size_t stride_;  // n_bvc rounded up to a multiple of 8; padding (and an odd count's last row) stays 0
     PlaceParams p_;
-    std::vector<float> w_, s_, v_, vb_, drive_;
+    std::vector<float, simd::CacheAligned<float>> w_, vb2_;  // vb2_: the BVC rates in the paired layout
+    std::vector<float> s_, v_, vb_, drive_;
 };
 
 }  // namespace bvc3d

@@ -7,38 +7,81 @@ namespace bvc3d::kernels {
 using simd::f8;
 
 namespace {
-inline float reduce8(const f8& acc) {
-    return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+template <class V>
+inline float reduce8(const V& acc, int first) {
+    const int f = first;
+    return ((acc[f] + acc[f + 1]) + (acc[f + 2] + acc[f + 3])) + ((acc[f + 4] + acc[f + 5]) + (acc[f + 6] + acc[f + 7]));
 }
 
-// Rows i .. i+R-1 at once: R independent accumulator chains share each load of v, so the loop runs
-// at the machine's load and multiply-add throughput instead of one add's latency per 8 columns.
-// Each row's sum is the same sequence of operations as a one-row loop: the bits do not change.
-// Eight rows: two FP ports × an add's 3–4 cycles of latency need 6–8 chains in flight (4 left the
-// ports idle half the time: 0.8× the time at 8 on AVX2 and AVX-512; 16 spills registers).
-template <int R>
-inline void rows_times(const float* W, std::size_t stride, const float* v, std::size_t n, float* out) {
-    f8 acc[R];
-    for (int r = 0; r < R; ++r) acc[r] = f8{0, 0, 0, 0, 0, 0, 0, 0};
-    for (std::size_t j = 0; j < n; j += 8) {
-        f8 b;
-        simd::load(b, v + j);
-        for (int r = 0; r < R; ++r) {
-            f8 a;
-            simd::load(a, W + r * stride + j);
-            acc[r] += a * b;
+template <int N>
+struct floats {
+    typedef float type __attribute__((vector_size(4 * N)));
+};
+
+// P pairs (2P rows) at once, with vectors of N floats (16: a pair's block in one AVX-512 register;
+// 8: one row's block). The 2P rows' accumulator chains share each load of v: the loop runs at the
+// machine's multiply and add throughput, not at an add's latency. Every lane does what a one-row
+// loop of 8 lanes does, whatever N and P: the bits do not change. P·16/N = 8 chains: two FP ports ×
+// an add's 3–4 cycles of latency need 6–8 in flight; 16 spill registers.
+template <int N, int P>
+[[gnu::always_inline]] inline void pairs_times(const float* W, std::size_t pair_stride, const float* v2, std::size_t n,
+                                               float* out) {
+    using V = typename floats<N>::type;
+    constexpr int H = 16 / N;  // vectors per pair block
+    V acc[P][H];
+    for (int p = 0; p < P; ++p)
+        for (int h = 0; h < H; ++h) acc[p][h] = V{};
+    for (std::size_t j = 0; j < 2 * n; j += 16) {
+        V b[H];
+        for (int h = 0; h < H; ++h) simd::load(b[h], v2 + j + h * N);
+        for (int p = 0; p < P; ++p)
+            for (int h = 0; h < H; ++h) {
+                V a;
+                simd::load(a, W + p * pair_stride + j + h * N);
+                acc[p][h] += a * b[h];
+            }
+    }
+    for (int p = 0; p < P; ++p) {
+        if constexpr (N == 16) {
+            out[2 * p] = reduce8(acc[p][0], 0);
+            out[2 * p + 1] = reduce8(acc[p][0], 8);
+        } else {
+            out[2 * p] = reduce8(acc[p][0], 0);
+            out[2 * p + 1] = reduce8(acc[p][1], 0);
         }
     }
-    for (int r = 0; r < R; ++r) out[r] = reduce8(acc[r]);
 }
+
+template <int N>
+[[gnu::always_inline]] inline void paired(const float* W, std::size_t pair_stride, const float* v2, std::size_t n,
+                                          int pairs, float* out) {
+    constexpr int P = N == 16 ? 8 : 4;
+    int p = 0;
+    for (; p + P <= pairs; p += P) pairs_times<N, P>(W + p * pair_stride, pair_stride, v2, n, out + 2 * p);
+    for (; p < pairs; ++p) pairs_times<N, 1>(W + p * pair_stride, pair_stride, v2, n, out + 2 * p);
+}
+
+#if BVC3D_HAVE_DISPATCH
+BVC3D_TARGET_V4 void paired_v4(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs,
+                               float* out) {
+    paired<16>(W, pair_stride, v2, n, pairs, out);
+}
+BVC3D_TARGET_V3 void paired_v3(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs,
+                               float* out) {
+    paired<8>(W, pair_stride, v2, n, pairs, out);
+}
+#endif
 }  // namespace
 
-BVC3D_DISPATCH
-void matvec8(const float* W, std::size_t stride, const float* v, std::size_t n, int rows, float* out) {
-    int i = 0;
-    for (; i + 8 <= rows; i += 8) rows_times<8>(W + static_cast<std::size_t>(i) * stride, stride, v, n, out + i);
-    for (; i + 4 <= rows; i += 4) rows_times<4>(W + static_cast<std::size_t>(i) * stride, stride, v, n, out + i);
-    for (; i < rows; ++i) rows_times<1>(W + static_cast<std::size_t>(i) * stride, stride, v, n, out + i);
+void paired_matvec(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs, float* out) {
+#if BVC3D_HAVE_DISPATCH
+    switch (simd::isa()) {
+        case simd::Isa::v4: return paired_v4(W, pair_stride, v2, n, pairs, out);
+        case simd::Isa::v3: return paired_v3(W, pair_stride, v2, n, pairs, out);
+        case simd::Isa::baseline: break;
+    }
+#endif
+    paired<8>(W, pair_stride, v2, n, pairs, out);
 }
 
 BVC3D_DISPATCH
@@ -49,7 +92,7 @@ float sum8(const float* v, std::size_t n) {
         simd::load(a, v + j);
         acc += a;
     }
-    return reduce8(acc);
+    return reduce8(acc, 0);
 }
 
 BVC3D_DISPATCH
@@ -57,10 +100,10 @@ void oja_row(float* __restrict w, const float* __restrict v, float a, float c, f
     const f8 lo = {tiny, tiny, tiny, tiny, tiny, tiny, tiny, tiny}, zero = {0, 0, 0, 0, 0, 0, 0, 0};
     for (std::size_t j = 0; j < n; j += 8) {
         f8 x, b;
-        simd::load(x, w + j);
+        simd::load(x, w + 2 * j);
         simd::load(b, v + j);
         x = x + a * (b - c * x);
-        simd::store(w + j, (x < lo) & (x > -lo) ? zero : x);  // NaN stays NaN
+        simd::store(w + 2 * j, (x < lo) & (x > -lo) ? zero : x);  // NaN stays NaN
     }
 }
 
