@@ -155,6 +155,67 @@ TEST(BoundaryVectorLayer, RatesDoNotDependOnWhatTheLayerSawBefore) {
     }
 }
 
+// Models on one walk that differ only in their elevations read their sums from one layer that
+// summed the union once (the experiment engine does so): the same bits and the same verdict of the
+// truncation bound as each summing on its own, whatever the other layers and the order of the union.
+TEST(BoundaryVectorLayer, SharedSumsGiveEveryModelItsOwnBits) {
+    const World world = World::cross({.tilt_deg = 45});
+    const auto walk = random_walk(world, 0.02, 11);
+    const ModelSpec base = model_preset("3d-3l");
+    std::vector<BvcParams> models;
+    for (const std::vector<double>& e : std::vector<std::vector<double>>{{0.0, 0.1}, {0.0, 0.2}, {0.0, 0.1, 0.2}, {0.3}, {0.25, 0.0}}) {
+        BvcParams p = base.bvc;
+        p.elevations = e;
+        models.push_back(p);
+    }
+    BvcParams all = base.bvc;
+    all.elevations = {0.3, 0.2, 0.25, 0.0, 0.1};
+    const BoundaryVectorLayer summed(all);
+    const auto all_plan = summed.plan(base.sensor);
+    const Lidar lidar(base.sensor);
+    Scan scan;
+    for (std::size_t i = 0; i < walk.size(); i += 7) {
+        lidar.scan(world, walk[i].pose, scan, {}, all_plan.rows);
+        summed.sum_pruned(scan, all_plan);
+        for (const auto& p : models) {
+            const BoundaryVectorLayer own(p), reader(p);
+            const auto plan = own.plan(base.sensor);
+            std::vector<double> a(own.n_cells()), b(own.n_cells());
+            const bool ok_own = own.rates_pruned(scan, plan, a);
+            ASSERT_EQ(reader.rates_pruned_shared(scan, plan, summed, b), ok_own);
+            if (ok_own) {
+                ASSERT_EQ(a, b) << "elevations[0] " << p.elevations[0] << ", step " << i;
+            }
+        }
+    }
+    // The bound's verdict is each reader's own: nothing in reach is declined.
+    summed.sum_pruned(Scan{}, all_plan);
+    const BoundaryVectorLayer first(models[0]);
+    std::vector<double> v(first.n_cells());
+    EXPECT_FALSE(first.rates_pruned_shared(Scan{}, first.plan(base.sensor), summed, v));
+    // Planar layers share with planar ones.
+    const ModelSpec flat = model_preset("2d");
+    const BoundaryVectorLayer flat_sum(flat.bvc), flat_reader(flat.bvc);
+    const auto flat_plan = flat_sum.plan(flat.sensor);
+    const Lidar flat_lidar(flat.sensor);
+    flat_lidar.scan(world, walk[5].pose, scan);
+    flat_sum.sum_pruned(scan, flat_plan);
+    std::vector<double> a(flat_sum.n_cells()), b(flat_sum.n_cells());
+    ASSERT_TRUE(flat_sum.rates_pruned(scan, flat_plan, a));
+    ASSERT_TRUE(flat_reader.rates_pruned_shared(scan, flat_plan, flat_sum, b));
+    EXPECT_EQ(a, b);
+    // Sums of other parameters, or without one of the reader's elevations, are refused.
+    EXPECT_FALSE(flat_reader.can_share_sums(all));
+    BvcParams wider = models[0];
+    wider.sigma_r = 0.5;
+    EXPECT_THROW(BoundaryVectorLayer(wider).rates_pruned_shared(scan, BoundaryVectorLayer(wider).plan(base.sensor), summed, v),
+                 InputError);
+    BvcParams missing = models[0];
+    missing.elevations = {0.15};
+    EXPECT_THROW(BoundaryVectorLayer(missing).rates_pruned_shared(scan, BoundaryVectorLayer(missing).plan(base.sensor), summed, v),
+                 InputError);
+}
+
 TEST(BoundaryVectorLayer, ScanPlansCastOnlyTheRowsThatMatter) {
     // Rows of the spherical scanner are at 89°, 87°, ..., 1°. With sigma_phi = 0.01 rad a row counts
     // when its weight exceeds 1e-8 of the peak: 1°, 3° for the 0-rad layer, 3°..9° for 0.1 rad,

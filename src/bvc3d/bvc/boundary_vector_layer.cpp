@@ -117,23 +117,50 @@ namespace {
 bool is_no_return(const LidarReturn& r) { return std::isnan(r.range) || r.range == INFINITY; }
 }  // namespace
 
+void BoundaryVectorLayer::row_factors(double phi) const {
+    const double h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
+    for (int l = 0; l < p_.n_layers(); ++l) {
+        elev_[l] = dropped_e_[l] = 0.0;
+        if (p_.elevations.empty()) {
+            elev_[l] = 1.0;
+        } else {
+            const double x = phi - p_.elevations[l];
+            if (std::abs(x) <= cut_row_) elev_[l] = c_phi_ * std::exp(-x * x * h_p);
+            else if (std::abs(x) <= cut_phi_) dropped_e_[l] = c_phi_ * std::exp(-x * x * h_p);
+        }
+        row_factor_[l] = elev_[l] + dropped_e_[l];
+    }
+}
+
 bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan,
-                                     std::span<double> result) const {
+                                     std::span<double> result, Pass pass, const BoundaryVectorLayer* summed) const {
+    // One instance per pass, so that each pass's loop carries none of the others' work.
+    switch (pass) {
+        case Pass::own: return pruned_pass<Pass::own>(returns, plan, result, summed);
+        case Pass::sums: return pruned_pass<Pass::sums>(returns, plan, result, summed);
+        case Pass::bound: break;
+    }
+    return pruned_pass<Pass::bound>(returns, plan, result, summed);
+}
+
+template <BoundaryVectorLayer::Pass pass>
+bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan,
+                                      std::span<double> result, const BoundaryVectorLayer* summed) const {
     // Sums go to a buffer whose axes are padded by one 8-lane block, so the vector kernel never
     // needs a scalar tail; they are copied to `result` at the end.
     const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis, stride = axis_stride_;
-    std::fill(padded_.begin(), padded_.end(), 0.0);
+    constexpr bool sums = pass != Pass::bound, own_bound = pass != Pass::sums;
+    if (sums) std::fill(padded_.begin(), padded_.end(), 0.0);
     double* out_data = padded_.data();
-    const bool planar = p_.elevations.empty();
     const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
-    const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r), h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
+    const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r);
     // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
     // keeps the power recurrence below far from overflow.
     const bool recurrence = dd > 0 && dd <= p_.sigma_r;
     // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_);
     // the layers with a summed factor (kept_l, n_kept of them) and with any factor (any_l, n_any).
-    double* elev = elev_.data();
-    double* dropped_e = dropped_e_.data();
+    const double* elev = elev_.data();
+    const double* dropped_e = dropped_e_.data();
     int* kept_l = kept_layers_.data();
     int* any_l = any_layers_.data();
     int n_kept = 0, n_any = 0;
@@ -145,6 +172,15 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
     std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
     double* kept_weight = kept_weight_.data();
     double* layer_weight = layer_weight_.data();
+    // The `sums` pass keeps, per row, what the bound of any layer reading these sums needs instead.
+    row_totals_.clear();
+    row_angles_.clear();
+    rows_complete_ = pass == Pass::sums;
+    constexpr bool keep_rows = pass == Pass::sums;
+    RowTotal* row_total = nullptr;
+    double* near_angles = nullptr;  // this row's Σ A of returns with a distance window, per direction
+    double* all_angles = nullptr;   // ... and of every return
+    constexpr std::size_t max_row_totals = 1024;
     // The recurrence path lists the returns' profiles (jobs) and the rows each feeds (offsets into
     // the sums, weights), and adds a few hundred at a time in one kernel call, in return order.
     kernels::ProfileJob* jobs = jobs_.data();
@@ -175,23 +211,31 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             last_phi = ret.elevation;
             skipped_row = plan && std::find(plan->skipped_rows.begin(), plan->skipped_rows.end(), ret.elevation) !=
                                       plan->skipped_rows.end();
+            row_factors(ret.elevation);
             n_kept = n_any = 0;
             for (int l = 0; l < L; ++l) {
-                elev[l] = dropped_e[l] = 0.0;
-                if (planar) {
-                    elev[l] = 1.0;
-                } else {
-                    const double x = ret.elevation - p_.elevations[l];
-                    if (std::abs(x) <= cut_row_) elev[l] = c_phi_ * std::exp(-x * x * h_p);
-                    else if (std::abs(x) <= cut_phi_) dropped_e[l] = c_phi_ * std::exp(-x * x * h_p);
-                }
-                row_factor_[l] = elev[l] + dropped_e[l];
                 if (elev[l] > 0.0) kept_l[n_kept++] = l;
                 if (row_factor_[l] > 0.0) any_l[n_any++] = l;  // adding 0 to layer_weight changes nothing
+            }
+            if (keep_rows && rows_complete_ && !skipped_row) {
+                if (row_totals_.size() == max_row_totals) {
+                    rows_complete_ = false;  // not a beam table: readers do their own bookkeeping
+                } else {
+                    row_totals_.push_back({ret.elevation, 0, 0});
+                    row_angles_.resize(row_angles_.size() + 2 * static_cast<std::size_t>(K), 0.0);
+                }
+            }
+            if (keep_rows && rows_complete_ && !skipped_row) {
+                row_total = &row_totals_.back();
+                near_angles = row_angles_.data() + row_angles_.size() - 2 * static_cast<std::size_t>(K);
+                all_angles = near_angles + K;
+            } else {
+                row_total = nullptr;
             }
         }
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
         ++valid;
+        if (keep_rows && row_total) ++row_total->valid;
         if (n_any == 0) continue;
         const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
         const int* dir = direct_dir_.data();
@@ -211,12 +255,16 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         } else {
             n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
         }
-        for (int i = 0; i < n_any; ++i) layer_weight[any_l[i]] += row_factor_[any_l[i]];
-        if (n_any > n_kept)
-            for (int l = 0; l < L; ++l)
-                if (dropped_e[l] > 0.0)
-                    for (int d = 0; d < n_dirs; ++d)
-                        dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
+        if constexpr (own_bound) {
+            for (int i = 0; i < n_any; ++i) layer_weight[any_l[i]] += row_factor_[any_l[i]];
+            if (n_any > n_kept)
+                for (int l = 0; l < L; ++l)
+                    if (dropped_e[l] > 0.0)
+                        for (int d = 0; d < n_dirs; ++d)
+                            dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
+        }
+        if (keep_rows && row_total)
+            for (int d = 0; d < n_dirs; ++d) all_angles[dir[d]] += ang[d];
         if (n_kept == 0) continue;
 
         // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
@@ -231,10 +279,14 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
             m_lo = 1;  // no cell in reach
         }
         if (m_lo > m_hi) {
-            for (int i = 0; i < n_kept; ++i) far_weight_[kept_l[i]] += elev[kept_l[i]];
+            if (own_bound)
+                for (int i = 0; i < n_kept; ++i) far_weight_[kept_l[i]] += elev[kept_l[i]];
+            if (keep_rows && row_total) ++row_total->far;
             continue;
         }
         const int W = m_hi - m_lo + 1;
+        if (keep_rows && row_total)
+            for (int d = 0; d < n_dirs; ++d) near_angles[dir[d]] += ang[d];
 
         // The (layer, direction) rows this return feeds, with their elevation × angular weights.
         const std::size_t first = n_rows;
@@ -243,13 +295,17 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
                 const int l = kept_l[i];
                 const double w = elev[l] * ang[d];
                 const std::size_t lk = static_cast<std::size_t>(l) * K + dir[d];
-                kept_weight[lk] += w;
+                if (own_bound) kept_weight[lk] += w;
                 job_weight[n_rows] = w;
                 job_offset[n_rows] = static_cast<std::uint32_t>(lk * stride + m_lo);
                 ++n_rows;
             }
         const int count = static_cast<int>(n_rows - first);
         if (count == 0) continue;
+        if constexpr (!sums) {  // the sums are read from `summed`
+            n_rows = 0;
+            continue;
+        }
 
         // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
         if (recurrence) {
@@ -267,16 +323,32 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
         }
     }
     if (n_jobs > 0) flush();
-    for (int axis = 0; axis < L * K; ++axis)
-        std::copy(out_data + static_cast<std::size_t>(axis) * stride, out_data + static_cast<std::size_t>(axis) * stride + M,
-                  result.begin() + static_cast<std::ptrdiff_t>(axis) * M);
+    if constexpr (pass == Pass::sums) return true;
+    copy_sums(pass == Pass::bound ? *summed : *this, result);
+    const double max_raw = result.empty() ? 0.0 : *std::max_element(result.begin(), result.end());
+    return pruned_bound(plan, valid) <= pruned_tolerance * max_raw;
+}
 
+void BoundaryVectorLayer::copy_sums(const BoundaryVectorLayer& from_layer, std::span<double> result) const {
+    const int K = p_.n_dir, M = p_.n_per_axis;
+    const std::size_t stride = static_cast<std::size_t>(axis_stride_);
+    for (int l = 0; l < p_.n_layers(); ++l) {
+        const std::size_t axis = &from_layer == this ? static_cast<std::size_t>(l) * K : from_layer.first_axis(p_, l);
+        const double* from = from_layer.padded_.data() + axis * stride;
+        for (int k = 0; k < K; ++k)
+            std::copy(from + static_cast<std::size_t>(k) * stride, from + static_cast<std::size_t>(k) * stride + M,
+                      result.begin() + (static_cast<std::ptrdiff_t>(l) * K + k) * M);
+    }
+}
+
+double BoundaryVectorLayer::pruned_bound(const ScanPlan* plan, std::size_t valid) const {
     // Every pruned term of cell (l, k, m) is one of: a distance factor below tiny_r of a kept
     // (return, layer, direction); an angular factor below tiny_theta of a (return, layer) whose
     // elevation factor was evaluated; a (return, layer, direction) whose elevation factor is below
     // tiny_row (its weight E·A is known exactly, D <= c_r); an elevation factor below tiny_phi
     // (worst case, for every beam cast or not); the distance factor of a return whose whole window
     // was empty; a row the plan did not cast (bounded by the plan).
+    const int L = p_.n_layers(), K = p_.n_dir;
     double bound = 0;
     for (int l = 0; l < L; ++l)
         for (int k = 0; k < K; ++k) {
@@ -287,9 +359,77 @@ bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const
                                         (plan ? plan->skipped_bound[l] : 0.0));
         }
     const std::size_t n_beams = std::max(valid, plan ? plan->beams : std::size_t{0});
-    if (!planar) bound += static_cast<double>(n_beams) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
-    const double max_raw = result.empty() ? 0.0 : *std::max_element(result.begin(), result.end());
-    return bound <= pruned_tolerance * max_raw;
+    if (!p_.elevations.empty()) bound += static_cast<double>(n_beams) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
+    return bound;
+}
+
+bool BoundaryVectorLayer::bound_sums_from_rows(const ScanPlan& plan, const BoundaryVectorLayer& summed,
+                                               std::size_t& valid) const {
+    if (!summed.rows_complete_) return false;
+    valid = 0;
+    const int L = p_.n_layers(), K = p_.n_dir;
+    std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
+    std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
+    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
+    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    for (std::size_t r = 0; r < summed.row_totals_.size(); ++r) {
+        const RowTotal& t = summed.row_totals_[r];
+        if (std::find(plan.skipped_rows.begin(), plan.skipped_rows.end(), t.elevation) != plan.skipped_rows.end()) continue;
+        const double* near_angles = summed.row_angles_.data() + 2 * r * static_cast<std::size_t>(K);
+        const double* all_angles = near_angles + K;
+        row_factors(t.elevation);
+        valid += t.valid;
+        for (int l = 0; l < L; ++l) {
+            layer_weight_[l] += row_factor_[l] * static_cast<double>(t.valid);
+            far_weight_[l] += elev_[l] * static_cast<double>(t.far);
+            for (int k = 0; k < K; ++k) {
+                kept_weight_[static_cast<std::size_t>(l) * K + k] += elev_[l] * near_angles[k];
+                dropped_weight_[static_cast<std::size_t>(l) * K + k] += dropped_e_[l] * all_angles[k];
+            }
+        }
+    }
+    return true;
+}
+
+bool BoundaryVectorLayer::can_share_sums(const BvcParams& o) const {
+    // Everything but the elevations, which only select layers (and planar models share only with planar ones).
+    return p_.reading == BvcReading::gaussian && o.reading == BvcReading::gaussian &&
+           p_.elevations.empty() == o.elevations.empty() && p_.n_dir == o.n_dir && p_.n_per_axis == o.n_per_axis &&
+           p_.max_dist == o.max_dist && p_.sigma_r == o.sigma_r && p_.sigma_theta == o.sigma_theta &&
+           p_.sigma_phi == o.sigma_phi;
+}
+
+std::size_t BoundaryVectorLayer::first_axis(const BvcParams& reader, int l) const {
+    if (reader.elevations.empty()) return 0;
+    const auto at = std::find(p_.elevations.begin(), p_.elevations.end(), reader.elevations[static_cast<std::size_t>(l)]);
+    if (at == p_.elevations.end()) throw InputError("BVC layer: shared sums lack the elevation of layer " + std::to_string(l));
+    return static_cast<std::size_t>(at - p_.elevations.begin()) * static_cast<std::size_t>(p_.n_dir);
+}
+
+void BoundaryVectorLayer::sum_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan) const {
+    raw_pruned(returns, &plan, {}, Pass::sums);  // the bound is each reader's own
+}
+
+bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn> returns, const ScanPlan& plan,
+                                              const BoundaryVectorLayer& summed, std::span<double> out) const {
+    if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
+    if (!can_share_sums(summed.p_)) throw InputError("BVC layer: cannot read the sums of a layer with other parameters");
+    // The bound's sums from the summing layer's row totals: the same terms as this layer's own pass
+    // adds return by return, in another order. Sums of n positive terms in two orders differ by at
+    // most 2n·2^-53 of their value, so the verdict is the own pass's whenever the bound is further
+    // than 1e-9 from the threshold (n < 10^6 here: a beam table); closer, the own pass decides.
+    bool ok;
+    copy_sums(summed, out);
+    std::size_t valid = 0;
+    const double max_raw = out.empty() ? 0.0 : *std::max_element(out.begin(), out.end());
+    const double threshold = pruned_tolerance * max_raw;
+    const double bound = bound_sums_from_rows(plan, summed, valid) && valid < 1000000 ? pruned_bound(&plan, valid) : NAN;
+    if (bound < threshold * (1 - 1e-9)) ok = true;
+    else if (bound > threshold * (1 + 1e-9)) ok = false;
+    else ok = raw_pruned(returns, &plan, out, Pass::bound, &summed);
+    if (!ok) return false;
+    normalize(out);
+    return true;
 }
 
 int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weight) const {

@@ -78,12 +78,47 @@ public:
     // the caller then casts every row and calls rates().
     bool rates_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan, std::span<double> out) const;
 
+    // Several models on one scan (an experiment's models sharing a walk): the layers' sums of one
+    // (return, layer) pair do not depend on the other layers, so a layer whose parameters equal
+    // this one's but for its elevations can read the sums of those it has from a layer that summed
+    // their union once. sum_pruned sums (the union's side); rates_pruned_shared gives what
+    // rates_pruned gives, the same bits and its own truncation bound, reading the sums from
+    // `summed` (which must hold every elevation of this layer and have summed the same scan).
+    bool can_share_sums(const BvcParams& other) const;
+    void sum_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan) const;
+    bool rates_pruned_shared(std::span<const LidarReturn> returns, const ScanPlan& plan,
+                             const BoundaryVectorLayer& summed, std::span<double> out) const;
+
     // The full triple-Gaussian sum with no pruning: the definition itself, for checking.
     void raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const;
 
 private:
-    // Returns false if the pruning bound is not met (out then holds the pruned sums).
-    bool raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out) const;
+    // What raw_pruned does: `own` sums and checks its bound (returns false if the bound is not met;
+    // out then holds the pruned sums); `sums` only sums, into padded_, and keeps row totals
+    // (sum_pruned); `bound` only does the bound's bookkeeping, reading the sums from `summed`.
+    enum class Pass { own, sums, bound };
+    bool raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out,
+                    Pass pass = Pass::own, const BoundaryVectorLayer* summed = nullptr) const;
+    template <Pass pass>
+    bool pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out,
+                     const BoundaryVectorLayer* summed) const;
+    // The truncation bound's sums (per layer and direction: kept and dropped weights; per layer:
+    // weights and empty-window weights) from `summed`'s row totals, as this layer's own pass would
+    // add them return by return, and the returns counted; false if summed kept none.
+    bool bound_sums_from_rows(const ScanPlan& plan, const BoundaryVectorLayer& summed, std::size_t& valid) const;
+    // This layer's elevation factors of a row at elevation phi: summed (elev_) and dropped (dropped_e_).
+    void row_factors(double phi) const;
+    // Every pruned term's bound from the bound sums, for cells whose largest sum is max_raw.
+    double pruned_bound(const ScanPlan* plan, std::size_t valid) const;
+    // Row totals of the last `sums` pass, per scanner row: its elevation, returns counted, returns with an empty
+    // distance window, and in row_angles_ per direction Σ angular factors of the returns with a window, then of all.
+    struct RowTotal {
+        double elevation;
+        std::size_t valid, far;
+    };
+    mutable std::vector<RowTotal> row_totals_;
+    mutable std::vector<double> row_angles_;
+    mutable bool rows_complete_ = false;  // false: too many rows (an irregular point set) to keep
     // The nearest_beam reading into `out` (zeroed by the caller). Pruned: only each direction's
     // distance window; returns false if what that drops is not below the pruning tolerance.
     bool raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out, bool prune) const;
@@ -128,6 +163,10 @@ private:
     mutable std::vector<double> kept_weight_, layer_weight_, far_weight_, dropped_weight_;  // truncation bound
     int axis_stride_ = 0;                 // n_per_axis rounded up to 8, plus 8
     mutable std::vector<double> padded_;  // sums with padded axes
+    // This layer's sums (its layers as `from_layer` holds them, padded) into result.
+    void copy_sums(const BoundaryVectorLayer& from_layer, std::span<double> result) const;
+    // The first padded axis of the layer with `reader`'s layer l's elevation (shared sums).
+    std::size_t first_axis(const BvcParams& reader, int l) const;
     mutable std::vector<std::size_t> best_return_;  // nearest_beam reading
     mutable std::vector<double> best_gap_;
 };

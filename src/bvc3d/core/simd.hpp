@@ -13,9 +13,6 @@
 #define BVC3D_HAVE_DISPATCH 0
 #endif
 
-#include <cstddef>
-#include <new>
-
 namespace bvc3d::simd {
 
 // Explicit 8-lane vectors (GCC vector extensions): element-wise arithmetic that each clone lowers
@@ -29,19 +26,6 @@ typedef double d8 __attribute__((vector_size(64)));
 template <int N>
 struct doubles {
     typedef double type __attribute__((vector_size(8 * N)));
-};
-
-// An allocator for vector kernels' arrays: 64-byte (cache-line) aligned, so that no AVX-512 load
-// of an aligned block spans two cache lines (each such load costs two).
-template <class T>
-struct CacheAligned {
-    using value_type = T;
-    CacheAligned() = default;
-    template <class U>
-    CacheAligned(const CacheAligned<U>&) {}
-    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
-    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t{64}); }
-    friend bool operator==(const CacheAligned&, const CacheAligned&) { return true; }
 };
 
 template <class V, class T>

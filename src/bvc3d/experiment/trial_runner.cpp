@@ -1,5 +1,6 @@
 #include "bvc3d/experiment/trial_runner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -43,6 +44,17 @@ struct GroupRun {
     std::vector<int> source_of;  // per model
     std::vector<BoundaryVectorLayer> layers;
     std::vector<BoundaryVectorLayer::ScanPlan> plans;  // per model; empty rows without a beam table
+    // Models whose BVC layers differ only in their elevations (on one source) read their sums from
+    // one layer that sums the union of their elevations once a step: shared[u], per model shared_of
+    // (-1: sums its own). Each model keeps its own truncation bound: the same bits either way.
+    struct SharedSums {
+        int source;
+        std::vector<std::size_t> models;
+        std::unique_ptr<BoundaryVectorLayer> layer;
+        BoundaryVectorLayer::ScanPlan plan;
+    };
+    std::vector<SharedSums> shared;
+    std::vector<int> shared_of;
     std::vector<PlaceCellNetwork> nets;
     std::vector<std::vector<double>> bvc_rates;
     // Place-cell steps wait here until `block` of them are due; then each model takes its steps in a
@@ -61,6 +73,7 @@ struct GroupRun {
 
     GroupRun(const World* w, const std::vector<TrialConfig>& t, const SourceFactory& factory);
     int use_source(const ModelSpec& model, const SourceFactory& factory);
+    void share_sums();
     void reserve_samples();
     bool model_rates(std::size_t i, const Pose& pose);
     void step(const ModelStep& s, bool learn, bool record);
@@ -86,6 +99,7 @@ GroupRun::GroupRun(const World* w, const std::vector<TrialConfig>& t, const Sour
         rec.n_bvc = c.model.bvc.n_cells();
         result.models.push_back(std::move(rec));
     }
+    share_sums();
     // One model's weights stay in cache anyway: block only when several share the walk.
     block = nets.size() > 1 ? 16 : 1;
     due_rates.resize(nets.size());
@@ -114,6 +128,35 @@ int GroupRun::use_source(const ModelSpec& model, const SourceFactory& factory) {
     return static_cast<int>(sources.size() - 1);
 }
 
+void GroupRun::share_sums() {
+    shared_of.assign(layers.size(), -1);
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+        const LidarSpec* table = sources[source_of[i]].source->beam_table();
+        if (!table || trials[i].model.bvc.reading != BvcReading::gaussian) continue;
+        auto same = std::find_if(shared.begin(), shared.end(), [&](const SharedSums& g) {
+            return g.source == source_of[i] && layers[i].can_share_sums(layers[g.models.front()].params());
+        });
+        if (same == shared.end()) same = shared.insert(shared.end(), SharedSums{source_of[i], {}, nullptr, {}});
+        same->models.push_back(i);
+    }
+    std::erase_if(shared, [](const SharedSums& g) { return g.models.size() < 2; });
+    for (std::size_t u = 0; u < shared.size(); ++u) {
+        SharedSums& g = shared[u];
+        BvcParams all = layers[g.models.front()].params();
+        for (std::size_t i : g.models)
+            for (double psi : layers[i].params().elevations)
+                if (std::find(all.elevations.begin(), all.elevations.end(), psi) == all.elevations.end())
+                    all.elevations.push_back(psi);
+        if (static_cast<double>(all.elevations.size()) * all.n_dir * all.n_per_axis > BvcParams::max_cells) {
+            for (std::size_t i : g.models) shared_of[i] = -1;  // too many layers to sum at once: each sums its own
+            continue;
+        }
+        g.layer = std::make_unique<BoundaryVectorLayer>(all);
+        g.plan = g.layer->plan(*sources[g.source].source->beam_table());
+        for (std::size_t i : g.models) shared_of[i] = static_cast<int>(u);
+    }
+}
+
 void GroupRun::reserve_samples() {
     const auto& first = trials.front();
     const auto expected =
@@ -129,7 +172,10 @@ void GroupRun::reserve_samples() {
 // pruning bound fails (almost nothing in view) is read again in full and summed exactly.
 bool GroupRun::model_rates(std::size_t i, const Pose& pose) {
     SourceUse& u = sources[source_of[i]];
-    if (u.source->beam_table() && pose.level() && layers[i].rates_pruned(u.scan, plans[i], bvc_rates[i])) return true;
+    if (u.source->beam_table() && pose.level() &&
+        (shared_of[i] < 0 ? layers[i].rates_pruned(u.scan, plans[i], bvc_rates[i])
+                          : layers[i].rates_pruned_shared(u.scan, plans[i], *shared[shared_of[i]].layer, bvc_rates[i])))
+        return true;
     if (!u.source->beam_table() || !pose.level()) {
         layers[i].rates(u.scan, bvc_rates[i]);  // every return was read
         return true;
@@ -146,6 +192,9 @@ void GroupRun::step(const ModelStep& s, bool learn, bool record) {
         u.source->returns(static_cast<std::uint64_t>(step_index), s.pose, s.pose.level() ? u.rows : all_rows, u.scan);
         u.full_read = false;
     }
+    if (s.pose.level())
+        for (const auto& g : shared)
+            if (g.layer) g.layer->sum_pruned(sources[g.source].scan, g.plan);
     for (std::size_t i = 0; i < layers.size(); ++i) {
         if (!model_rates(i, s.pose)) ++result.stats.full_scan_fallbacks;
         due_rates[i].insert(due_rates[i].end(), bvc_rates[i].begin(), bvc_rates[i].end());

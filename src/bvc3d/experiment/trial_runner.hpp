@@ -4,9 +4,10 @@
 //
 // A group is several models on one agent in one world with one seed: they share the agent's steps
 // (the agent has its own random stream) and each distinct return source is read once per step
-// (a ray-cast sensor with the union of the rows the models need); their place cells are stepped
-// in blocks of steps, model by model, so each model's weights stay in cache. Each model's results
-// are bit-identical to running it alone.
+// (a ray-cast sensor with the union of the rows the models need); models whose BVC layers differ
+// only in their elevations read their sums from one layer that sums the union of their elevations
+// once; their place cells are stepped in blocks of steps, model by model, so each model's weights
+// stay in cache. Each model's results are bit-identical to running it alone.
 #include <atomic>
 #include <filesystem>
 #include <functional>

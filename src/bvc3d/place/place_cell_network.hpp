@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "bvc3d/core/params.hpp"
-#include "bvc3d/core/simd.hpp"
+#include "bvc3d/core/aligned.hpp"
 
 namespace bvc3d {
 
@@ -63,7 +63,7 @@ private:
     int n_bvc_;
     std::size_t stride_;  // n_bvc rounded up to a multiple of 8; padding (and an odd count's last row) stays 0
     PlaceParams p_;
-    std::vector<float, simd::CacheAligned<float>> w_, vb2_;  // vb2_: the BVC rates in the paired layout
+    std::vector<float, CacheAligned<float>> w_, vb2_;  // vb2_: the BVC rates in the paired layout
     std::vector<float> s_, v_, vb_, drive_;
 };
 
