@@ -174,6 +174,7 @@ TEST(BoundaryVectorLayer, SharedSumsGiveEveryModelItsOwnBits) {
     const auto all_plan = summed.plan(base.sensor);
     const Lidar lidar(base.sensor);
     Scan scan;
+    std::mt19937_64 gen(3);
     for (std::size_t i = 0; i < walk.size(); i += 7) {
         lidar.scan(world, walk[i].pose, scan, {}, all_plan.rows);
         summed.sum_pruned(scan, all_plan);
@@ -185,6 +186,20 @@ TEST(BoundaryVectorLayer, SharedSumsGiveEveryModelItsOwnBits) {
             ASSERT_EQ(reader.rates_pruned_shared(scan, plan, summed, b), ok_own);
             if (ok_own) {
                 ASSERT_EQ(a, b) << "elevations[0] " << p.elevations[0] << ", step " << i;
+            }
+        }
+        // Irregular order (no rows to total): each reader's bound then comes from its own pass.
+        Scan shuffled = scan;
+        std::shuffle(shuffled.begin(), shuffled.end(), gen);
+        summed.sum_pruned(shuffled, all_plan);
+        for (const auto& p : models) {
+            const BoundaryVectorLayer own(p), reader(p);
+            const auto plan = own.plan(base.sensor);
+            std::vector<double> a(own.n_cells()), b(own.n_cells());
+            const bool ok_own = own.rates_pruned(shuffled, plan, a);
+            ASSERT_EQ(reader.rates_pruned_shared(shuffled, plan, summed, b), ok_own);
+            if (ok_own) {
+                ASSERT_EQ(a, b) << "shuffled, elevations[0] " << p.elevations[0] << ", step " << i;
             }
         }
     }
