@@ -173,35 +173,29 @@ TEST(BoundaryVectorLayer, SharedSumsGiveEveryModelItsOwnBits) {
     const BoundaryVectorLayer summed(all);
     const auto all_plan = summed.plan(base.sensor);
     const Lidar lidar(base.sensor);
-    Scan scan;
-    std::mt19937_64 gen(3);
-    for (std::size_t i = 0; i < walk.size(); i += 7) {
-        lidar.scan(world, walk[i].pose, scan, {}, all_plan.rows);
+    // Every model, summing on its own and reading `summed`'s sums of the same scan: same verdict, same bits.
+    auto expect_readers_match = [&](const Scan& scan, const std::string& what) {
         summed.sum_pruned(scan, all_plan);
         for (const auto& p : models) {
             const BoundaryVectorLayer own(p), reader(p);
             const auto plan = own.plan(base.sensor);
             std::vector<double> a(own.n_cells()), b(own.n_cells());
             const bool ok_own = own.rates_pruned(scan, plan, a);
-            ASSERT_EQ(reader.rates_pruned_shared(scan, plan, summed, b), ok_own);
+            ASSERT_EQ(reader.rates_pruned_shared(scan, plan, summed, b), ok_own) << what;
             if (ok_own) {
-                ASSERT_EQ(a, b) << "elevations[0] " << p.elevations[0] << ", step " << i;
+                ASSERT_EQ(a, b) << what << ", elevations[0] " << p.elevations[0];
             }
         }
+    };
+    Scan scan;
+    std::mt19937_64 gen(3);
+    for (std::size_t i = 0; i < walk.size(); i += 7) {
+        lidar.scan(world, walk[i].pose, scan, {}, all_plan.rows);
+        expect_readers_match(scan, "step " + std::to_string(i));
         // Irregular order (no rows to total): each reader's bound then comes from its own pass.
         Scan shuffled = scan;
         std::shuffle(shuffled.begin(), shuffled.end(), gen);
-        summed.sum_pruned(shuffled, all_plan);
-        for (const auto& p : models) {
-            const BoundaryVectorLayer own(p), reader(p);
-            const auto plan = own.plan(base.sensor);
-            std::vector<double> a(own.n_cells()), b(own.n_cells());
-            const bool ok_own = own.rates_pruned(shuffled, plan, a);
-            ASSERT_EQ(reader.rates_pruned_shared(shuffled, plan, summed, b), ok_own);
-            if (ok_own) {
-                ASSERT_EQ(a, b) << "shuffled, elevations[0] " << p.elevations[0] << ", step " << i;
-            }
-        }
+        expect_readers_match(shuffled, "shuffled, step " + std::to_string(i));
     }
     // The bound's verdict is each reader's own: nothing in reach is declined.
     summed.sum_pruned(Scan{}, all_plan);

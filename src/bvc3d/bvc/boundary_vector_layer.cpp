@@ -150,7 +150,7 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
     // needs a scalar tail; they are copied to `result` at the end.
     const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis, stride = axis_stride_;
     constexpr bool sums = pass != Pass::bound, own_bound = pass != Pass::sums;
-    if (sums) std::fill(padded_.begin(), padded_.end(), 0.0);
+    if constexpr (sums) std::fill(padded_.begin(), padded_.end(), 0.0);
     double* out_data = padded_.data();
     const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
     const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r);
@@ -166,17 +166,14 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
     int n_kept = 0, n_any = 0;
     // For the truncation bound: per (layer, direction) the kept weights Σ E·A and the dropped ones,
     // per layer Σ E over returns that reach it and Σ E over those whose distance window is empty.
-    std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
-    std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
-    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
-    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    clear_bound_sums();
     double* kept_weight = kept_weight_.data();
     double* layer_weight = layer_weight_.data();
     // The `sums` pass keeps, per row, what the bound of any layer reading these sums needs instead.
+    constexpr bool keep_rows = pass == Pass::sums;
     row_totals_.clear();
     row_angles_.clear();
-    rows_complete_ = pass == Pass::sums;
-    constexpr bool keep_rows = pass == Pass::sums;
+    rows_complete_ = keep_rows;
     RowTotal* row_total = nullptr;
     double* near_angles = nullptr;  // this row's Σ A of returns with a distance window, per direction
     double* all_angles = nullptr;   // ... and of every return
@@ -209,28 +206,23 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
         // Elevation factors, cached across the returns of one scanner row.
         if (!(ret.elevation == last_phi)) {
             last_phi = ret.elevation;
-            skipped_row = plan && std::find(plan->skipped_rows.begin(), plan->skipped_rows.end(), ret.elevation) !=
-                                      plan->skipped_rows.end();
+            skipped_row = plan && plan->skips(ret.elevation);
             row_factors(ret.elevation);
             n_kept = n_any = 0;
             for (int l = 0; l < L; ++l) {
                 if (elev[l] > 0.0) kept_l[n_kept++] = l;
                 if (row_factor_[l] > 0.0) any_l[n_any++] = l;  // adding 0 to layer_weight changes nothing
             }
+            row_total = nullptr;
             if (keep_rows && rows_complete_ && !skipped_row) {
                 if (row_totals_.size() == max_row_totals) {
                     rows_complete_ = false;  // not a beam table: readers do their own bookkeeping
                 } else {
-                    row_totals_.push_back({ret.elevation, 0, 0});
+                    row_total = &row_totals_.emplace_back(RowTotal{ret.elevation, 0, 0});
                     row_angles_.resize(row_angles_.size() + 2 * static_cast<std::size_t>(K), 0.0);
+                    near_angles = row_angles_.data() + row_angles_.size() - 2 * static_cast<std::size_t>(K);
+                    all_angles = near_angles + K;
                 }
-            }
-            if (keep_rows && rows_complete_ && !skipped_row) {
-                row_total = &row_totals_.back();
-                near_angles = row_angles_.data() + row_angles_.size() - 2 * static_cast<std::size_t>(K);
-                all_angles = near_angles + K;
-            } else {
-                row_total = nullptr;
             }
         }
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
@@ -279,7 +271,7 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
             m_lo = 1;  // no cell in reach
         }
         if (m_lo > m_hi) {
-            if (own_bound)
+            if constexpr (own_bound)
                 for (int i = 0; i < n_kept; ++i) far_weight_[kept_l[i]] += elev[kept_l[i]];
             if (keep_rows && row_total) ++row_total->far;
             continue;
@@ -295,7 +287,7 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
                 const int l = kept_l[i];
                 const double w = elev[l] * ang[d];
                 const std::size_t lk = static_cast<std::size_t>(l) * K + dir[d];
-                if (own_bound) kept_weight[lk] += w;
+                if constexpr (own_bound) kept_weight[lk] += w;
                 job_weight[n_rows] = w;
                 job_offset[n_rows] = static_cast<std::uint32_t>(lk * stride + m_lo);
                 ++n_rows;
@@ -341,6 +333,13 @@ void BoundaryVectorLayer::copy_sums(const BoundaryVectorLayer& from_layer, std::
     }
 }
 
+void BoundaryVectorLayer::clear_bound_sums() const {
+    std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
+    std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
+    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
+    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+}
+
 double BoundaryVectorLayer::pruned_bound(const ScanPlan* plan, std::size_t valid) const {
     // Every pruned term of cell (l, k, m) is one of: a distance factor below tiny_r of a kept
     // (return, layer, direction); an angular factor below tiny_theta of a (return, layer) whose
@@ -368,13 +367,10 @@ bool BoundaryVectorLayer::bound_sums_from_rows(const ScanPlan& plan, const Bound
     if (!summed.rows_complete_) return false;
     valid = 0;
     const int L = p_.n_layers(), K = p_.n_dir;
-    std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
-    std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
-    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
-    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    clear_bound_sums();
     for (std::size_t r = 0; r < summed.row_totals_.size(); ++r) {
         const RowTotal& t = summed.row_totals_[r];
-        if (std::find(plan.skipped_rows.begin(), plan.skipped_rows.end(), t.elevation) != plan.skipped_rows.end()) continue;
+        if (plan.skips(t.elevation)) continue;
         const double* near_angles = summed.row_angles_.data() + 2 * r * static_cast<std::size_t>(K);
         const double* all_angles = near_angles + K;
         row_factors(t.elevation);

@@ -4,6 +4,7 @@
 // Takes: LiDAR returns (range, azimuth, elevation), from a beam table or any point set. Gives: one
 // rate per cell, cell i = (l, k, m) at index (l·n_dir + k)·n_per_axis + m, for preferred elevation
 // psi_l, azimuth theta_k = 2πk/n_dir and distance d_m = m·max_dist/(n_per_axis - 1).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -71,6 +72,9 @@ public:
         std::vector<double> skipped_rows;    // elevations of the rows not needed
         std::vector<double> skipped_bound;   // per layer: bound on their contribution to any cell
         std::size_t beams = 0;               // beams in the full table
+        bool skips(double elevation) const {
+            return std::find(skipped_rows.begin(), skipped_rows.end(), elevation) != skipped_rows.end();
+        }
     };
     ScanPlan plan(const LidarSpec& sensor) const;
     // Rates from a scan cast with plan.rows (returns of other rows, e.g. cast for another model,
@@ -108,7 +112,8 @@ private:
     bool bound_sums_from_rows(const ScanPlan& plan, const BoundaryVectorLayer& summed, std::size_t& valid) const;
     // This layer's elevation factors of a row at elevation phi: summed (elev_) and dropped (dropped_e_).
     void row_factors(double phi) const;
-    // Every pruned term's bound from the bound sums, for cells whose largest sum is max_raw.
+    // The bound sums back to zero, and every pruned term's bound from them (`valid` returns counted).
+    void clear_bound_sums() const;
     double pruned_bound(const ScanPlan* plan, std::size_t valid) const;
     // Row totals of the last `sums` pass, per scanner row: its elevation, returns counted, returns with an empty
     // distance window, and in row_angles_ per direction Σ angular factors of the returns with a window, then of all.

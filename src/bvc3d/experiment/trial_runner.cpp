@@ -129,32 +129,30 @@ int GroupRun::use_source(const ModelSpec& model, const SourceFactory& factory) {
 }
 
 void GroupRun::share_sums() {
-    shared_of.assign(layers.size(), -1);
     for (std::size_t i = 0; i < layers.size(); ++i) {
-        const LidarSpec* table = sources[source_of[i]].source->beam_table();
-        if (!table || trials[i].model.bvc.reading != BvcReading::gaussian) continue;
+        if (!sources[source_of[i]].source->beam_table()) continue;
         auto same = std::find_if(shared.begin(), shared.end(), [&](const SharedSums& g) {
             return g.source == source_of[i] && layers[i].can_share_sums(layers[g.models.front()].params());
         });
         if (same == shared.end()) same = shared.insert(shared.end(), SharedSums{source_of[i], {}, nullptr, {}});
         same->models.push_back(i);
     }
-    std::erase_if(shared, [](const SharedSums& g) { return g.models.size() < 2; });
-    for (std::size_t u = 0; u < shared.size(); ++u) {
-        SharedSums& g = shared[u];
+    for (SharedSums& g : shared) {
         BvcParams all = layers[g.models.front()].params();
         for (std::size_t i : g.models)
             for (double psi : layers[i].params().elevations)
                 if (std::find(all.elevations.begin(), all.elevations.end(), psi) == all.elevations.end())
                     all.elevations.push_back(psi);
-        if (static_cast<double>(all.elevations.size()) * all.n_dir * all.n_per_axis > BvcParams::max_cells) {
-            for (std::size_t i : g.models) shared_of[i] = -1;  // too many layers to sum at once: each sums its own
+        // Alone, or too many layers to sum at once: each sums its own.
+        if (g.models.size() < 2 || static_cast<double>(all.elevations.size()) * all.n_dir * all.n_per_axis > BvcParams::max_cells)
             continue;
-        }
         g.layer = std::make_unique<BoundaryVectorLayer>(all);
         g.plan = g.layer->plan(*sources[g.source].source->beam_table());
-        for (std::size_t i : g.models) shared_of[i] = static_cast<int>(u);
     }
+    std::erase_if(shared, [](const SharedSums& g) { return !g.layer; });
+    shared_of.assign(layers.size(), -1);
+    for (std::size_t u = 0; u < shared.size(); ++u)
+        for (std::size_t i : shared[u].models) shared_of[i] = static_cast<int>(u);
 }
 
 void GroupRun::reserve_samples() {
@@ -193,8 +191,7 @@ void GroupRun::step(const ModelStep& s, bool learn, bool record) {
         u.full_read = false;
     }
     if (s.pose.level())
-        for (const auto& g : shared)
-            if (g.layer) g.layer->sum_pruned(sources[g.source].scan, g.plan);
+        for (const auto& g : shared) g.layer->sum_pruned(sources[g.source].scan, g.plan);
     for (std::size_t i = 0; i < layers.size(); ++i) {
         if (!model_rates(i, s.pose)) ++result.stats.full_scan_fallbacks;
         due_rates[i].insert(due_rates[i].end(), bvc_rates[i].begin(), bvc_rates[i].end());

@@ -8,8 +8,7 @@ using simd::f8;
 
 namespace {
 template <class V>
-inline float reduce8(const V& acc, int first) {
-    const int f = first;
+inline float reduce8(const V& acc, int f) {
     return ((acc[f] + acc[f + 1]) + (acc[f + 2] + acc[f + 3])) + ((acc[f + 4] + acc[f + 5]) + (acc[f + 6] + acc[f + 7]));
 }
 
