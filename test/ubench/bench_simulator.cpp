@@ -2,6 +2,7 @@
 #include <benchmark/benchmark.h>
 #include <embree3/rtcore.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "bvc3d/agent/random_walk.hpp"
@@ -55,9 +56,10 @@ void BM_ScanPlanned(benchmark::State& state, std::string preset) {
     state.counters["rays/s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
 }
 
-// The floor of ray casting: Embree alone on the same rays (the same scene flags, packets of 16 rays
-// filled in advance, one packet per 16 columns of a row), with nothing around it: no directions to
-// compute, no ranges to refine in double, no returns to write.
+// The floor of ray casting: Embree alone on the rays BM_ScanPlanned casts (the same scene flags,
+// the same poses, packets of 16 rays column by column over the planned rows, as Lidar::scan fills
+// them), with nothing around it: the directions are computed in advance, in float, and a packet
+// only copies its own and resets its hit; no ranges refined in double, no returns written.
 void BM_EmbreeOnly(benchmark::State& state, std::string preset) {
     const ModelSpec model = model_preset(preset);
     const World world = World::cross({.tilt_deg = 45});
@@ -81,54 +83,60 @@ void BM_EmbreeOnly(benchmark::State& state, std::string preset) {
     rtcReleaseGeometry(geom);
     rtcCommitScene(scene);
 
-    // Every pose's packets, filled in advance.
-    const auto& walk = poses(world);
-    const std::size_t n_poses = std::min<std::size_t>(walk.size(), 64);
+    // Every pose's packets: 16 x, 16 y and 16 z; ray c + rows·j is planned row c of column j, and
+    // the idle lanes of a last packet repeat its first ray.
     const LidarSpec& sensor = model.sensor;
-    std::vector<std::vector<RTCRayHit16>> packets(n_poses);
-    std::size_t rays_per_scan = 0;
-    for (std::size_t p = 0; p < n_poses; ++p) {
-        const Pose& pose = walk[p * (walk.size() / n_poses)].pose;
-        rays_per_scan = 0;
-        for (std::size_t row = 0; row < sensor.elevations.size(); ++row) {
-            if (!plan.rows[row]) continue;
-            const double e = sensor.elevations[row];
-            for (int c0 = 0; c0 < sensor.azimuth_count; c0 += 16) {
-                RTCRayHit16 rh;
-                std::memset(&rh, 0, sizeof rh);
-                for (int k = 0; k < 16; ++k) {
-                    const int c = std::min(c0 + k, sensor.azimuth_count - 1);
-                    const double az = pose.heading + sensor.azimuth_offset + c * 2 * M_PI / sensor.azimuth_count;
-                    rh.ray.org_x[k] = static_cast<float>(pose.x);
-                    rh.ray.org_y[k] = static_cast<float>(pose.y);
-                    rh.ray.org_z[k] = static_cast<float>(pose.z + sensor.height);
-                    rh.ray.dir_x[k] = static_cast<float>(std::cos(e) * std::cos(az));
-                    rh.ray.dir_y[k] = static_cast<float>(std::cos(e) * std::sin(az));
-                    rh.ray.dir_z[k] = static_cast<float>(std::sin(e));
-                    rh.ray.tfar[k] = static_cast<float>(sensor.max_range);
-                    rh.ray.mask[k] = 0xFFFFFFFFu;
-                    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-                    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-                }
-                packets[p].push_back(rh);
-                rays_per_scan += static_cast<std::size_t>(std::min(16, sensor.azimuth_count - c0));
-            }
+    std::vector<double> rows;  // the planned rows' elevations
+    for (std::size_t row = 0; row < sensor.elevations.size(); ++row)
+        if (plan.rows[row]) rows.push_back(sensor.elevations[row]);
+    const std::size_t n_rays = rows.size() * static_cast<std::size_t>(sensor.azimuth_count);
+    const std::size_t n_packets = (n_rays + 15) / 16;
+    const auto& walk = poses(world);
+    std::vector<float> dirs(walk.size() * n_packets * 48);
+    for (std::size_t p = 0; p < walk.size(); ++p)
+        for (std::size_t lane = 0; lane < n_packets * 16; ++lane) {
+            const std::size_t ray = lane < n_rays ? lane : lane / 16 * 16;
+            const double e = rows[ray % rows.size()];
+            const double az = walk[p].pose.heading + sensor.azimuth_offset +
+                              static_cast<double>(ray / rows.size()) * 2 * M_PI / sensor.azimuth_count;
+            float* d = &dirs[(p * n_packets + lane / 16) * 48 + lane % 16];
+            d[0] = static_cast<float>(std::cos(e) * std::cos(az));
+            d[16] = static_cast<float>(std::cos(e) * std::sin(az));
+            d[32] = static_cast<float>(std::sin(e));
         }
-    }
     alignas(64) int valid[16];
     alignas(64) RTCRayHit16 rh;
+    std::memset(&rh, 0, sizeof rh);
+    for (int k = 0; k < 16; ++k) {
+        rh.ray.mask[k] = 0xFFFFFFFFu;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    const float tfar = static_cast<float>(sensor.max_range) * (1.0f + 1e-6f);
     std::size_t i = 0, rays = 0;
     for (auto _ : state) {
-        for (const auto& packet : packets[i++ % n_poses]) {
-            std::memcpy(&rh, &packet, sizeof rh);
-            for (int k = 0; k < 16; ++k) valid[k] = -1;
+        const Pose& pose = walk[i % walk.size()].pose;
+        const float* d = &dirs[i++ % walk.size() * n_packets * 48];
+        for (int k = 0; k < 16; ++k) {
+            rh.ray.org_x[k] = static_cast<float>(pose.x);
+            rh.ray.org_y[k] = static_cast<float>(pose.y);
+            rh.ray.org_z[k] = static_cast<float>(pose.z + sensor.height);
+        }
+        for (std::size_t packet = 0; packet < n_packets; ++packet, d += 48) {
+            std::memcpy(rh.ray.dir_x, d, sizeof rh.ray.dir_x);
+            std::memcpy(rh.ray.dir_y, d + 16, sizeof rh.ray.dir_y);
+            std::memcpy(rh.ray.dir_z, d + 32, sizeof rh.ray.dir_z);
+            for (std::size_t k = 0; k < 16; ++k) {
+                valid[k] = packet * 16 + k < n_rays ? -1 : 0;
+                rh.ray.tfar[k] = tfar;
+                rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            }
             RTCIntersectContext ctx;
             rtcInitIntersectContext(&ctx);
             ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
             rtcIntersect16(valid, scene, &ctx, &rh);
             benchmark::DoNotOptimize(rh.ray.tfar[0]);
         }
-        rays += rays_per_scan;
+        rays += n_rays;
     }
     state.counters["rays/s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
     rtcReleaseScene(scene);

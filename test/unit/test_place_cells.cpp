@@ -210,3 +210,58 @@ TEST(PlaceCellNetwork, ResetAndWeightsRoundTrip) {
     bad.n_place = 0;
     EXPECT_THROW(PlaceCellNetwork(960, bad, 0), InputError);
 }
+
+// step_block (one pass over the weights for several steps, the rows Oja's rule changed multiplied
+// again) gives the bits of step() called step after step: rates of every step, membrane, weights;
+// for blocks longer and shorter than the kernels' tiles, learning switched on and off inside a block,
+// odd cell counts (a pair's second row empty) and BVC counts that are not a multiple of 8.
+TEST(PlaceCellNetwork, StepBlockIsStepAfterStep) {
+    for (const auto& [n_place, n_bvc] : {std::pair{250, 960}, std::pair{17, 37}, std::pair{1, 8}, std::pair{6, 130}}) {
+        PlaceParams p;
+        p.n_place = n_place;
+        if (n_place < 100) p.gamma_pb = 0.02;  // small networks fire only under weak inhibition
+        PlaceCellNetwork stepped(n_bvc, p, 21), blocked(n_bvc, p, 21);
+        std::mt19937_64 gen(static_cast<unsigned>(n_place));
+        std::uniform_real_distribution<double> u(0, 1);
+        int active = 0;
+        std::size_t learned_steps = 0;
+        for (const int steps : {16, 1, 3, 8, 9, 20, 16, 16, 5, 16}) {
+            std::vector<double> rates(static_cast<std::size_t>(steps) * n_bvc);
+            std::vector<char> learn(static_cast<std::size_t>(steps));
+            for (int t = 0; t < steps; ++t) {
+                const double center = u(gen) * n_bvc;  // a bump of BVC activity: some cells fire and learn
+                for (int j = 0; j < n_bvc; ++j)
+                    rates[static_cast<std::size_t>(t) * n_bvc + j] = 0.5 * std::exp(-0.5 * (j - center) * (j - center) / 400.0);
+                learn[static_cast<std::size_t>(t)] = u(gen) < 0.8;
+                learned_steps += learn[static_cast<std::size_t>(t)] != 0;
+            }
+            const auto block = blocked.step_block(rates, learn);
+            ASSERT_EQ(block.size(), static_cast<std::size_t>(steps) * n_place);
+            for (int t = 0; t < steps; ++t) {
+                const auto v = stepped.step(std::span<const double>(rates.data() + static_cast<std::size_t>(t) * n_bvc, n_bvc),
+                                            learn[static_cast<std::size_t>(t)] != 0);
+                for (int i = 0; i < n_place; ++i) {
+                    ASSERT_EQ(block[static_cast<std::size_t>(t) * n_place + i], v[i]) << n_place << " cells, step " << t;
+                    active += v[i] > 0;
+                }
+            }
+            ASSERT_TRUE(std::equal(stepped.membrane().begin(), stepped.membrane().end(), blocked.membrane().begin()));
+            ASSERT_EQ(stepped.weights(), blocked.weights()) << n_place << " cells";
+        }
+        EXPECT_GT(active, 10) << n_place << " cells: the inputs should make some cells fire and learn";
+        EXPECT_GT(learned_steps, 50u);
+    }
+}
+
+// A block with a bad input anywhere changes nothing: every input is checked before the first step.
+TEST(PlaceCellNetwork, StepBlockChecksEveryInputFirst) {
+    PlaceCellNetwork net(16, PlaceParams{}, 2);
+    std::vector<double> rates(3 * 16, 0.25);
+    EXPECT_THROW(net.step_block(rates, std::vector<char>(2, 1)), InputError);  // 3 steps of rates, 2 flags
+    rates[2 * 16 + 5] = NAN;
+    const auto weights = net.weights();
+    EXPECT_THROW(net.step_block(rates, std::vector<char>(3, 1)), InputError);
+    EXPECT_EQ(net.weights(), weights);
+    for (float s : net.membrane()) EXPECT_EQ(s, 0.0f);
+    EXPECT_TRUE(net.step_block({}, {}).empty());
+}

@@ -8,6 +8,7 @@
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/vector_exp.hpp"
 
 namespace bvc3d {
 
@@ -24,6 +25,8 @@ constexpr double tiny_theta = 1e-10;
 constexpr double tiny_row = 1e-8;
 constexpr double tiny_phi = 1e-13;
 constexpr double pruned_tolerance = 1e-7;
+// A memo of at most this many slots (a beam table's columns; more, and the default is kept).
+constexpr std::size_t max_slots = 1 << 16;
 
 double window(double sigma, double tiny) { return sigma * std::sqrt(2.0 * std::log(1.0 / tiny)); }
 double gauss_norm(double sigma) { return 1.0 / std::sqrt(two_pi * sigma * sigma); }
@@ -80,27 +83,37 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     // Padded with zeros to a multiple of 8 for the vector kernel.
     const int padded = (p_.n_per_axis + 7) / 8 * 8;
     dist_decay_.assign(padded, 0.0);
-    for (int n = 0; n < p_.n_per_axis; ++n) dist_decay_[n] = std::exp(-0.5 * (n * d) * (n * d) / (p_.sigma_r * p_.sigma_r));
+    for (int n = 0; n < padded; ++n) dist_decay_[n] = std::exp(-0.5 * (n * d) * (n * d) / (p_.sigma_r * p_.sigma_r));
     elev_.assign(p_.n_layers(), 0.0);
     dropped_e_.assign(p_.n_layers(), 0.0);
     row_factor_.assign(p_.n_layers(), 0.0);
     kept_layers_.assign(p_.n_layers(), 0);
+    kept_elev_.assign(p_.n_layers(), 0.0);
+    kept_base_.assign(p_.n_layers(), 0);
     any_layers_.assign(p_.n_layers(), 0);
     // A batch: 256 returns, or as many rows as fill 1024 entries (plus one return's worth).
     jobs_.resize(256);
+    exp_args_.resize(2 * jobs_.size());
     job_offset_.resize(1024 + static_cast<std::size_t>(p_.n_layers()) * p_.n_dir);
     job_weight_.resize(job_offset_.size());
     kept_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
     layer_weight_.assign(p_.n_layers(), 0.0);
     far_weight_.assign(p_.n_layers(), 0.0);
     dropped_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
-    axis_stride_ = padded + 8;
+    axis_stride_ = padded;
     padded_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir * axis_stride_, 0.0);
-    memo_weight_.assign(cache_slots * (p_.n_dir + 1), 0.0);
-    memo_dir_.assign(cache_slots * (p_.n_dir + 1), 0);
-    for (std::size_t slot = 0; slot < cache_slots; ++slot) memo_weight_[slot * (p_.n_dir + 1)] = NAN;  // the keys
-    direct_dir_.assign(p_.n_dir, 0);
-    direct_weight_.assign(p_.n_dir, 0.0);
+    row_sums_.assign(static_cast<std::size_t>(p_.n_dir) * axis_stride_, 0.0);
+    // k_first..k_last in angular_weights span at most 2·cut/Δθ, plus one for each end's rounding.
+    const double span = 2.0 * cut_theta_ / (two_pi / p_.n_dir);
+    reach_ = span >= p_.n_dir ? p_.n_dir : std::min(p_.n_dir, static_cast<int>(span) + 2);
+    feeds_.resize(256);
+    size_memo(default_slots);
+    // θ_k, padded with NaN to whole vectors of 8 (kernels::nearest_returns).
+    const std::size_t dirs8 = (static_cast<std::size_t>(p_.n_dir) + 7) / 8 * 8;
+    dir_angle_.assign(dirs8, NAN);
+    for (int k = 0; k < p_.n_dir; ++k) dir_angle_[k] = k * two_pi / p_.n_dir;
+    best_return_.assign(dirs8, 0);
+    best_gap_.assign(dirs8, 0.0);
 }
 
 void BoundaryVectorLayer::check_return(const LidarReturn& r, std::size_t index) {
@@ -132,62 +145,58 @@ void BoundaryVectorLayer::row_factors(double phi) const {
     }
 }
 
-bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan,
-                                     std::span<double> result, Pass pass, const BoundaryVectorLayer* summed) const {
-    // One instance per pass, so that each pass's loop carries none of the others' work.
-    switch (pass) {
-        case Pass::own: return pruned_pass<Pass::own>(returns, plan, result, summed);
-        case Pass::sums: return pruned_pass<Pass::sums>(returns, plan, result, summed);
-        case Pass::bound: break;
-    }
-    return pruned_pass<Pass::bound>(returns, plan, result, summed);
-}
-
-template <BoundaryVectorLayer::Pass pass>
-bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan,
-                                      std::span<double> result, const BoundaryVectorLayer* summed) const {
-    // Sums go to a buffer whose axes are padded by one 8-lane block, so the vector kernel never
-    // needs a scalar tail; they are copied to `result` at the end.
-    const int L = p_.n_layers(), K = p_.n_dir, M = p_.n_per_axis, stride = axis_stride_;
-    constexpr bool sums = pass != Pass::bound, own_bound = pass != Pass::sums;
-    if constexpr (sums) std::fill(padded_.begin(), padded_.end(), 0.0);
-    double* out_data = padded_.data();
+template <bool planned>
+std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan) const {
+    // Sums go to a buffer whose axes are padded to whole blocks of 8 cells, so the vector kernel never
+    // needs a scalar tail; they are copied to the result by copy_sums. Two phases, a row's returns at
+    // a time: this loop reads the returns (which cells and directions each reaches: feeds_), then
+    // expand_feeds lists the rows they feed: two short loops, each with few values to keep in
+    // registers, rather than one long one. Planned (a beam table, row by row), each direction's sum
+    // over a scanner row's returns, Σ A·D, is formed once (row_sums_) and added to every layer the
+    // row feeds with its elevation factor E (add_row_sums): a return feeding two layers is summed
+    // once. Unplanned (any point set, whose elevations need not repeat), E·A weights each return.
+    const int L = p_.n_layers(), M = p_.n_per_axis;
+    std::fill(padded_.begin(), padded_.end(), 0.0);
     const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
-    const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r);
-    // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
-    // keeps the power recurrence below far from overflow.
-    const bool recurrence = dd > 0 && dd <= p_.sigma_r;
     // Elevation factors of the current row: summed (elev_) and in [tiny_phi, tiny_row) (dropped_e_);
-    // the layers with a summed factor (kept_l, n_kept of them) and with any factor (any_l, n_any).
-    const double* elev = elev_.data();
+    // n_kept layers with a summed factor and n_any with any factor.
     const double* dropped_e = dropped_e_.data();
-    int* kept_l = kept_layers_.data();
-    int* any_l = any_layers_.data();
     int n_kept = 0, n_any = 0;
-    // For the truncation bound: per (layer, direction) the kept weights Σ E·A and the dropped ones,
-    // per layer Σ E over returns that reach it and Σ E over those whose distance window is empty.
-    clear_bound_sums();
-    double* kept_weight = kept_weight_.data();
-    double* layer_weight = layer_weight_.data();
-    // The `sums` pass keeps, per row, what the bound of any layer reading these sums needs instead.
-    constexpr bool keep_rows = pass == Pass::sums;
-    row_totals_.clear();
-    row_angles_.clear();
-    rows_complete_ = keep_rows;
-    RowTotal* row_total = nullptr;
-    double* near_angles = nullptr;  // this row's Σ A of returns with a distance window, per direction
-    double* all_angles = nullptr;   // ... and of every return
-    constexpr std::size_t max_row_totals = 1024;
-    // The recurrence path lists the returns' profiles (jobs) and the rows each feeds (offsets into
-    // the sums, weights), and adds a few hundred at a time in one kernel call, in return order.
-    kernels::ProfileJob* jobs = jobs_.data();
-    std::uint32_t* job_offset = job_offset_.data();
-    double* job_weight = job_weight_.data();
-    std::size_t n_jobs = 0, n_rows = 0;
-    const std::size_t rows_room = job_offset_.size() - static_cast<std::size_t>(K) * L;
-    auto flush = [&] {
-        kernels::add_distance_profiles(jobs, n_jobs, job_offset, job_weight, dist_decay_.data(), out_data);
-        n_jobs = n_rows = 0;
+    // Unplanned, for the truncation bound: per (layer, direction) the kept weights Σ E·A (added by
+    // expand_feeds) and the dropped ones, per layer Σ E over returns that reach it and Σ E over those
+    // whose distance window is empty. Planned: the current run's counts.
+    if constexpr (!planned) {
+        std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
+        std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
+        std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
+        std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    }
+    runs_.clear();
+    std::size_t run_valid = 0, run_far = 0;
+    auto end_run = [&] {
+        if (!runs_.empty()) {
+            runs_.back().valid = run_valid;
+            runs_.back().far = run_far;
+        }
+        run_valid = run_far = 0;
+    };
+    n_jobs_ = n_rows_ = 0;
+    Feed* feeds = feeds_.data();
+    std::size_t n_feeds = 0, n_direct = 0;
+    if (plan && plan->columns > 0 && plan->columns != memo_slots_ && plan->columns <= max_slots) size_memo(plan->columns);
+    const std::size_t record = static_cast<std::size_t>(reach_) + 1;
+    auto expand = [&] {
+        expand_feeds<!planned>(n_feeds, n_kept);
+        n_feeds = n_direct = 0;
+        ++batch_;
+    };
+    bool row_summed = false;  // planned: row_sums_ holds the current row's sums
+    auto end_row = [&] {
+        expand();
+        if (!planned || !row_summed) return;
+        if (n_jobs_ > 0) flush_jobs<false>();
+        add_row_sums(n_kept);
+        row_summed = false;
     };
     std::size_t valid = 0;
     // A beam table comes row by row; returns whose elevation changes nearly every time are an
@@ -198,6 +207,7 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
     const bool use_memo = probe < 64 || changes < 56;
     double last_phi = NAN;
     bool skipped_row = false;
+    ++batch_;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
         const LidarReturn& ret = returns[j];
@@ -205,58 +215,57 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
         if (!(ret.range >= 0) || !std::isfinite(ret.azimuth) || !std::isfinite(ret.elevation)) check_return(ret, j);
         // Elevation factors, cached across the returns of one scanner row.
         if (!(ret.elevation == last_phi)) {
+            end_row();
             last_phi = ret.elevation;
             skipped_row = plan && plan->skips(ret.elevation);
             row_factors(ret.elevation);
             n_kept = n_any = 0;
             for (int l = 0; l < L; ++l) {
-                if (elev[l] > 0.0) kept_l[n_kept++] = l;
-                if (row_factor_[l] > 0.0) any_l[n_any++] = l;  // adding 0 to layer_weight changes nothing
-            }
-            row_total = nullptr;
-            if (keep_rows && rows_complete_ && !skipped_row) {
-                if (row_totals_.size() == max_row_totals) {
-                    rows_complete_ = false;  // not a beam table: readers do their own bookkeeping
-                } else {
-                    row_total = &row_totals_.emplace_back(RowTotal{ret.elevation, 0, 0});
-                    row_angles_.resize(row_angles_.size() + 2 * static_cast<std::size_t>(K), 0.0);
-                    near_angles = row_angles_.data() + row_angles_.size() - 2 * static_cast<std::size_t>(K);
-                    all_angles = near_angles + K;
+                if (elev_[l] > 0.0) {
+                    kept_layers_[n_kept] = l;
+                    kept_elev_[n_kept] = elev_[l];
+                    kept_base_[n_kept++] = static_cast<std::size_t>(l) * p_.n_dir * axis_stride_;
                 }
+                if (row_factor_[l] > 0.0) any_layers_[n_any++] = l;  // adding 0 to layer_weight changes nothing
+            }
+            if constexpr (planned) {
+                end_run();
+                if (!skipped_row) runs_.push_back(Run{ret.elevation, 0, 0});
             }
         }
         if (skipped_row) continue;  // the plan's bound covers the rows it did not cast
         ++valid;
-        if (keep_rows && row_total) ++row_total->valid;
-        if (n_any == 0) continue;
-        const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
-        const int* dir = direct_dir_.data();
-        const double* ang = direct_weight_.data();
-        int n_dirs;
-        if (use_memo) {
-            const std::size_t at = slot_of(azimuth) * (K + 1);
-            double* const key = memo_weight_.data() + at;
-            int* const count = memo_dir_.data() + at;
-            if (!(*key == azimuth)) {
-                *count = angular_weights(azimuth, count + 1, key + 1);
-                *key = azimuth;
-            }
-            dir = count + 1;
-            ang = key + 1;
-            n_dirs = *count;
-        } else {
-            n_dirs = angular_weights(azimuth, direct_dir_.data(), direct_weight_.data());
+        if constexpr (planned) {
+            ++run_valid;
+            if (n_kept == 0) continue;  // the bound reads no angular factor
         }
-        if constexpr (own_bound) {
-            for (int i = 0; i < n_any; ++i) layer_weight[any_l[i]] += row_factor_[any_l[i]];
+        if (n_any == 0) continue;
+        // The directions the azimuth reaches and their angular factors: its memo slot's record, or
+        // one of its own after the memo's records.
+        const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
+        std::size_t at;
+        if (use_memo) {
+            const std::size_t slot = slot_of(azimuth);
+            at = slot * record;
+            if (!(memo_weight_[at] == azimuth)) {
+                if (slot_batch_[slot] == batch_) expand();  // a waiting feed reads this record
+                memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
+                memo_weight_[at] = azimuth;
+            }
+            slot_batch_[slot] = batch_;
+        } else {
+            at = (memo_slots_ + n_direct++) * record;
+            memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
+        }
+        if constexpr (!planned) {
+            for (int i = 0; i < n_any; ++i) layer_weight_[any_layers_[i]] += row_factor_[any_layers_[i]];
             if (n_any > n_kept)
                 for (int l = 0; l < L; ++l)
                     if (dropped_e[l] > 0.0)
-                        for (int d = 0; d < n_dirs; ++d)
-                            dropped_weight_[static_cast<std::size_t>(l) * K + dir[d]] += dropped_e[l] * ang[d];
+                        for (int d = 0; d < memo_dir_[at]; ++d)
+                            dropped_weight_[static_cast<std::size_t>(l) * p_.n_dir + memo_dir_[at + 1 + d]] +=
+                                dropped_e[l] * memo_weight_[at + 1 + d];
         }
-        if (keep_rows && row_total)
-            for (int d = 0; d < n_dirs; ++d) all_angles[dir[d]] += ang[d];
         if (n_kept == 0) continue;
 
         // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
@@ -271,54 +280,137 @@ bool BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, cons
             m_lo = 1;  // no cell in reach
         }
         if (m_lo > m_hi) {
-            if constexpr (own_bound)
-                for (int i = 0; i < n_kept; ++i) far_weight_[kept_l[i]] += elev[kept_l[i]];
-            if (keep_rows && row_total) ++row_total->far;
+            if constexpr (planned) ++run_far;
+            else
+                for (int i = 0; i < n_kept; ++i) far_weight_[kept_layers_[i]] += kept_elev_[i];
             continue;
         }
-        const int W = m_hi - m_lo + 1;
-        if (keep_rows && row_total)
-            for (int d = 0; d < n_dirs; ++d) near_angles[dir[d]] += ang[d];
+        // The kernel adds whole blocks of 8 cells, aligned: a return's loads then meet the previous
+        // return's stores at the same addresses, which the CPU forwards (a load straddling two earlier
+        // stores waits for both to reach the cache). The cells this adds get their true terms.
+        const int m_first = m_lo & ~7;
+        feeds[n_feeds++] = {r, static_cast<std::uint32_t>(at), m_first, ((m_hi + 8) & ~7) - m_first};
+        row_summed = true;
+        if (n_feeds == feeds_.size()) expand();
+    }
+    end_row();
+    if (n_jobs_ > 0) flush_jobs<!planned>();
+    if constexpr (planned) end_run();
+    return valid;
+}
 
-        // The (layer, direction) rows this return feeds, with their elevation × angular weights.
+template <bool unplanned>
+void BoundaryVectorLayer::expand_feeds(std::size_t n_feeds, int n_kept) const {
+    const int K = p_.n_dir;
+    const std::size_t stride = static_cast<std::size_t>(axis_stride_);
+    const std::size_t rows_room = job_offset_.size() - static_cast<std::size_t>(K) * p_.n_layers();
+    // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
+    // keeps the power recurrence below far from overflow.
+    const double dd = p_.spacing();
+    const bool recurrence = dd > 0 && dd <= p_.sigma_r;
+    // Local copies: stores through these pointers cannot then be taken to change the members.
+    const Feed* feeds = feeds_.data();
+    const std::uint16_t* memo_dir = memo_dir_.data();
+    const double* memo_weight = memo_weight_.data();
+    const double* kept_elev = kept_elev_.data();
+    const std::size_t* kept_base = kept_base_.data();
+    const int* kept_layers = kept_layers_.data();
+    double* kept_weight = kept_weight_.data();
+    double* job_weight = job_weight_.data();
+    std::uint32_t* job_offset = job_offset_.data();
+    kernels::ProfileJob* jobs = jobs_.data();
+    const std::size_t max_jobs = jobs_.size();
+    std::size_t n_jobs = n_jobs_, n_rows = n_rows_;
+    for (std::size_t f = 0; f < n_feeds; ++f) {
+        const Feed& feed = feeds[f];
+        const int n_dirs = memo_dir[feed.record];
+        const std::uint16_t* dir = memo_dir + feed.record + 1;
+        const double* ang = memo_weight + feed.record + 1;
+        // The rows this return feeds: per direction its row of row_sums_ weighted A (planned), or per
+        // (layer, direction) its row of padded_ weighted E·A (unplanned).
         const std::size_t first = n_rows;
-        for (int d = 0; d < n_dirs; ++d)
-            for (int i = 0; i < n_kept; ++i) {
-                const int l = kept_l[i];
-                const double w = elev[l] * ang[d];
-                const std::size_t lk = static_cast<std::size_t>(l) * K + dir[d];
-                if constexpr (own_bound) kept_weight[lk] += w;
-                job_weight[n_rows] = w;
-                job_offset[n_rows] = static_cast<std::uint32_t>(lk * stride + m_lo);
+        for (int d = 0; d < n_dirs; ++d) {
+            const std::size_t cells = dir[d] * stride + static_cast<std::size_t>(feed.first_cell);
+            if constexpr (unplanned) {
+                for (int i = 0; i < n_kept; ++i) {
+                    const double w = kept_elev[i] * ang[d];
+                    kept_weight[static_cast<std::size_t>(kept_layers[i]) * K + dir[d]] += w;
+                    job_weight[n_rows] = w;
+                    job_offset[n_rows] = static_cast<std::uint32_t>(kept_base[i] + cells);
+                    ++n_rows;
+                }
+            } else {
+                job_weight[n_rows] = ang[d];
+                job_offset[n_rows] = static_cast<std::uint32_t>(cells);
                 ++n_rows;
             }
+        }
         const int count = static_cast<int>(n_rows - first);
         if (count == 0) continue;
-        if constexpr (!sums) {  // the sums are read from `summed`
-            n_rows = 0;
-            continue;
-        }
-
         // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
         if (recurrence) {
-            // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return.
-            const double x0 = r - m_lo * dd;
-            jobs[n_jobs++] = {c_r_ * std::exp(-h_r * x0 * x0), std::exp(2.0 * h_r * x0 * dd), W, count};
-            if (n_jobs == jobs_.size() || n_rows > rows_room) flush();
-        } else {
-            for (int n = 0; n < W; ++n) {
-                const double x = r - (m_lo + n) * dd;
-                const double u = c_r_ * std::exp(-h_r * x * x);
-                for (int i = 0; i < count; ++i) out_data[job_offset[first + i] + n] += job_weight[first + i] * u;
+            // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return,
+            // computed for the whole batch at once (profile_factors) when it is flushed.
+            jobs[n_jobs++] = {feed.range - feed.first_cell * dd, 0.0, feed.width, count};
+            if (n_jobs == max_jobs || n_rows > rows_room) {
+                n_jobs_ = n_jobs;
+                flush_jobs<unplanned>();
+                n_jobs = n_rows = 0;
             }
-            n_rows = 0;
+        } else {
+            const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r);
+            double* sums = unplanned ? padded_.data() : row_sums_.data();
+            for (int n = 0; n < feed.width; ++n) {
+                const double x = feed.range - (feed.first_cell + n) * dd;
+                const double u = c_r_ * std::exp(-h_r * x * x);
+                for (int i = 0; i < count; ++i) sums[job_offset[first + i] + n] += job_weight[first + i] * u;
+            }
+            n_rows = first;
         }
     }
-    if (n_jobs > 0) flush();
-    if constexpr (pass == Pass::sums) return true;
-    copy_sums(pass == Pass::bound ? *summed : *this, result);
-    const double max_raw = result.empty() ? 0.0 : *std::max_element(result.begin(), result.end());
-    return pruned_bound(plan, valid) <= pruned_tolerance * max_raw;
+    n_jobs_ = n_jobs;
+    n_rows_ = n_rows;
+}
+
+void BoundaryVectorLayer::add_row_sums(int n_kept) const {
+    const std::size_t n = row_sums_.size();
+    double* row = row_sums_.data();
+    for (int i = 0; i < n_kept; ++i) {
+        double* layer = padded_.data() + kept_base_[i];
+        const double e = kept_elev_[i];
+        for (std::size_t c = 0; c < n; ++c) layer[c] += e * row[c];
+    }
+    std::fill(row_sums_.begin(), row_sums_.end(), 0.0);
+}
+
+template <bool unplanned>
+void BoundaryVectorLayer::flush_jobs() const {
+    profile_factors(n_jobs_);
+    kernels::add_distance_profiles(jobs_.data(), n_jobs_, job_offset_.data(), job_weight_.data(), dist_decay_.data(),
+                                   unplanned ? padded_.data() : row_sums_.data());
+    n_jobs_ = n_rows_ = 0;
+}
+
+bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, std::span<double> result) const {
+    const std::size_t valid = pruned_pass<false>(returns, nullptr);
+    copy_sums(*this, result);
+    const double max_raw = kernels::largest(result.data(), result.size());
+    return pruned_bound(valid) <= pruned_tolerance * max_raw;
+}
+
+void BoundaryVectorLayer::profile_factors(std::size_t n_jobs) const {
+    const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r), dd = p_.spacing();
+    double* e = exp_args_.data();
+    for (std::size_t i = 0; i < n_jobs; ++i) {
+        const double x0 = jobs_[i].a;
+        e[i] = -h_r * x0 * x0;
+        e[n_jobs + i] = 2.0 * h_r * x0 * dd;
+    }
+    vector_exp(e, e, 2 * n_jobs);
+    for (std::size_t i = 0; i < n_jobs; ++i) {
+        jobs_[i].a = c_r_ * e[i];
+        jobs_[i].b = e[n_jobs + i];
+    }
 }
 
 void BoundaryVectorLayer::copy_sums(const BoundaryVectorLayer& from_layer, std::span<double> result) const {
@@ -333,20 +425,12 @@ void BoundaryVectorLayer::copy_sums(const BoundaryVectorLayer& from_layer, std::
     }
 }
 
-void BoundaryVectorLayer::clear_bound_sums() const {
-    std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
-    std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
-    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
-    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
-}
-
-double BoundaryVectorLayer::pruned_bound(const ScanPlan* plan, std::size_t valid) const {
+double BoundaryVectorLayer::pruned_bound(std::size_t valid) const {
     // Every pruned term of cell (l, k, m) is one of: a distance factor below tiny_r of a kept
     // (return, layer, direction); an angular factor below tiny_theta of a (return, layer) whose
     // elevation factor was evaluated; a (return, layer, direction) whose elevation factor is below
     // tiny_row (its weight E·A is known exactly, D <= c_r); an elevation factor below tiny_phi
-    // (worst case, for every beam cast or not); the distance factor of a return whose whole window
-    // was empty; a row the plan did not cast (bounded by the plan).
+    // (worst case, for every return); the distance factor of a return whose whole window was empty.
     const int L = p_.n_layers(), K = p_.n_dir;
     double bound = 0;
     for (int l = 0; l < L; ++l)
@@ -354,37 +438,44 @@ double BoundaryVectorLayer::pruned_bound(const ScanPlan* plan, std::size_t valid
             const std::size_t lk = static_cast<std::size_t>(l) * K + k;
             bound = std::max(bound, kept_weight_[lk] * c_r_ * tiny_r + dropped_weight_[lk] * c_r_ +
                                         layer_weight_[l] * c_theta_ * c_r_ * tiny_theta +
-                                        far_weight_[l] * c_theta_ * c_r_ * tiny_r +
-                                        (plan ? plan->skipped_bound[l] : 0.0));
+                                        far_weight_[l] * c_theta_ * c_r_ * tiny_r);
         }
-    const std::size_t n_beams = std::max(valid, plan ? plan->beams : std::size_t{0});
-    if (!p_.elevations.empty()) bound += static_cast<double>(n_beams) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
+    if (!p_.elevations.empty()) bound += static_cast<double>(valid) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
     return bound;
 }
 
-bool BoundaryVectorLayer::bound_sums_from_rows(const ScanPlan& plan, const BoundaryVectorLayer& summed,
-                                               std::size_t& valid) const {
-    if (!summed.rows_complete_) return false;
-    valid = 0;
-    const int L = p_.n_layers(), K = p_.n_dir;
-    clear_bound_sums();
-    for (std::size_t r = 0; r < summed.row_totals_.size(); ++r) {
-        const RowTotal& t = summed.row_totals_[r];
-        if (plan.skips(t.elevation)) continue;
-        const double* near_angles = summed.row_angles_.data() + 2 * r * static_cast<std::size_t>(K);
-        const double* all_angles = near_angles + K;
-        row_factors(t.elevation);
-        valid += t.valid;
+double BoundaryVectorLayer::planned_bound(const ScanPlan& plan, const std::vector<Run>& runs) const {
+    // The same terms as pruned_bound, with each run's Σ_returns A_k (kept or dropped, any direction k)
+    // at most the lattice bound of the rows its label can be (and at most c_θ per return), and a row
+    // the plan did not cast bounded by the plan. It depends on the scan's rows and this layer's
+    // elevations only: a layer reading shared sums gets the verdict of its own pass.
+    const int L = p_.n_layers();
+    std::fill(kept_weight_.begin(), kept_weight_.begin() + L, 0.0);
+    std::fill(dropped_weight_.begin(), dropped_weight_.begin() + L, 0.0);
+    std::fill(layer_weight_.begin(), layer_weight_.end(), 0.0);
+    std::fill(far_weight_.begin(), far_weight_.end(), 0.0);
+    std::size_t valid = 0;
+    for (const Run& run : runs) {
+        if (plan.skips(run.elevation)) continue;
+        row_factors(run.elevation);
+        valid += run.valid;
+        const double n = static_cast<double>(run.valid);
+        const double angles = std::min(plan.angular_sum * plan.rows_per_label, n * c_theta_);
         for (int l = 0; l < L; ++l) {
-            layer_weight_[l] += row_factor_[l] * static_cast<double>(t.valid);
-            far_weight_[l] += elev_[l] * static_cast<double>(t.far);
-            for (int k = 0; k < K; ++k) {
-                kept_weight_[static_cast<std::size_t>(l) * K + k] += elev_[l] * near_angles[k];
-                dropped_weight_[static_cast<std::size_t>(l) * K + k] += dropped_e_[l] * all_angles[k];
-            }
+            kept_weight_[l] += elev_[l] * angles;
+            dropped_weight_[l] += dropped_e_[l] * angles;
+            layer_weight_[l] += row_factor_[l] * n;
+            far_weight_[l] += elev_[l] * static_cast<double>(run.far);
         }
     }
-    return true;
+    double bound = 0;
+    for (int l = 0; l < L; ++l)
+        bound = std::max(bound, kept_weight_[l] * c_r_ * tiny_r + dropped_weight_[l] * c_r_ +
+                                    layer_weight_[l] * c_theta_ * c_r_ * tiny_theta +
+                                    far_weight_[l] * c_theta_ * c_r_ * tiny_r + plan.skipped_bound[l]);
+    const std::size_t n_beams = std::max(valid, plan.beams);
+    if (!p_.elevations.empty()) bound += static_cast<double>(n_beams) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
+    return bound;
 }
 
 bool BoundaryVectorLayer::can_share_sums(const BvcParams& o) const {
@@ -403,32 +494,32 @@ std::size_t BoundaryVectorLayer::first_axis(const BvcParams& reader, int l) cons
 }
 
 void BoundaryVectorLayer::sum_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan) const {
-    raw_pruned(returns, &plan, {}, Pass::sums);  // the bound is each reader's own
+    pruned_pass<true>(returns, &plan);  // the bound is each reader's own (planned_bound of these runs)
 }
 
-bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn> returns, const ScanPlan& plan,
+bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn>, const ScanPlan& plan,
                                               const BoundaryVectorLayer& summed, std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     if (!can_share_sums(summed.p_)) throw InputError("BVC layer: cannot read the sums of a layer with other parameters");
-    // The bound's sums from the summing layer's row totals: the same terms as this layer's own pass
-    // adds return by return, in another order. Sums of n positive terms in two orders differ by at
-    // most 2n·2^-53 of their value, so the verdict is the own pass's whenever the bound is further
-    // than 1e-9 from the threshold (n < 10^6 here: a beam table); closer, the own pass decides.
-    bool ok;
     copy_sums(summed, out);
-    std::size_t valid = 0;
-    const double max_raw = out.empty() ? 0.0 : *std::max_element(out.begin(), out.end());
-    const double threshold = pruned_tolerance * max_raw;
-    const double bound = bound_sums_from_rows(plan, summed, valid) && valid < 1000000 ? pruned_bound(&plan, valid) : NAN;
-    if (bound < threshold * (1 - 1e-9)) ok = true;
-    else if (bound > threshold * (1 + 1e-9)) ok = false;
-    else ok = raw_pruned(returns, &plan, out, Pass::bound, &summed);
-    if (!ok) return false;
-    normalize(out);
+    const double max_raw = kernels::largest(out.data(), out.size());
+    if (!(planned_bound(plan, summed.runs_) <= pruned_tolerance * max_raw)) return false;
+    normalize(out, max_raw);
     return true;
 }
 
-int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weight) const {
+void BoundaryVectorLayer::size_memo(std::size_t slots) const {
+    // The slots, then room for a batch of records that are not memoised (irregular point sets).
+    const std::size_t record = static_cast<std::size_t>(reach_) + 1;
+    memo_slots_ = slots;
+    slot_scale_ = static_cast<double>(slots) / two_pi;
+    memo_weight_.assign((slots + feeds_.size()) * record, 0.0);
+    memo_dir_.assign((slots + feeds_.size()) * record, 0);
+    for (std::size_t slot = 0; slot < slots; ++slot) memo_weight_[slot * record] = NAN;  // the keys
+    slot_batch_.assign(slots, 0);
+}
+
+int BoundaryVectorLayer::angular_weights(double azimuth, std::uint16_t* dir, double* weight) const {
     const int K = p_.n_dir;
     const double dtheta = two_pi / K, h_t = 0.5 / (p_.sigma_theta * p_.sigma_theta);
     const bool all_dirs = 2.0 * cut_theta_ >= two_pi;
@@ -447,7 +538,7 @@ int BoundaryVectorLayer::angular_weights(double azimuth, int* dir, double* weigh
     for (int ki = k_first; ki <= k_last; ++ki) {
         const double x = all_dirs ? wrap_pi(azimuth - ki * dtheta) : azimuth - ki * dtheta;
         if (std::abs(x) > cut_theta_) continue;
-        dir[count] = ki < 0 ? ki + K : ki >= K ? ki - K : ki;  // |ki| < K: the window is under a turn
+        dir[count] = static_cast<std::uint16_t>(ki < 0 ? ki + K : ki >= K ? ki - K : ki);  // |ki| < K: the window is under a turn
         weight[count] = c_theta_ * std::exp(-x * x * h_t);
         ++count;
     }
@@ -489,21 +580,19 @@ bool BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns,
                                            bool prune) const {
     // For each direction, the first return with the smallest |wrap(azimuth - θ_k)|.
     const int K = p_.n_dir, M = p_.n_per_axis;
-    best_return_.assign(K, returns.size());
-    best_gap_.assign(K, INFINITY);
+    near_azimuth_.clear();
+    near_index_.clear();
     for (std::size_t j = 0; j < returns.size(); ++j) {
         if (is_no_return(returns[j])) continue;
         check_return(returns[j], j);
-        const double az = wrap_pi(returns[j].azimuth);
-        for (int k = 0; k < K; ++k) {
-            double gap = az - k * two_pi / K;  // in (-3π, π]: one correction wraps it
-            if (gap <= -pi) gap += two_pi;
-            gap = std::abs(gap);
-            if (gap < best_gap_[k]) {
-                best_gap_[k] = gap;
-                best_return_[k] = j;
-            }
-        }
+        near_azimuth_.push_back(wrap_pi(returns[j].azimuth));
+        near_index_.push_back(j);
+    }
+    kernels::nearest_returns(near_azimuth_.data(), near_azimuth_.size(), dir_angle_.data(), K, best_return_.data(),
+                             best_gap_.data());
+    for (int k = 0; k < K; ++k) {  // back to the returns' own indices
+        const auto i = static_cast<std::size_t>(best_return_[k]);
+        best_return_[k] = static_cast<std::int64_t>(i < near_index_.size() ? near_index_[i] : returns.size());
     }
     // Pruned, a direction's profile is evaluated over its distance window only (as raw_pruned does):
     // a cell outside it would get less than tiny_r·c_r. Those Gaussian tails (down to 1e-56 of the
@@ -511,10 +600,12 @@ bool BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns,
     // the place cells take a microcode assist per product on many CPUs.
     const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
     prune = prune && dd > 0;
-    double max_raw = 0;
+    // The exponents of every cell to evaluate, then one batched exp.
+    cells_.clear();
+    exponents_.clear();
     for (int k = 0; k < K; ++k) {
-        if (best_return_[k] == returns.size()) continue;
-        const double r = returns[best_return_[k]].range;
+        if (static_cast<std::size_t>(best_return_[k]) == returns.size()) continue;
+        const double r = returns[static_cast<std::size_t>(best_return_[k])].range;
         int m_lo = 0, m_hi = M - 1;
         if (prune) {  // a superset of |r - d_m| <= cut, as in raw_pruned
             const double lo = (r - cut_r_) * inv_dd, hi = (r + cut_r_) * inv_dd;
@@ -523,10 +614,16 @@ bool BoundaryVectorLayer::raw_nearest_beam(std::span<const LidarReturn> returns,
         }
         for (int m = m_lo; m <= m_hi; ++m) {
             const double x = r - m * p_.spacing();
-            const double v = c_r_ * std::exp(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
-            out[static_cast<std::size_t>(k) * M + m] = v;
-            max_raw = std::max(max_raw, v);
+            cells_.push_back(static_cast<std::size_t>(k) * M + m);
+            exponents_.push_back(-0.5 * x * x / (p_.sigma_r * p_.sigma_r));
         }
+    }
+    vector_exp(exponents_.data(), exponents_.data(), exponents_.size());
+    double max_raw = 0;
+    for (std::size_t i = 0; i < cells_.size(); ++i) {
+        const double v = c_r_ * exponents_[i];
+        out[cells_[i]] = v;
+        max_raw = std::max(max_raw, v);
     }
     return !prune || c_r_ * tiny_r <= pruned_tolerance * max_raw;
 }
@@ -536,14 +633,13 @@ void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<do
     if (p_.reading == BvcReading::nearest_beam) {
         std::fill(out.begin(), out.end(), 0.0);
         if (!raw_nearest_beam(returns, out, true)) raw_nearest_beam(returns, out, false);
-    } else if (!raw_pruned(returns, nullptr, out)) {
+    } else if (!raw_pruned(returns, out)) {
         raw_exact(returns, out);
     }
 }
 
-void BoundaryVectorLayer::normalize(std::span<double> out) const {
+void BoundaryVectorLayer::normalize(std::span<double> out, double mx) const {
     if (p_.normalization == BvcNormalization::per_step_max) {
-        const double mx = out.empty() ? 0.0 : *std::max_element(out.begin(), out.end());
         if (mx > 0) {
             const double denom = 2.0 * mx;
             for (double& v : out) v = v / denom;  // exact 0.5 at the maximum
@@ -557,7 +653,7 @@ void BoundaryVectorLayer::normalize(std::span<double> out) const {
 
 void BoundaryVectorLayer::rates(std::span<const LidarReturn> returns, std::span<double> out) const {
     raw(returns, out);
-    normalize(out);
+    normalize(out, kernels::largest(out.data(), out.size()));
 }
 
 bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan,
@@ -567,8 +663,11 @@ bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, con
         rates(returns, out);
         return true;
     }
-    if (!raw_pruned(returns, &plan, out)) return false;
-    normalize(out);
+    pruned_pass<true>(returns, &plan);
+    copy_sums(*this, out);
+    const double max_raw = kernels::largest(out.data(), out.size());
+    if (!(planned_bound(plan, runs_) <= pruned_tolerance * max_raw)) return false;
+    normalize(out, max_raw);
     return true;
 }
 
@@ -579,13 +678,22 @@ BoundaryVectorLayer::ScanPlan BoundaryVectorLayer::plan(const LidarSpec& sensor)
     plan.rows.assign(rows.size(), 1);
     plan.skipped_bound.assign(L, 0.0);
     plan.beams = sensor.beam_count();
-    if (p_.elevations.empty() || p_.reading == BvcReading::nearest_beam) return plan;  // reads every row
+    plan.columns = static_cast<std::size_t>(sensor.azimuth_count);
     // A row's beams are evenly spaced in azimuth (δ apart), so for any heading and direction
     // Σ_columns exp(-x²/2σ_θ²) <= 1 + √(2π)·σ_θ/δ (a unimodal function summed over a lattice).
     // linspace labels are δ' = 2π/(n−1) > δ apart with one azimuth twice (0 and 2π): one term more.
     const double delta = two_pi / sensor.azimuth_count;
     const double repeated = sensor.azimuth_labels == AzimuthLabels::linspace ? 1.0 : 0.0;
     const double angular_sum = c_theta_ * (1.0 + std::sqrt(two_pi) * p_.sigma_theta / delta + repeated);
+    plan.angular_sum = angular_sum;
+    std::vector<double> labels = rows;
+    std::sort(labels.begin(), labels.end());
+    for (auto at = labels.begin(); at != labels.end();) {
+        const auto next = std::upper_bound(at, labels.end(), *at);
+        plan.rows_per_label = std::max(plan.rows_per_label, static_cast<int>(next - at));
+        at = next;
+    }
+    if (p_.elevations.empty() || p_.reading == BvcReading::nearest_beam) return plan;  // reads every row
     const double h_p = 0.5 / (p_.sigma_phi * p_.sigma_phi);
     for (std::size_t i = 0; i < rows.size(); ++i) {
         bool needed = false;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bvc3d/bvc/profile_job.hpp"
+#include "bvc3d/core/aligned.hpp"
 #include "bvc3d/core/params.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
@@ -72,22 +73,31 @@ public:
         std::vector<double> skipped_rows;    // elevations of the rows not needed
         std::vector<double> skipped_bound;   // per layer: bound on their contribution to any cell
         std::size_t beams = 0;               // beams in the full table
+        // Σ_columns c_θ·exp(-x²/2σ_θ²) over one row's columns, for any heading and direction, is at
+        // most angular_sum (a unimodal function summed over a lattice); rows_per_label rows at most
+        // carry the same elevation label.
+        double angular_sum = 0;
+        int rows_per_label = 1;
+        std::size_t columns = 0;  // the sensor's columns per row
         bool skips(double elevation) const {
             return std::find(skipped_rows.begin(), skipped_rows.end(), elevation) != skipped_rows.end();
         }
     };
     ScanPlan plan(const LidarSpec& sensor) const;
-    // Rates from a scan cast with plan.rows (returns of other rows, e.g. cast for another model,
-    // are ignored). Returns false, leaving `out` unspecified, if the truncation bound is not met:
-    // the caller then casts every row and calls rates().
+    // Rates from a scan of the plan's sensor at a level pose, cast with plan.rows (returns of other
+    // rows, e.g. cast for another model, are ignored): its truncation bound takes each row's angular
+    // factors from the plan's lattice bound, so it needs no bookkeeping per return. Returns false,
+    // leaving `out` unspecified, if the bound is not met: the caller then casts every row and calls
+    // rates().
     bool rates_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan, std::span<double> out) const;
 
     // Several models on one scan (an experiment's models sharing a walk): the layers' sums of one
     // (return, layer) pair do not depend on the other layers, so a layer whose parameters equal
     // this one's but for its elevations can read the sums of those it has from a layer that summed
     // their union once. sum_pruned sums (the union's side); rates_pruned_shared gives what
-    // rates_pruned gives, the same bits and its own truncation bound, reading the sums from
-    // `summed` (which must hold every elevation of this layer and have summed the same scan).
+    // rates_pruned gives, the same bits and the same verdict of the truncation bound (which depends
+    // on the scan's rows, not on the sums), reading the sums from `summed` (which must hold every
+    // elevation of this layer and have summed the same scan).
     bool can_share_sums(const BvcParams& other) const;
     void sum_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan) const;
     bool rates_pruned_shared(std::span<const LidarReturn> returns, const ScanPlan& plan,
@@ -97,37 +107,30 @@ public:
     void raw_exact(std::span<const LidarReturn> returns, std::span<double> out) const;
 
 private:
-    // What raw_pruned does: `own` sums and checks its bound (returns false if the bound is not met;
-    // out then holds the pruned sums); `sums` only sums, into padded_, and keeps row totals
-    // (sum_pruned); `bound` only does the bound's bookkeeping, reading the sums from `summed`.
-    enum class Pass { own, sums, bound };
-    bool raw_pruned(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out,
-                    Pass pass = Pass::own, const BoundaryVectorLayer* summed = nullptr) const;
-    template <Pass pass>
-    bool pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan, std::span<double> out,
-                     const BoundaryVectorLayer* summed) const;
-    // The truncation bound's sums (per layer and direction: kept and dropped weights; per layer:
-    // weights and empty-window weights) from `summed`'s row totals, as this layer's own pass would
-    // add them return by return, and the returns counted; false if summed kept none.
-    bool bound_sums_from_rows(const ScanPlan& plan, const BoundaryVectorLayer& summed, std::size_t& valid) const;
+    // The pruned sums of `returns` into padded_, and the bookkeeping of the truncation bound: with a
+    // plan (a beam table's scan), per run of returns of one row: its elevation, the returns counted
+    // and those whose distance window is empty (runs_); without one (any point set), the exact
+    // weights of every pruned term, return by return (kept_weight_ ...). Returns the returns counted.
+    template <bool planned>
+    std::size_t pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan) const;
+    // The pruned sums of any point set into out; false if the bound is not met.
+    bool raw_pruned(std::span<const LidarReturn> returns, std::span<double> out) const;
     // This layer's elevation factors of a row at elevation phi: summed (elev_) and dropped (dropped_e_).
     void row_factors(double phi) const;
-    // The bound sums back to zero, and every pruned term's bound from them (`valid` returns counted).
-    void clear_bound_sums() const;
-    double pruned_bound(const ScanPlan* plan, std::size_t valid) const;
-    // Row totals of the last `sums` pass, per scanner row: its elevation, returns counted, returns with an empty
-    // distance window, and in row_angles_ per direction Σ angular factors of the returns with a window, then of all.
-    struct RowTotal {
+    // The bound on every pruned term of a cell: from the exact weights (no plan), or from `runs`
+    // and the plan's lattice bound; `valid` returns counted.
+    double pruned_bound(std::size_t valid) const;
+    struct Run {
         double elevation;
         std::size_t valid, far;
     };
-    mutable std::vector<RowTotal> row_totals_;
-    mutable std::vector<double> row_angles_;
-    mutable bool rows_complete_ = false;  // false: too many rows (an irregular point set) to keep
+    double planned_bound(const ScanPlan& plan, const std::vector<Run>& runs) const;
+    // The runs of the last planned pass (sum_pruned's, for the layers reading its sums).
+    mutable std::vector<Run> runs_;
     // The nearest_beam reading into `out` (zeroed by the caller). Pruned: only each direction's
     // distance window; returns false if what that drops is not below the pruning tolerance.
     bool raw_nearest_beam(std::span<const LidarReturn> returns, std::span<double> out, bool prune) const;
-    void normalize(std::span<double> out) const;
+    void normalize(std::span<double> out, double largest) const;  // largest: the largest of out
     static void check_return(const LidarReturn& r, std::size_t index);
 
     BvcParams p_;
@@ -137,24 +140,52 @@ private:
     // The directions an azimuth reaches and their angular factors c_θ·exp(-x²/2σ_θ²): a pure
     // function of the azimuth, memoised in a direct-mapped table keyed by the azimuth's bits
     // (scanners repeat the same azimuths row after row, and step after step while the agent does not
-    // turn). Slot s is memo_weight_[s·(n_dir + 1) ...] = key, factors and memo_dir_[same] = count,
-    // directions: two cache lines a lookup. A NaN key never matches.
-    static constexpr std::size_t cache_slots = 1024;
-    // The slot for `azimuth` in (-π, π]: its position on the circle, so a beam table's evenly spaced
-    // columns (up to cache_slots of them) never share a slot. A hit is an add, a multiply and a
-    // compare; a miss fills the slot.
-    static std::size_t slot_of(double azimuth) {
-        const auto s = static_cast<std::size_t>((azimuth + 3.14159265358979323846) * (cache_slots / 6.283185307179586477));
-        return s < cache_slots ? s : cache_slots - 1;
+    // turn). An azimuth reaches at most reach_ directions (3 with the defaults), so the record at
+    // memo_weight_[s·(reach_ + 1) ...] = key, factors and memo_dir_[same] = count, directions, is
+    // small. A NaN key never matches. Irregular point sets (real LiDAR) repeat no azimuth: the memo
+    // would only evict useful cache lines, so their records go to the room after the slots, one per
+    // return of a batch. The numbers are the same either way.
+    //
+    // The slot of an azimuth in (-π, π] is its position on the circle, in memo_slots_ equal parts:
+    // a beam table's evenly spaced columns, as many as the slots or fewer, never share one. A planned
+    // pass makes the slots as many as the sensor's columns, so that a row's records lie side by side
+    // (a few cache lines, which stay in the L1 cache across the rows of a scan).
+    static constexpr std::size_t default_slots = 1024;
+    mutable std::size_t memo_slots_ = 0;
+    mutable double slot_scale_ = 0;  // memo_slots_ / 2π
+    std::size_t slot_of(double azimuth) const {
+        const auto s = static_cast<std::size_t>((azimuth + 3.14159265358979323846) * slot_scale_);
+        return s < memo_slots_ ? s : memo_slots_ - 1;
     }
-    // The directions `azimuth` reaches and their angular factors; returns how many.
-    int angular_weights(double azimuth, int* dir, double* weight) const;
+    void size_memo(std::size_t slots) const;
+    int reach_ = 0;
+    // The directions `azimuth` reaches and their angular factors; returns how many (at most reach_).
+    int angular_weights(double azimuth, std::uint16_t* dir, double* weight) const;
     mutable std::vector<double> memo_weight_;
-    mutable std::vector<int> memo_dir_;
-    // Irregular point sets (real LiDAR) repeat no azimuth: the memo would only evict useful cache
-    // lines, so their factors are computed directly (into direct_*). The numbers are the same.
-    mutable std::vector<int> direct_dir_;
-    mutable std::vector<double> direct_weight_;
+    mutable std::vector<std::uint16_t> memo_dir_;
+    mutable std::vector<std::uint32_t> slot_batch_;  // the batch of feeds that last read each slot
+    mutable std::uint32_t batch_ = 0;
+
+    // pruned_pass's first phase gives, per return that feeds a row: its range, its record, and its
+    // window (from a block of 8 cells); the second (expand_feeds) lists the rows for the kernel with
+    // the row's kept layers fixed: their elevation factors and first offsets in padded_.
+    struct Feed {
+        double range;
+        std::uint32_t record;
+        std::int32_t first_cell, width;
+    };
+    mutable std::vector<Feed> feeds_;
+    mutable std::vector<double> kept_elev_;
+    mutable std::vector<std::size_t> kept_base_;
+    template <bool unplanned>
+    void expand_feeds(std::size_t n_feeds, int n_kept) const;
+    mutable std::size_t n_jobs_ = 0, n_rows_ = 0;  // jobs and rows listed, not yet added
+    template <bool unplanned>
+    void flush_jobs() const;  // into padded_ (unplanned) or row_sums_
+    // A scanner row's sums per direction, Σ A·D over its returns, padded like padded_'s axes; added
+    // to each layer it feeds with that layer's elevation factor, then cleared.
+    mutable std::vector<double, CacheAligned<double>> row_sums_;
+    void add_row_sums(int n_kept) const;
 
     // Scratch for one step (a layer is not shared between threads): the elevation factors of the
     // current row (summed, dropped, their sum) and which layers have them; a batch of returns'
@@ -162,18 +193,26 @@ private:
     // and weights.
     mutable std::vector<double> elev_, dropped_e_, row_factor_;
     mutable std::vector<int> kept_layers_, any_layers_;
-    mutable std::vector<kernels::ProfileJob> jobs_;
+    mutable std::vector<kernels::ProfileJob> jobs_;  // until profile_factors: a holds x0 = r - m·Δ
+    mutable std::vector<double> exp_args_;
+    // The first n_jobs jobs' a and b from their x0 (two batched exps per return).
+    void profile_factors(std::size_t n_jobs) const;
     mutable std::vector<std::uint32_t> job_offset_;
     mutable std::vector<double> job_weight_;
     mutable std::vector<double> kept_weight_, layer_weight_, far_weight_, dropped_weight_;  // truncation bound
-    int axis_stride_ = 0;                 // n_per_axis rounded up to 8, plus 8
-    mutable std::vector<double> padded_;  // sums with padded axes
+    int axis_stride_ = 0;  // n_per_axis rounded up to 8
+    mutable std::vector<double, CacheAligned<double>> padded_;  // sums with padded axes, blocks of 8 cache-aligned
     // This layer's sums (its layers as `from_layer` holds them, padded) into result.
     void copy_sums(const BoundaryVectorLayer& from_layer, std::span<double> result) const;
     // The first padded axis of the layer with `reader`'s layer l's elevation (shared sums).
     std::size_t first_axis(const BvcParams& reader, int l) const;
-    mutable std::vector<std::size_t> best_return_;  // nearest_beam reading
+    std::vector<double> dir_angle_;                  // θ_k = k·2π/n_dir, NaN-padded to a multiple of 8
+    mutable std::vector<std::int64_t> best_return_;  // nearest_beam reading: per direction
     mutable std::vector<double> best_gap_;
+    mutable std::vector<double> near_azimuth_;       // ... the valid returns' azimuths and indices
+    mutable std::vector<std::size_t> near_index_;
+    mutable std::vector<std::size_t> cells_;        // ... its cells to evaluate and their exponents
+    mutable std::vector<double> exponents_;
 };
 
 }  // namespace bvc3d

@@ -1,6 +1,8 @@
 #include "bvc3d/bvc/bvc_kernels.hpp"
 
 #include <array>
+#include <cmath>
+#include <numbers>
 
 #include "bvc3d/core/simd.hpp"
 
@@ -26,28 +28,21 @@ template <int N>
                                             const double* weights, const double* decay, double* sums) {
     using V = typename simd::doubles<N>::type;
     constexpr int P = 8 / N;
-    V lane[P], zero;
-    for (int k = 0; k < N; ++k) zero[k] = 0.0;
-    for (int p = 0; p < P; ++p)
-        for (int k = 0; k < N; ++k) lane[p][k] = p * N + k;
     for (std::size_t j = 0; j < n_jobs; ++j) {
         const ProfileJob& job = jobs[j];
         const double a = job.a, b = job.b;
-        // Eight independent power chains b^(n+t), t = 0..7, stepped by b^8; the first powers come
-        // from a product tree (three multiplications deep rather than eight).
+        // Eight independent chains a·b^(n+t), t = 0..7, stepped by b^8; the first powers come from a
+        // product tree (three multiplications deep rather than eight).
         const double b2 = b * b, b4 = b2 * b2, b8 = b4 * b4;
         std::array<V, P> pw = powers<N, V>(b, b2, b4);
+        for (int p = 0; p < P; ++p) pw[p] *= a;
         const int W = job.width, count = job.rows;
         for (int n = 0; n < W; n += 8) {
             V u[P];
             for (int p = 0; p < P; ++p) {
                 V dec;
                 simd::load(dec, decay + n + p * N);
-                u[p] = a * pw[p] * dec;
-            }
-            if (n + 8 > W) {  // past the window: exact zeros
-                const double left = W - n;
-                for (int p = 0; p < P; ++p) u[p] = lane[p] < left ? u[p] : zero;
+                u[p] = pw[p] * dec;
             }
             for (int i = 0; i < count; ++i) {
                 double* row = sums + offsets[i] + n;
@@ -91,6 +86,47 @@ void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std
     }
 #endif
     profiles<2>(jobs, n_jobs, offsets, weights, decay, sums);
+}
+
+BVC3D_DISPATCH
+void nearest_returns(const double* azimuth, std::size_t n, const double* theta, int n_dir, std::int64_t* best,
+                     double* gap) {
+    typedef std::int64_t i8 __attribute__((vector_size(64)));
+    using simd::d8;
+    const d8 pi = {std::numbers::pi, std::numbers::pi, std::numbers::pi, std::numbers::pi,
+                   std::numbers::pi, std::numbers::pi, std::numbers::pi, std::numbers::pi};
+    const d8 two_pi = pi + pi, zero = pi - pi;
+    for (int k = 0; k < n_dir; k += 8) {  // eight directions at once; a NaN lane is never nearer
+        d8 th, nearest = zero + INFINITY;
+        simd::load(th, theta + k);
+        i8 which = (i8{} + static_cast<std::int64_t>(n));
+        for (std::size_t i = 0; i < n; ++i) {
+            d8 g = azimuth[i] - th;  // in (-3π, π]: one correction wraps it
+            g = g <= -pi ? g + two_pi : g;
+            g = g < zero ? -g : g;
+            const auto nearer = g < nearest;
+            nearest = nearer ? g : nearest;
+            which = nearer ? (i8{} + static_cast<std::int64_t>(i)) : which;
+        }
+        simd::store(gap + k, nearest);
+        simd::store(best + k, which);
+    }
+}
+
+BVC3D_DISPATCH
+double largest(const double* v, std::size_t n) {
+    if (n == 0) return 0.0;
+    simd::d8 m = {v[0], v[0], v[0], v[0], v[0], v[0], v[0], v[0]};
+    std::size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        simd::d8 x;
+        simd::load(x, v + i);
+        m = x > m ? x : m;
+    }
+    double best = m[0];
+    for (int k = 1; k < 8; ++k) best = m[k] > best ? m[k] : best;
+    for (; i < n; ++i) best = v[i] > best ? v[i] : best;
+    return best;
 }
 
 }  // namespace bvc3d::kernels

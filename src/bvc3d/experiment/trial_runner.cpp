@@ -57,16 +57,13 @@ struct GroupRun {
     std::vector<int> shared_of;
     std::vector<PlaceCellNetwork> nets;
     std::vector<std::vector<double>> bvc_rates;
-    // Place-cell steps wait here until `block` of them are due; then each model takes its steps in a
-    // row, so its weights stay in cache between them (a thread stepping four models reads 4 × 960 KB
-    // of weights per walk step otherwise, more than a 2 MB L2 holds). A step's BVC rates do not
-    // depend on the place cells, so only the timing changes, not a bit of the results.
-    struct Due {
-        bool learn, record;
-    };
-    std::vector<Due> due;
-    std::vector<std::vector<double>> due_rates;  // per model: due.size() × n_bvc
-    std::size_t block = 1;
+    // Place-cell steps wait here until `block` of them are due; then each model takes them in one
+    // PlaceCellNetwork::step_block, which reads its weights once for every 8 steps (a thread stepping
+    // four models read 4 × 960 KB of weights per walk step otherwise, more than an L2 holds). A step's
+    // BVC rates do not depend on the place cells, so only the timing changes, not a bit of the results.
+    static constexpr std::size_t block = 16;
+    std::vector<char> due_learn, due_record;
+    std::vector<std::vector<double>> due_rates;  // per model: due_learn.size() × n_bvc
     GroupResult result;
     std::int64_t step_index = 0;
     std::size_t ckpt_segments = 0, ckpt_saved = 0;  // samples already in checkpoint segments
@@ -100,8 +97,6 @@ GroupRun::GroupRun(const World* w, const std::vector<TrialConfig>& t, const Sour
         result.models.push_back(std::move(rec));
     }
     share_sums();
-    // One model's weights stay in cache anyway: block only when several share the walk.
-    block = nets.size() > 1 ? 16 : 1;
     due_rates.resize(nets.size());
     for (std::size_t i = 0; i < nets.size(); ++i) due_rates[i].reserve(block * bvc_rates[i].size());
     // Room for the samples a full recording phase can hold, so growing buffers never double past
@@ -198,8 +193,9 @@ void GroupRun::step(const ModelStep& s, bool learn, bool record) {
         if (record && trials.front().protocol.record_bvc)
             for (double b : bvc_rates[i]) result.models[i].bvc.push_back(static_cast<float>(b));
     }
-    due.push_back({learn, record});
-    if (due.size() >= block) run_place_cells();
+    due_learn.push_back(learn);
+    due_record.push_back(record);
+    if (due_learn.size() >= block) run_place_cells();
     if (record) {
         const Pose& logged = s.logged();  // the scan's pose unless the agent logs with a lag
         result.t.push_back(s.t);
@@ -215,15 +211,15 @@ void GroupRun::step(const ModelStep& s, bool learn, bool record) {
 
 void GroupRun::run_place_cells() {
     for (std::size_t i = 0; i < nets.size(); ++i) {
-        const std::size_t n = bvc_rates[i].size();
+        const auto v = nets[i].step_block(due_rates[i], due_learn);
         auto& rec = result.models[i];
-        for (std::size_t k = 0; k < due.size(); ++k) {
-            const auto v = nets[i].step(std::span<const double>(due_rates[i].data() + k * n, n), due[k].learn);
-            if (due[k].record) rec.rates.insert(rec.rates.end(), v.begin(), v.end());
-        }
+        const std::size_t n = static_cast<std::size_t>(nets[i].n_place());
+        for (std::size_t k = 0; k < due_record.size(); ++k)
+            if (due_record[k]) rec.rates.insert(rec.rates.end(), v.begin() + k * n, v.begin() + (k + 1) * n);
         due_rates[i].clear();
     }
-    due.clear();
+    due_learn.clear();
+    due_record.clear();
 }
 
 GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {

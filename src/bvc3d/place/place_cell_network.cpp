@@ -48,46 +48,81 @@ PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::ui
     v_.assign(p_.n_place, 0.0f);
     drive_.assign(2 * static_cast<std::size_t>(pairs()), 0.0f);
     vb_.assign(stride_, 0.0f);
-    vb2_.assign(2 * stride_, 0.0f);
 }
 
-std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates, bool learn) {
+void PlaceCellNetwork::inputs(std::span<const double> bvc_rates, float* vb) const {
     if (bvc_rates.size() != static_cast<std::size_t>(n_bvc_))
         throw InputError("place cells: expected " + std::to_string(n_bvc_) + " BVC rates, got " +
                          std::to_string(bvc_rates.size()));
-    for (int j = 0; j < n_bvc_; ++j) {
-        if (!std::isfinite(bvc_rates[j])) throw InputError("place cells: BVC rate " + std::to_string(j) + " is not finite");
-        vb_[j] = flush_tiny(static_cast<float>(bvc_rates[j]));
-        vb2_[kernels::paired_column(j)] = vb2_[kernels::paired_column(j) + 8] = vb_[j];
-    }
+    const std::size_t bad = kernels::to_floats(bvc_rates.data(), vb, bvc_rates.size(), tiny_operand);
+    if (bad < bvc_rates.size()) throw InputError("place cells: BVC rate " + std::to_string(bad) + " is not finite");
+}
+
+void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, std::vector<int>* learned) {
     const float k = static_cast<float>(p_.dt_over_tau);
     // Inhibition uses the BVC total and the place cells' previous rates.
-    const float inhibition = static_cast<float>(p_.gamma_pb) * kernels::sum8(vb_.data(), stride_) +
+    const float inhibition = static_cast<float>(p_.gamma_pb) * kernels::sum8(vb, stride_) +
                              static_cast<float>(p_.gamma_pp) * [&] {
                                  float s = 0;
                                  for (float v : v_) s += v;
                                  return s;
                              }();
     const float gain = static_cast<float>(p_.gain);
-    kernels::paired_matvec(w_.data(), pair_stride(), vb2_.data(), stride_, pairs(), drive_.data());
     for (int i = 0; i < p_.n_place; ++i) {
-        s_[i] = s_[i] + k * (-s_[i] + drive_[i] - inhibition);
-        v_[i] = std::tanh(gain * std::max(s_[i], 0.0f));
+        s_[i] = s_[i] + k * (-s_[i] + drive[i] - inhibition);
+        // tanh(g·[s]+), but for a silent cell (the argument ±0, or NaN) the argument is its own tanh.
+        const float x = gain * std::max(s_[i], 0.0f);
+        v_[i] = s_[i] > 0.0f ? std::tanh(x) : x;
     }
     // Weights that ran away (a learning rate far too large) show up here first: stop early.
     if (!std::isfinite(inhibition) || !std::all_of(s_.begin(), s_.end(), [](float x) { return std::isfinite(x); }))
         throw InputError("place cells diverged (non-finite membrane potentials): the weights ran away; is the "
                          "learning rate eta = " + std::to_string(p_.eta) + " too large?");
-    if (learn && p_.eta > 0) {
-        // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
-        const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
-        for (int i = 0; i < p_.n_place; ++i) {
-            const float vi = v_[i];
-            if (vi == 0.0f) continue;
-            kernels::oja_row(row(i), vb_.data(), eta * vi, vi * inv_alpha, tiny_operand, stride_);
+    if (!learn || !(p_.eta > 0)) return;
+    // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
+    const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
+    for (int i = 0; i < p_.n_place; ++i) {
+        const float vi = v_[i];
+        if (vi == 0.0f) continue;
+        kernels::oja_row(row(i), vb, eta * vi, vi * inv_alpha, tiny_operand, stride_);
+        if (learned && !is_learned_[i]) {
+            is_learned_[i] = 1;
+            learned->push_back(i);
         }
     }
+}
+
+std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates, bool learn) {
+    inputs(bvc_rates, vb_.data());
+    kernels::paired_products(w_.data(), pair_stride(), vb_.data(), stride_, stride_, pairs(), 1, drive_.data(), 0);
+    advance(drive_.data(), vb_.data(), learn, nullptr);
     return v_;
+}
+
+std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_rates, std::span<const char> learn) {
+    const std::size_t steps = learn.size(), n = static_cast<std::size_t>(n_bvc_);
+    if (bvc_rates.size() != steps * n)
+        throw InputError("place cells: expected " + std::to_string(steps) + " × " + std::to_string(n_bvc_) +
+                         " BVC rates, got " + std::to_string(bvc_rates.size()));
+    // Every input is checked before the state changes.
+    vb_.resize(std::max<std::size_t>(steps, 1) * stride_, 0.0f);
+    for (std::size_t t = 0; t < steps; ++t) inputs(bvc_rates.subspan(t * n, n), vb_.data() + t * stride_);
+    const std::size_t drive_stride = 2 * static_cast<std::size_t>(pairs());
+    drive_.resize(std::max<std::size_t>(steps, 1) * drive_stride);
+    kernels::paired_products(w_.data(), pair_stride(), vb_.data(), stride_, stride_, pairs(), static_cast<int>(steps),
+                             drive_.data(), drive_stride);
+    block_rates_.resize(steps * static_cast<std::size_t>(p_.n_place));
+    learned_.clear();
+    is_learned_.assign(p_.n_place, 0);
+    for (std::size_t t = 0; t < steps; ++t) {
+        float* drive = drive_.data() + t * drive_stride;
+        const float* vb = vb_.data() + t * stride_;
+        // The products of rows changed since the block began, with their weights as they are now.
+        for (int i : learned_) drive[i] = kernels::paired_row_product(row(i), vb, stride_);
+        advance(drive, vb, learn[t] != 0, &learned_);
+        std::copy(v_.begin(), v_.end(), block_rates_.begin() + static_cast<std::ptrdiff_t>(t * p_.n_place));
+    }
+    return block_rates_;
 }
 
 std::vector<float> PlaceCellNetwork::weights() const {

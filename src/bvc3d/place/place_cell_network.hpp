@@ -41,6 +41,11 @@ public:
 
     // One Euler step of the membrane, new rates, and (if learn) one Oja update. Returns the rates.
     std::span<const float> step(std::span<const double> bvc_rates, bool learn);
+    // learn.size() steps at once, step t reading bvc_rates[t·n_bvc ...] and learning if learn[t]: the
+    // same bits as that many calls of step(). Returns every step's rates (steps × n_place, row-major).
+    // One pass over the weights serves every 8 steps; the rows Oja's rule changes within the block
+    // (the few active cells) are multiplied again for the steps after.
+    std::span<const float> step_block(std::span<const double> bvc_rates, std::span<const char> learn);
 
     std::span<const float> rates() const { return v_; }
     std::span<const float> membrane() const { return s_; }
@@ -59,12 +64,20 @@ private:
     float* row(int i) { return w_.data() + static_cast<std::size_t>(i / 2) * pair_stride() + 8 * (i % 2); }
     const float* row(int i) const { return w_.data() + static_cast<std::size_t>(i / 2) * pair_stride() + 8 * (i % 2); }
     int pairs() const { return (p_.n_place + 1) / 2; }
+    // BVC rates as the network's float inputs (vb: stride_ entries, padding 0); throws on a non-finite rate.
+    void inputs(std::span<const double> bvc_rates, float* vb) const;
+    // The membrane and rates from this step's drive (W·vb) and inputs, then Oja's update if learn;
+    // `learned` (if not null) collects the rows the update changed.
+    void advance(const float* drive, const float* vb, bool learn, std::vector<int>* learned);
 
     int n_bvc_;
     std::size_t stride_;  // n_bvc rounded up to a multiple of 8; padding (and an odd count's last row) stays 0
     PlaceParams p_;
-    std::vector<float, CacheAligned<float>> w_, vb2_;  // vb2_: the BVC rates in the paired layout
+    std::vector<float, CacheAligned<float>> w_;
     std::vector<float> s_, v_, vb_, drive_;
+    std::vector<float> block_rates_;  // step_block's results
+    std::vector<int> learned_;        // rows Oja's rule changed within a block
+    std::vector<char> is_learned_;
 };
 
 }  // namespace bvc3d

@@ -17,70 +17,138 @@ struct floats {
     typedef float type __attribute__((vector_size(4 * N)));
 };
 
-// P pairs (2P rows) at once, with vectors of N floats (16: a pair's block in one AVX-512 register;
-// 8: one row's block). The 2P rows' accumulator chains share each load of v: the loop runs at the
-// machine's multiply and add throughput, not at an add's latency. Every lane does what a one-row
-// loop of 8 lanes does, whatever N and P: the bits do not change. P·16/N = 8 chains: two FP ports ×
-// an add's 3–4 cycles of latency need 6–8 in flight; 16 spill registers.
-template <int N, int P>
-[[gnu::always_inline]] inline void pairs_times(const float* W, std::size_t pair_stride, const float* v2, std::size_t n,
-                                               float* out) {
-    using V = typename floats<N>::type;
-    constexpr int H = 16 / N;  // vectors per pair block
-    V acc[P][H];
-    for (int p = 0; p < P; ++p)
-        for (int h = 0; h < H; ++h) acc[p][h] = V{};
-    for (std::size_t j = 0; j < 2 * n; j += 16) {
-        V b[H];
-        for (int h = 0; h < H; ++h) simd::load(b[h], v2 + j + h * N);
-        for (int p = 0; p < P; ++p)
-            for (int h = 0; h < H; ++h) {
-                V a;
-                simd::load(a, W + p * pair_stride + j + h * N);
-                acc[p][h] += a * b[h];
-            }
-    }
-    for (int p = 0; p < P; ++p) {
-        if constexpr (N == 16) {
-            out[2 * p] = reduce8(acc[p][0], 0);
-            out[2 * p + 1] = reduce8(acc[p][0], 8);
-        } else {
-            out[2 * p] = reduce8(acc[p][0], 0);
-            out[2 * p + 1] = reduce8(acc[p][1], 0);
-        }
-    }
+// Columns 8b..8b+7 of v as the vector that multiplies a pair's block: twice over (16 lanes, both rows
+// of the pair) or once (8 lanes, one row).
+template <int N>
+[[gnu::always_inline]] inline void columns(typename floats<N>::type& out, const float* v) {
+    f8 x;
+    simd::load(x, v);
+    if constexpr (N == 16) out = __builtin_shufflevector(x, x, 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7);
+    else out = x;
 }
 
-template <int N>
-[[gnu::always_inline]] inline void paired(const float* W, std::size_t pair_stride, const float* v2, std::size_t n,
-                                          int pairs, float* out) {
-    constexpr int P = N == 16 ? 8 : 4;
-    int p = 0;
-    for (; p + P <= pairs; p += P) pairs_times<N, P>(W + p * pair_stride, pair_stride, v2, n, out + 2 * p);
-    for (; p < pairs; ++p) pairs_times<N, 1>(W + p * pair_stride, pair_stride, v2, n, out + 2 * p);
+// T steps × P pairs (2P rows) at once, with vectors of N floats (16: a pair's block in one AVX-512
+// register; 8: one row's block). Each weight block is loaded once for the T steps, and the T·2P
+// accumulator chains keep both FP ports busy. Every lane does what a one-row, one-step loop of 8 lanes
+// does, whatever N, P and T: the bits do not change.
+template <int N, int P, int T>
+[[gnu::always_inline]] inline void tile(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride,
+                                        std::size_t n, float* out, std::size_t out_stride) {
+    using V = typename floats<N>::type;
+    constexpr int H = 16 / N;  // vectors per pair block
+    V acc[T][P][H];
+    for (int t = 0; t < T; ++t)
+        for (int p = 0; p < P; ++p)
+            for (int h = 0; h < H; ++h) acc[t][p][h] = V{};
+    for (std::size_t b = 0; b < n; b += 8) {
+        V w[P][H];
+        for (int p = 0; p < P; ++p)
+            for (int h = 0; h < H; ++h) simd::load(w[p][h], W + p * pair_stride + 2 * b + h * N);
+        for (int t = 0; t < T; ++t) {
+            V x;
+            columns<N>(x, v + t * v_stride + b);
+            for (int p = 0; p < P; ++p)
+                for (int h = 0; h < H; ++h) acc[t][p][h] += w[p][h] * x;
+        }
+    }
+    for (int t = 0; t < T; ++t)
+        for (int p = 0; p < P; ++p) {
+            float* o = out + t * out_stride + 2 * p;
+            if constexpr (N == 16) {
+                o[0] = reduce8(acc[t][p][0], 0);
+                o[1] = reduce8(acc[t][p][0], 8);
+            } else {
+                o[0] = reduce8(acc[t][p][0], 0);
+                o[1] = reduce8(acc[t][p][1], 0);
+            }
+        }
+}
+
+// Tiles of TB steps × PB pairs (registers: TB·PB·16/N accumulators), then single pairs, then single
+// steps. One step: PS pairs at a time, so that 6-8 chains are in flight (two FP ports × an add's 3-4
+// cycles of latency).
+template <int N, int PS, int PB, int TB>
+[[gnu::always_inline]] inline void products(const float* W, std::size_t pair_stride, const float* v,
+                                            std::size_t v_stride, std::size_t n, int pairs, int steps, float* out,
+                                            std::size_t out_stride) {
+    int t = 0;
+    for (; t + TB <= steps && TB > 1; t += TB) {
+        int p = 0;
+        for (; p + PB <= pairs; p += PB)
+            tile<N, PB, TB>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
+                            out_stride);
+        for (; p < pairs; ++p)
+            tile<N, 1, TB>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
+                           out_stride);
+    }
+    for (; t < steps; ++t) {
+        int p = 0;
+        for (; p + PS <= pairs; p += PS)
+            tile<N, PS, 1>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
+                           out_stride);
+        for (; p < pairs; ++p)
+            tile<N, 1, 1>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
+                          out_stride);
+    }
 }
 
 #if BVC3D_HAVE_DISPATCH
-BVC3D_TARGET_V4 void paired_v4(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs,
-                               float* out) {
-    paired<16>(W, pair_stride, v2, n, pairs, out);
+// AVX-512: 32 registers; AVX2: 16.
+BVC3D_TARGET_V4 void products_v4(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride,
+                                 std::size_t n, int pairs, int steps, float* out, std::size_t out_stride) {
+    products<16, 8, 2, 8>(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
 }
-BVC3D_TARGET_V3 void paired_v3(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs,
-                               float* out) {
-    paired<8>(W, pair_stride, v2, n, pairs, out);
+BVC3D_TARGET_V3 void products_v3(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride,
+                                 std::size_t n, int pairs, int steps, float* out, std::size_t out_stride) {
+    products<8, 4, 1, 4>(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
 }
 #endif
 }  // namespace
 
-void paired_matvec(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs, float* out) {
+void paired_products(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride, std::size_t n,
+                     int pairs, int steps, float* out, std::size_t out_stride) {
 #if BVC3D_HAVE_DISPATCH
     switch (simd::isa()) {
-        case simd::Isa::v4: return paired_v4(W, pair_stride, v2, n, pairs, out);
-        case simd::Isa::v3: return paired_v3(W, pair_stride, v2, n, pairs, out);
+        case simd::Isa::v4: return products_v4(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
+        case simd::Isa::v3: return products_v3(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
         case simd::Isa::baseline: break;
     }
 #endif
-    paired<8>(W, pair_stride, v2, n, pairs, out);
+    products<8, 4, 1, 2>(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
+}
+
+BVC3D_DISPATCH
+float paired_row_product(const float* w, const float* v, std::size_t n) {
+    f8 acc = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (std::size_t b = 0; b < n; b += 8) {
+        f8 a, x;
+        simd::load(a, w + 2 * b);
+        simd::load(x, v + b);
+        acc += a * x;
+    }
+    return reduce8(acc, 0);
+}
+
+BVC3D_DISPATCH
+std::size_t to_floats(const double* in, float* out, std::size_t n, float tiny) {
+    const f8 lo = {tiny, tiny, tiny, tiny, tiny, tiny, tiny, tiny}, zero = {0, 0, 0, 0, 0, 0, 0, 0};
+    std::size_t j = 0;
+    for (; j + 8 <= n; j += 8) {
+        simd::d8 x;
+        simd::load(x, in + j);
+        const simd::d8 finite = x - x;  // 0 for a finite x, NaN otherwise
+        if (!(finite[0] == 0 && finite[1] == 0 && finite[2] == 0 && finite[3] == 0 && finite[4] == 0 &&
+              finite[5] == 0 && finite[6] == 0 && finite[7] == 0))
+            break;
+        const f8 f = __builtin_convertvector(x, f8);
+        simd::store(out + j, (f < lo) & (f > -lo) ? zero : f);
+    }
+    for (; j < n; ++j) {
+        if (!(in[j] - in[j] == 0)) return j;
+        const float f = static_cast<float>(in[j]);
+        out[j] = f < tiny && f > -tiny ? 0.0f : f;
+    }
+    return n;
 }
 
 BVC3D_DISPATCH

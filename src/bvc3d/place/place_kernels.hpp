@@ -12,9 +12,17 @@ namespace bvc3d::kernels {
 // Where column j of a row sits, counted from the row's first block (row 2p+h: W + p·pair_stride + 8h).
 inline std::size_t paired_column(std::size_t j) { return (j / 8) * 16 + j % 8; }
 
-// out[2p + h] = Σ_j W_(2p+h)[j]·v[j] for p < pairs, h = 0, 1; `v2` is v in the paired layout of one
-// pair (each block of 8 twice: v2[16b + 8h + k] = v[8b + k]); n is a multiple of 8.
-void paired_matvec(const float* W, std::size_t pair_stride, const float* v2, std::size_t n, int pairs, float* out);
+// For each step t < steps: out[t·out_stride + i] = Σ_j W_i[j]·v_t[j] for every row i < 2·pairs, with
+// v_t = v + t·v_stride (plain layout, n entries, n a multiple of 8). Each row's sum is the same
+// sequence of operations whatever `steps` (8 lanes, then reduce8): one pass over the weights serves up
+// to 8 steps (one load of a weight block feeds 8 products) and gives the bits a pass per step gives.
+void paired_products(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride, std::size_t n,
+                     int pairs, int steps, float* out, std::size_t out_stride);
+// Row `w` (its first block; blocks 16 floats apart) times v: the bits of paired_products for that row.
+float paired_row_product(const float* w, const float* v, std::size_t n);
+// out[j] = (float)in[j] for j < n, a result smaller than `tiny` in magnitude stored as 0; returns the
+// index of the first non-finite in[j] (then out is unspecified), or n.
+std::size_t to_floats(const double* in, float* out, std::size_t n, float tiny);
 // Σ_j v[j], n a multiple of 8.
 float sum8(const float* v, std::size_t n);
 // Oja's update of one row in the paired layout (w: its first block; its blocks are 16 floats apart):

@@ -1,5 +1,6 @@
 #include "bvc3d/sensor/lidar.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "bvc3d/core/angles.hpp"
@@ -123,32 +124,9 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
         scan_tilted(world, pose, out, noise);
         return;
     }
-    const std::size_t n_rows = spec_.elevations.size(), n_cols = column_azimuth_.size();
+    const std::size_t n_rows = spec_.elevations.size();
     if (!rows.empty() && rows.size() != n_rows) throw InputError("row mask has the wrong length");
     const Vec3 origin(pose.x, pose.y, pose.z + spec_.height);
-    const bool noisy = spec_.range_noise_sd > 0 || spec_.dropout > 0;
-
-    // Allocentric azimuths (exact; docs/model-reference.md#conventions) and the horizontal unit
-    // vectors of the columns: the robot-frame table rotated by the heading, which saves a sin and
-    // cos per beam.
-    azimuths_.resize(n_cols);
-    horizontal_.resize(n_cols);
-    const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);
-    // The image rolled by whole columns (HeadingRoll::whole_columns): the heading in [0, 2π), truncated.
-    std::size_t roll = 0;
-    if (spec_.heading_roll == HeadingRoll::whole_columns) {
-        double h = std::fmod(pose.heading, two_pi);
-        if (h < 0) h += two_pi;
-        roll = static_cast<std::size_t>(std::floor(h / (two_pi / static_cast<double>(n_cols)))) % n_cols;
-    }
-    for (std::size_t j = 0; j < n_cols; ++j) {
-        if (spec_.heading_roll == HeadingRoll::whole_columns)
-            azimuths_[j] = wrap_pi(column_label_[(j + roll) % n_cols]);
-        else
-            azimuths_[j] = wrap_pi(pose.heading + column_label_[j]);
-        horizontal_[j] = Vec2(ch * column_cos_[j] - sh * column_sin_[j], sh * column_cos_[j] + ch * column_sin_[j]);
-    }
-    const std::vector<double>& row_label = spec_.row_labels();
     // Every row to cast in one call, column by column: the rays of one ray packet then share an
     // azimuth or two and meet the same walls, which Embree traverses a third faster than packets
     // that sweep 16 columns of one row. Each ray's range is its own; the returns keep the beam
@@ -156,21 +134,85 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
     cast_rows_.clear();
     for (std::size_t i = 0; i < n_rows; ++i)
         if (rows.empty() || rows[i]) cast_rows_.push_back(i);
-    const std::size_t n_cast = cast_rows_.size();
+    set_azimuths(pose.heading);
+    set_beams(pose.heading);
+    world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
+    if (spec_.range_noise_sd > 0 || spec_.dropout > 0) write_noisy_returns(out, noise);
+    else write_returns(out);
+}
+
+// The beams of the cast rows, column by column: each column's horizontal unit vector (the
+// robot-frame table rotated by the heading, which saves a sin and cos per beam) scaled by each
+// row's cos(elevation).
+void Lidar::set_beams(double heading) const {
+    const std::size_t n_cols = column_azimuth_.size(), n_cast = cast_rows_.size();
+    const double ch = std::cos(heading), sh = std::sin(heading);
+    horizontal_.resize(n_cols);
+    for (std::size_t j = 0; j < n_cols; ++j)
+        horizontal_[j] = Vec2(ch * column_cos_[j] - sh * column_sin_[j], sh * column_cos_[j] + ch * column_sin_[j]);
     dirs_.resize(n_cols * n_cast);
     ranges_.resize(n_cols * n_cast);
-    for (std::size_t j = 0; j < n_cols; ++j)
-        for (std::size_t c = 0; c < n_cast; ++c) {
-            const std::size_t i = cast_rows_[c];
-            dirs_[j * n_cast + c] = Vec3(cos_el_[i] * horizontal_[j].x(), cos_el_[i] * horizontal_[j].y(), sin_el_[i]);
+    const Vec2* h = horizontal_.data();
+    for (std::size_t c = 0; c < n_cast; ++c) {
+        const double ce = cos_el_[cast_rows_[c]], se = sin_el_[cast_rows_[c]];
+        Vec3* d = dirs_.data() + c;
+        for (std::size_t j = 0; j < n_cols; ++j) d[j * n_cast] = Vec3(ce * h[j].x(), ce * h[j].y(), se);
+    }
+}
+
+// Allocentric azimuths of the columns (exact; docs/model-reference.md#conventions), or the labels
+// the image rolled by whole columns carries (HeadingRoll::whole_columns).
+void Lidar::set_azimuths(double heading) const {
+    const std::size_t n_cols = column_azimuth_.size();
+    azimuths_.resize(n_cols);
+    if (spec_.heading_roll == HeadingRoll::exact) {
+        // The labels increase with the column, and so do their sums with the heading (rounding is
+        // monotonic). When these lie in (-π, 3π), wrap_pi keeps those up to π and turns the others
+        // back by 2π: two loops split at the first column past π do it without a branch per column.
+        const double* label = column_label_.data();
+        if (heading + label[0] > -pi && heading + label[n_cols - 1] < 3 * pi) {
+            const std::size_t turn = static_cast<std::size_t>(
+                std::partition_point(label, label + n_cols, [&](double l) { return heading + l <= pi; }) - label);
+            for (std::size_t j = 0; j < turn; ++j) azimuths_[j] = heading + label[j];
+            for (std::size_t j = turn; j < n_cols; ++j) azimuths_[j] = (heading + label[j]) - two_pi;
+            return;
         }
-    world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
+        for (std::size_t j = 0; j < n_cols; ++j) azimuths_[j] = wrap_pi(heading + label[j]);
+        return;
+    }
+    // The heading in [0, 2π), truncated to whole columns.
+    double h = std::fmod(heading, two_pi);
+    if (h < 0) h += two_pi;
+    const auto roll = static_cast<std::size_t>(std::floor(h / (two_pi / static_cast<double>(n_cols)))) % n_cols;
+    for (std::size_t j = 0; j < n_cols; ++j) azimuths_[j] = wrap_pi(column_label_[(j + roll) % n_cols]);
+}
+
+// The hits of the cast rows (ranges_, column by column) as returns, row by row.
+void Lidar::write_returns(Scan& out) const {
+    const std::size_t n_cols = azimuths_.size(), n_cast = cast_rows_.size();
     out.reserve(n_cols * n_cast);
+    const double* azimuth = azimuths_.data();
+    const double* range = ranges_.data();
+    const std::vector<double>& row_label = spec_.row_labels();
+    for (std::size_t c = 0; c < n_cast; ++c) {
+        const double elevation = row_label[cast_rows_[c]];
+        for (std::size_t j = 0; j < n_cols; ++j) {
+            const double r = range[j * n_cast + c];
+            if (r != RayCaster::no_hit) out.push_back({r, azimuth[j], elevation});
+        }
+    }
+}
+
+// The same with range noise and dropout: a beam's noise depends on its index in the beam table.
+void Lidar::write_noisy_returns(Scan& out, const NoiseKey& noise) const {
+    const std::size_t n_cols = azimuths_.size(), n_cast = cast_rows_.size();
+    out.reserve(n_cols * n_cast);
+    const std::vector<double>& row_label = spec_.row_labels();
     for (std::size_t c = 0; c < n_cast; ++c) {
         const std::size_t i = cast_rows_[c];
         for (std::size_t j = 0; j < n_cols; ++j) {
             double r = ranges_[j * n_cast + c];
-            if (r == RayCaster::no_hit || (noisy && !add_noise(r, noise, i * n_cols + j))) continue;
+            if (r == RayCaster::no_hit || !add_noise(r, noise, i * n_cols + j)) continue;
             out.push_back({r, azimuths_[j], row_label[i]});
         }
     }

@@ -106,6 +106,12 @@ public:
 
 private:
     void scan_tilted(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise) const;
+    // The steps of a level scan: the columns' azimuths_, the cast rows' dirs_ (and ranges_ sized
+    // for them), then the returns from ranges_ into the cleared `out`.
+    void set_azimuths(double heading) const;
+    void set_beams(double heading) const;
+    void write_returns(Scan& out) const;
+    void write_noisy_returns(Scan& out, const NoiseKey& noise) const;
     // Adds the beam's noise to r; false if the beam drops out or leaves (0, max_range].
     bool add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) const;
 

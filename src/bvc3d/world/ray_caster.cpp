@@ -28,6 +28,14 @@ void check_device(RTCDevice device, const char* what) {
         throw std::runtime_error(std::string("Embree error ") + std::to_string(static_cast<int>(e)) + " in " + what);
 }
 
+// Lane k of a ray packet points along dir (in float).
+template <class RayHitN>
+void set_direction(RayHitN& rh, int k, const Vec3& dir) {
+    rh.ray.dir_x[k] = static_cast<float>(dir.x());
+    rh.ray.dir_y[k] = static_cast<float>(dir.y());
+    rh.ray.dir_z[k] = static_cast<float>(dir.z());
+}
+
 }  // namespace
 
 RayCaster::RayCaster(const TriangleMesh& mesh, const std::vector<SphereSet>& spheres)
@@ -80,26 +88,62 @@ RayCaster::RayCaster(const TriangleMesh& mesh, const std::vector<SphereSet>& sph
     if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) impl_->packet = 16;
     else if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) impl_->packet = 8;
 
-    planes_.reserve(mesh.size());
+    planes_.reserve(mesh.size() + 1);
+    corners_.reserve(mesh.size() + 1);
     for (std::size_t t = 0; t < mesh.size(); ++t) {
         const auto c = mesh.corners(t);
         const Vec3 normal = (c[1] - c[0]).cross(c[2] - c[0]);
-        planes_.push_back({normal, c[0], 1e-9 * normal.norm()});
+        planes_.push_back({normal, 1e-9 * normal.norm()});
+        corners_.push_back(c[0]);
     }
+    // What refine reads for the rays that hit no triangle (and then redoes): any plane.
+    planes_.push_back({Vec3::UnitZ(), 0.0});
+    corners_.push_back(Vec3::Zero());
 }
 
 RayCaster::~RayCaster() = default;
 
-double RayCaster::refine(unsigned geom, unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const {
+// The ranges of a packet's rays, in passes over the whole packet so that the divisions of the plane
+// solves and the tests after them vectorize. A ray that is not a triangle hit at a clear angle (a
+// miss, a sphere, a grazing ray) goes through them on a stand-in plane with a denominator of 1,
+// and is then redone on its own.
+template <int N, class RayHitN>
+void RayCaster::refine(const RayHitN& rh, const Call& call, std::span<const Vec3> dirs,
+                       std::span<double> ranges) const {
+    const std::size_t n = dirs.size();
+    const Plane* planes = planes_.data();
+    const unsigned first_sphere = first_sphere_geom_, none = static_cast<unsigned>(planes_.size() - 1);
+    alignas(64) double num[N], den[N];
+    unsigned others = 0;  // a bit per ray that is not a triangle hit at a clear angle
+    for (std::size_t k = 0; k < n; ++k) {
+        const unsigned geom = rh.hit.geomID[k], prim = rh.hit.primID[k];
+        const bool triangle = geom < first_sphere;  // a miss's ID is the largest
+        const unsigned t = triangle ? prim : none;
+        const double d = planes[t].normal.dot(dirs[k]);
+        // Grazing rays: the plane solve is ill-conditioned, Embree's float distance is better.
+        const bool other = !triangle || !(std::abs(d) > planes[t].grazing);
+        den[k] = other ? 1.0 : d;  // no division by zero for the rays redone below
+        num[k] = planes[t].normal.dot(corners_[t] - call.origin);
+        others |= static_cast<unsigned>(other) << k;
+    }
+    const double max_range = call.max_range;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double r = std::max(0.0, num[k] / den[k]);
+        ranges[k] = r > max_range ? no_hit : r;
+    }
+    for (std::size_t k = 0; others; ++k, others >>= 1)
+        if (others & 1) ranges[k] = refine_other(rh.hit.geomID[k], rh.hit.primID[k], call, dirs[k], rh.ray.tfar[k]);
+}
+
+// A ray that missed, hit a sphere or grazed a triangle.
+double RayCaster::refine_other(unsigned geom, unsigned prim, const Call& call, const Vec3& dir, float t_float) const {
+    if (geom == RTC_INVALID_GEOMETRY_ID) return no_hit;
+    double r = t_float;  // a grazing ray
     if (geom >= first_sphere_geom_) {
         const SphereSet& set = spheres_[geom - first_sphere_geom_];
-        return refine_sphere(set.centers[prim], set.radius, origin, dir, t_float);
+        r = refine_sphere(set.centers[prim], set.radius, call.origin, dir, t_float);
     }
-    const Plane& p = planes_[prim];
-    const double nd = p.normal.dot(dir);
-    // Grazing rays: the plane solve is ill-conditioned, Embree's float distance is better.
-    if (std::abs(nd) <= p.grazing) return t_float;
-    return std::max(0.0, p.normal.dot(p.point - origin) / nd);
+    return r > call.max_range ? no_hit : r;
 }
 
 double RayCaster::refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir,
@@ -124,15 +168,17 @@ double RayCaster::cast(const Vec3& origin, const Vec3& dir, double max_range) co
 }
 
 // Packets of N rays from a common origin through rtcIntersect{4,8,16}. The fields every ray of the
-// call shares are written once; each packet writes its directions and resets its hit.
+// call shares are written once (Embree writes instID[0] only with the context's, invalid, value);
+// each packet writes its directions and resets its hit.
 template <int N, class RayHitN, class Intersect>
-void RayCaster::cast_packets(Intersect intersect, const Vec3& origin, std::span<const Vec3> dirs, double max_range,
+void RayCaster::cast_packets(Intersect intersect, const Call& call, std::span<const Vec3> dirs,
                              std::span<double> ranges) const {
+    const Vec3& origin = call.origin;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // every ray shares the origin
     // Embree's far limit is float: widen it by a hair so the exact double test below decides.
-    const float tfar = static_cast<float>(max_range) * (1.0f + 1e-6f);
+    const float tfar = static_cast<float>(call.max_range) * (1.0f + 1e-6f);
     alignas(64) RayHitN rh;
     alignas(64) int valid[N];
     for (int k = 0; k < N; ++k) {
@@ -145,38 +191,36 @@ void RayCaster::cast_packets(Intersect intersect, const Vec3& origin, std::span<
         rh.ray.mask[k] = 0xFFFFFFFFu;
         rh.ray.id[k] = static_cast<unsigned>(k);
         rh.ray.flags[k] = 0;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID[k] = 0;  // refine reads it (and drops it) for rays that hit nothing
     }
     for (std::size_t i = 0; i < dirs.size(); i += N) {
         const std::size_t n = std::min<std::size_t>(N, dirs.size() - i);
+        if (n == N) {
+            for (int k = 0; k < N; ++k) set_direction(rh, k, dirs[i + k]);
+        } else {  // the last packet: its idle lanes repeat its first ray and are masked off
+            for (int k = 0; k < N; ++k) {
+                const bool used = static_cast<std::size_t>(k) < n;
+                set_direction(rh, k, dirs[i + (used ? k : 0)]);
+                valid[k] = used ? -1 : 0;
+            }
+        }
         for (int k = 0; k < N; ++k) {
-            const Vec3& d = dirs[i + (static_cast<std::size_t>(k) < n ? k : 0)];
-            rh.ray.dir_x[k] = static_cast<float>(d.x());
-            rh.ray.dir_y[k] = static_cast<float>(d.y());
-            rh.ray.dir_z[k] = static_cast<float>(d.z());
             rh.ray.tfar[k] = tfar;
             rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
-        if (n < N)
-            for (int k = 0; k < N; ++k) valid[k] = static_cast<std::size_t>(k) < n ? -1 : 0;
         intersect(valid, impl_->scene, &ctx, &rh);
-        for (std::size_t k = 0; k < n; ++k) {
-            double r = no_hit;
-            if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) {
-                r = refine(rh.hit.geomID[k], rh.hit.primID[k], origin, dirs[i + k], rh.ray.tfar[k]);
-                if (r > max_range) r = no_hit;
-            }
-            ranges[i + k] = r;
-        }
+        refine<N>(rh, call, dirs.subspan(i, n), ranges.subspan(i, n));
     }
 }
 
 void RayCaster::cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range,
                      std::span<double> ranges) const {
+    const Call call{origin, max_range};
     switch (impl_->packet) {
-        case 16: return cast_packets<16, RTCRayHit16>(rtcIntersect16, origin, dirs, max_range, ranges);
-        case 8: return cast_packets<8, RTCRayHit8>(rtcIntersect8, origin, dirs, max_range, ranges);
-        default: return cast_packets<4, RTCRayHit4>(rtcIntersect4, origin, dirs, max_range, ranges);
+        case 16: return cast_packets<16, RTCRayHit16>(rtcIntersect16, call, dirs, ranges);
+        case 8: return cast_packets<8, RTCRayHit8>(rtcIntersect8, call, dirs, ranges);
+        default: return cast_packets<4, RTCRayHit4>(rtcIntersect4, call, dirs, ranges);
     }
 }
 

@@ -31,21 +31,28 @@ public:
     void cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range, std::span<double> ranges) const;
 
 private:
-    double refine(unsigned geom, unsigned prim, const Vec3& origin, const Vec3& dir, float t_float) const;
-    double refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir, float t_float) const;
+    // What every ray of one cast() shares.
+    struct Call {
+        const Vec3& origin;
+        double max_range;
+    };
     template <int N, class RayHitN, class Intersect>
-    void cast_packets(Intersect intersect, const Vec3& origin, std::span<const Vec3> dirs, double max_range,
-                      std::span<double> ranges) const;
+    void cast_packets(Intersect intersect, const Call& call, std::span<const Vec3> dirs, std::span<double> ranges) const;
+    template <int N, class RayHitN>
+    void refine(const RayHitN& rh, const Call& call, std::span<const Vec3> dirs, std::span<double> ranges) const;
+    double refine_other(unsigned geom, unsigned prim, const Call& call, const Vec3& dir, float t_float) const;
+    double refine_sphere(const Vec3& center, double radius, const Vec3& origin, const Vec3& dir, float t_float) const;
 
     struct Impl;
     std::unique_ptr<Impl> impl_;  // the Embree device and scene
     // Per triangle, in double precision: its plane (unnormalized normal, a corner) and the |n·d|
-    // below which a ray grazes it.
+    // below which a ray grazes it; then one more, read (and discarded) for rays that hit no triangle.
     struct Plane {
-        Vec3 normal, point;
+        Vec3 normal;
         double grazing;
     };
     std::vector<Plane> planes_;
+    std::vector<Vec3> corners_;  // a corner of each plane's triangle
     // Embree geometry IDs: the triangles (if any) first, then one per sphere set, in order.
     unsigned first_sphere_geom_ = 0;
     std::vector<SphereSet> spheres_;  // its own copy: a caster is shared by copies of a World
