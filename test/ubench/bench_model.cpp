@@ -40,26 +40,32 @@ void BM_ModelStep(benchmark::State& state, std::string preset) {
 }
 
 // What a trial does per model step on `walk`: cast the rows the model needs, BVC rates, place cells
-// learning. When the pruning bound fails (almost nothing in view) the scan is read again in full, as
-// the trial runner does, if `fallback`; otherwise the benchmark stops with an error.
+// learning, 16 steps at a time as the trial runner steps them (one iteration is one step; every 16th
+// also runs the place cells' block). When the pruning bound fails (almost nothing in view) the scan is
+// read again in full, as the trial runner does, if `fallback`; otherwise the benchmark stops with an
+// error.
 void planned_steps(benchmark::State& state, const ModelSpec& model, const World& world,
                    const std::vector<ModelStep>& walk, bool fallback) {
+    constexpr std::size_t block = 16;
     const Lidar lidar(model.sensor);
     const BoundaryVectorLayer layer(model.bvc);
     const auto plan = layer.plan(model.sensor);
     PlaceCellNetwork net(model.bvc.n_cells(), model.place, 1);
-    std::vector<double> rates(layer.n_cells());
+    const std::size_t n = layer.n_cells();
+    std::vector<double> rates(block * n);
+    const std::vector<char> learn(block, 1);
     Scan scan;
     std::size_t i = 0, rows = 0;
     for (char r : plan.rows) rows += r != 0;
     for (auto _ : state) {
-        const auto& s = walk[i++ % walk.size()];
+        const auto& s = walk[i % walk.size()];
+        const std::span<double> out(rates.data() + (i % block) * n, n);
         lidar.scan(world, s.pose, scan, {}, plan.rows);
-        if (!layer.rates_pruned(scan, plan, rates)) {
+        if (!layer.rates_pruned(scan, plan, out)) {
             if (!fallback) state.SkipWithError("pruning bound failed");
-            else layer.rates(lidar.scan(world, s.pose), rates);
+            else layer.rates(lidar.scan(world, s.pose), out);
         }
-        benchmark::DoNotOptimize(net.step(rates, true).data());
+        if (++i % block == 0) benchmark::DoNotOptimize(net.step_block(rates, learn).data());
     }
     state.counters["rays"] = static_cast<double>(rows * static_cast<std::size_t>(model.sensor.azimuth_count));
 }

@@ -94,8 +94,6 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     // A batch: 256 returns, or as many rows as fill 1024 entries (plus one return's worth).
     jobs_.resize(256);
     exp_args_.resize(2 * jobs_.size());
-    job_offset_.resize(1024 + static_cast<std::size_t>(p_.n_layers()) * p_.n_dir);
-    job_weight_.resize(job_offset_.size());
     kept_weight_.assign(static_cast<std::size_t>(p_.n_layers()) * p_.n_dir, 0.0);
     layer_weight_.assign(p_.n_layers(), 0.0);
     far_weight_.assign(p_.n_layers(), 0.0);
@@ -106,7 +104,6 @@ BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params
     // k_first..k_last in angular_weights span at most 2·cut/Δθ, plus one for each end's rounding.
     const double span = 2.0 * cut_theta_ / (two_pi / p_.n_dir);
     reach_ = span >= p_.n_dir ? p_.n_dir : std::min(p_.n_dir, static_cast<int>(span) + 2);
-    feeds_.resize(256);
     size_memo(default_slots);
     // θ_k, padded with NaN to whole vectors of 8 (kernels::nearest_returns).
     const std::size_t dirs8 = (static_cast<std::size_t>(p_.n_dir) + 7) / 8 * 8;
@@ -148,13 +145,13 @@ void BoundaryVectorLayer::row_factors(double phi) const {
 template <bool planned>
 std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> returns, const ScanPlan* plan) const {
     // Sums go to a buffer whose axes are padded to whole blocks of 8 cells, so the vector kernel never
-    // needs a scalar tail; they are copied to the result by copy_sums. Two phases, a row's returns at
-    // a time: this loop reads the returns (which cells and directions each reaches: feeds_), then
-    // expand_feeds lists the rows they feed: two short loops, each with few values to keep in
-    // registers, rather than one long one. Planned (a beam table, row by row), each direction's sum
-    // over a scanner row's returns, Σ A·D, is formed once (row_sums_) and added to every layer the
-    // row feeds with its elevation factor E (add_row_sums): a return feeding two layers is summed
-    // once. Unplanned (any point set, whose elevations need not repeat), E·A weights each return.
+    // needs a scalar tail; they are copied to the result by copy_sums. Each return that feeds a row
+    // becomes a job for the kernel: its profile, and its angular record (the directions it reaches
+    // and their factors). Planned (a beam table, row by row), each direction's sum of A·D over a
+    // scanner row's returns is formed once (row_sums_) and added to every layer the row feeds with
+    // its elevation factor E (add_row_sums): a return that two layers read is summed once.
+    // Unplanned (any point set, whose elevations need not repeat), a return gets a job per layer it
+    // feeds, its profile scaled by that layer's E.
     const int L = p_.n_layers(), M = p_.n_per_axis;
     std::fill(padded_.begin(), padded_.end(), 0.0);
     const double dd = p_.spacing(), inv_dd = dd > 0 ? 1.0 / dd : 0.0;
@@ -162,9 +159,9 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
     // n_kept layers with a summed factor and n_any with any factor.
     const double* dropped_e = dropped_e_.data();
     int n_kept = 0, n_any = 0;
-    // Unplanned, for the truncation bound: per (layer, direction) the kept weights Σ E·A (added by
-    // expand_feeds) and the dropped ones, per layer Σ E over returns that reach it and Σ E over those
-    // whose distance window is empty. Planned: the current run's counts.
+    // Unplanned, for the truncation bound: per (layer, direction) the kept weights Σ E·A and the
+    // dropped ones, per layer Σ E over returns that reach it and Σ E over those whose distance window
+    // is empty. Planned: the current run's counts.
     if constexpr (!planned) {
         std::fill(kept_weight_.begin(), kept_weight_.end(), 0.0);
         std::fill(dropped_weight_.begin(), dropped_weight_.end(), 0.0);
@@ -180,21 +177,23 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         }
         run_valid = run_far = 0;
     };
-    n_jobs_ = n_rows_ = 0;
-    Feed* feeds = feeds_.data();
-    std::size_t n_feeds = 0, n_direct = 0;
     if (plan && plan->columns > 0 && plan->columns != memo_slots_ && plan->columns <= max_slots) size_memo(plan->columns);
     const std::size_t record = static_cast<std::size_t>(reach_) + 1;
-    auto expand = [&] {
-        expand_feeds<!planned>(n_feeds, n_kept);
-        n_feeds = n_direct = 0;
-        ++batch_;
+    // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
+    // keeps the power recurrence below far from overflow.
+    const bool recurrence = dd > 0 && dd <= p_.sigma_r;
+    kernels::ProfileJob* jobs = jobs_.data();
+    const std::size_t max_jobs = jobs_.size();
+    n_jobs_ = n_direct_ = 0;
+    auto add_job = [&](const kernels::ProfileJob& job) {
+        if (!recurrence) return add_profile_directly<planned>(job);
+        jobs[n_jobs_++] = job;
+        if (n_jobs_ == max_jobs) flush_jobs<planned>();
     };
-    bool row_summed = false;  // planned: row_sums_ holds the current row's sums
+    bool row_summed = false;  // planned: row_sums_ holds sums of the current row
     auto end_row = [&] {
-        expand();
         if (!planned || !row_summed) return;
-        if (n_jobs_ > 0) flush_jobs<false>();
+        if (n_jobs_ > 0) flush_jobs<planned>();
         add_row_sums(n_kept);
         row_summed = false;
     };
@@ -207,7 +206,6 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
     const bool use_memo = probe < 64 || changes < 56;
     double last_phi = NAN;
     bool skipped_row = false;
-    ++batch_;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
         const LidarReturn& ret = returns[j];
@@ -241,30 +239,33 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         }
         if (n_any == 0) continue;
         // The directions the azimuth reaches and their angular factors: its memo slot's record, or
-        // one of its own after the memo's records.
+        // one of its own after the memo's records. A record stays as it is while a waiting job reads it.
         const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
         std::size_t at;
         if (use_memo) {
             const std::size_t slot = slot_of(azimuth);
             at = slot * record;
             if (!(memo_weight_[at] == azimuth)) {
-                if (slot_batch_[slot] == batch_) expand();  // a waiting feed reads this record
+                if (slot_batch_[slot] == batch_ && n_jobs_ > 0) flush_jobs<planned>();
                 memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
                 memo_weight_[at] = azimuth;
             }
             slot_batch_[slot] = batch_;
         } else {
-            at = (memo_slots_ + n_direct++) * record;
+            if (n_direct_ == max_jobs) {  // the room is full: free it (some returns left no job)
+                if (n_jobs_ > 0) flush_jobs<planned>();
+                n_direct_ = 0;
+            }
+            at = (memo_slots_ + n_direct_++) * record;
             memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
         }
         if constexpr (!planned) {
             for (int i = 0; i < n_any; ++i) layer_weight_[any_layers_[i]] += row_factor_[any_layers_[i]];
-            if (n_any > n_kept)
-                for (int l = 0; l < L; ++l)
-                    if (dropped_e[l] > 0.0)
-                        for (int d = 0; d < memo_dir_[at]; ++d)
-                            dropped_weight_[static_cast<std::size_t>(l) * p_.n_dir + memo_dir_[at + 1 + d]] +=
-                                dropped_e[l] * memo_weight_[at + 1 + d];
+            for (int l = 0; l < L && n_any > n_kept; ++l)
+                if (dropped_e[l] > 0.0)
+                    for (int d = 0; d < memo_dir_[at]; ++d)
+                        dropped_weight_[static_cast<std::size_t>(l) * p_.n_dir + memo_dir_[at + 1 + d]] +=
+                            dropped_e[l] * memo_weight_[at + 1 + d];
         }
         if (n_kept == 0) continue;
 
@@ -288,88 +289,52 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         // The kernel adds whole blocks of 8 cells, aligned: a return's loads then meet the previous
         // return's stores at the same addresses, which the CPU forwards (a load straddling two earlier
         // stores waits for both to reach the cache). The cells this adds get their true terms.
-        const int m_first = m_lo & ~7;
-        feeds[n_feeds++] = {r, static_cast<std::uint32_t>(at), m_first, ((m_hi + 8) & ~7) - m_first};
-        row_summed = true;
-        if (n_feeds == feeds_.size()) expand();
+        if (memo_dir_[at] == 0) continue;  // an azimuth between directions that reaches none
+        const int m_first = m_lo & ~7, width = ((m_hi + 8) & ~7) - m_first;
+        const double x0 = r - m_first * dd;
+        if constexpr (planned) {
+            add_job({x0, 1.0, static_cast<std::uint32_t>(m_first), static_cast<std::uint32_t>(at), width, 0});
+            row_summed = true;
+        } else {
+            for (int i = 0; i < n_kept; ++i) {
+                for (int d = 0; d < memo_dir_[at]; ++d)
+                    kept_weight_[static_cast<std::size_t>(kept_layers_[i]) * p_.n_dir + memo_dir_[at + 1 + d]] +=
+                        kept_elev_[i] * memo_weight_[at + 1 + d];
+                add_job({x0, kept_elev_[i], static_cast<std::uint32_t>(kept_base_[i] + m_first),
+                         static_cast<std::uint32_t>(at), width, 0});
+            }
+        }
     }
     end_row();
-    if (n_jobs_ > 0) flush_jobs<!planned>();
+    if (n_jobs_ > 0) flush_jobs<planned>();
     if constexpr (planned) end_run();
     return valid;
 }
 
-template <bool unplanned>
-void BoundaryVectorLayer::expand_feeds(std::size_t n_feeds, int n_kept) const {
-    const int K = p_.n_dir;
+template <bool planned>
+void BoundaryVectorLayer::add_profile_directly(const kernels::ProfileJob& job) const {
+    // exp(-h(x0 - nΔ)²) cell by cell (x0 = job.a, the profile's scale job.b), for each direction of
+    // the job's record.
+    const double dd = p_.spacing(), h_r = 0.5 / (p_.sigma_r * p_.sigma_r);
     const std::size_t stride = static_cast<std::size_t>(axis_stride_);
-    const std::size_t rows_room = job_offset_.size() - static_cast<std::size_t>(K) * p_.n_layers();
-    // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
-    // keeps the power recurrence below far from overflow.
-    const double dd = p_.spacing();
-    const bool recurrence = dd > 0 && dd <= p_.sigma_r;
-    // Local copies: stores through these pointers cannot then be taken to change the members.
-    const Feed* feeds = feeds_.data();
-    const std::uint16_t* memo_dir = memo_dir_.data();
-    const double* memo_weight = memo_weight_.data();
-    const double* kept_elev = kept_elev_.data();
-    const std::size_t* kept_base = kept_base_.data();
-    const int* kept_layers = kept_layers_.data();
-    double* kept_weight = kept_weight_.data();
-    double* job_weight = job_weight_.data();
-    std::uint32_t* job_offset = job_offset_.data();
-    kernels::ProfileJob* jobs = jobs_.data();
-    const std::size_t max_jobs = jobs_.size();
-    std::size_t n_jobs = n_jobs_, n_rows = n_rows_;
-    for (std::size_t f = 0; f < n_feeds; ++f) {
-        const Feed& feed = feeds[f];
-        const int n_dirs = memo_dir[feed.record];
-        const std::uint16_t* dir = memo_dir + feed.record + 1;
-        const double* ang = memo_weight + feed.record + 1;
-        // The rows this return feeds: per direction its row of row_sums_ weighted A (planned), or per
-        // (layer, direction) its row of padded_ weighted E·A (unplanned).
-        const std::size_t first = n_rows;
-        for (int d = 0; d < n_dirs; ++d) {
-            const std::size_t cells = dir[d] * stride + static_cast<std::size_t>(feed.first_cell);
-            if constexpr (unplanned) {
-                for (int i = 0; i < n_kept; ++i) {
-                    const double w = kept_elev[i] * ang[d];
-                    kept_weight[static_cast<std::size_t>(kept_layers[i]) * K + dir[d]] += w;
-                    job_weight[n_rows] = w;
-                    job_offset[n_rows] = static_cast<std::uint32_t>(kept_base[i] + cells);
-                    ++n_rows;
-                }
-            } else {
-                job_weight[n_rows] = ang[d];
-                job_offset[n_rows] = static_cast<std::uint32_t>(cells);
-                ++n_rows;
-            }
-        }
-        const int count = static_cast<int>(n_rows - first);
-        if (count == 0) continue;
-        // Distance profile c_r·exp(-(r - d_m)²/2σ²) over the window, added to every row.
-        if (recurrence) {
-            // exp(-h(x0 - nΔ)²) = exp(-h x0²) · exp(2h x0 Δ)^n · exp(-h n²Δ²): two exps per return,
-            // computed for the whole batch at once (profile_factors) when it is flushed.
-            jobs[n_jobs++] = {feed.range - feed.first_cell * dd, 0.0, feed.width, count};
-            if (n_jobs == max_jobs || n_rows > rows_room) {
-                n_jobs_ = n_jobs;
-                flush_jobs<unplanned>();
-                n_jobs = n_rows = 0;
-            }
-        } else {
-            const double h_r = 0.5 / (p_.sigma_r * p_.sigma_r);
-            double* sums = unplanned ? padded_.data() : row_sums_.data();
-            for (int n = 0; n < feed.width; ++n) {
-                const double x = feed.range - (feed.first_cell + n) * dd;
-                const double u = c_r_ * std::exp(-h_r * x * x);
-                for (int i = 0; i < count; ++i) sums[job_offset[first + i] + n] += job_weight[first + i] * u;
-            }
-            n_rows = first;
-        }
+    double* sums = planned ? row_sums_.data() : padded_.data();
+    const int n_dirs = memo_dir_[job.record];
+    for (int n = 0; n < job.width; ++n) {
+        const double x = job.a - n * dd;
+        const double u = c_r_ * std::exp(-h_r * x * x) * job.b;  // b: the scale
+        for (int d = 0; d < n_dirs; ++d)
+            sums[job.base + memo_dir_[job.record + 1 + d] * stride + n] += memo_weight_[job.record + 1 + d] * u;
     }
-    n_jobs_ = n_jobs;
-    n_rows_ = n_rows;
+}
+
+template <bool planned>
+void BoundaryVectorLayer::flush_jobs() const {
+    profile_factors(n_jobs_);
+    kernels::add_distance_profiles(jobs_.data(), n_jobs_, memo_dir_.data(), memo_weight_.data(),
+                                   static_cast<std::size_t>(axis_stride_), dist_decay_.data(),
+                                   planned ? row_sums_.data() : padded_.data());
+    n_jobs_ = n_direct_ = 0;
+    ++batch_;  // the records the flushed jobs read are free again
 }
 
 void BoundaryVectorLayer::add_row_sums(int n_kept) const {
@@ -381,14 +346,6 @@ void BoundaryVectorLayer::add_row_sums(int n_kept) const {
         for (std::size_t c = 0; c < n; ++c) layer[c] += e * row[c];
     }
     std::fill(row_sums_.begin(), row_sums_.end(), 0.0);
-}
-
-template <bool unplanned>
-void BoundaryVectorLayer::flush_jobs() const {
-    profile_factors(n_jobs_);
-    kernels::add_distance_profiles(jobs_.data(), n_jobs_, job_offset_.data(), job_weight_.data(), dist_decay_.data(),
-                                   unplanned ? padded_.data() : row_sums_.data());
-    n_jobs_ = n_rows_ = 0;
 }
 
 bool BoundaryVectorLayer::raw_pruned(std::span<const LidarReturn> returns, std::span<double> result) const {
@@ -408,7 +365,7 @@ void BoundaryVectorLayer::profile_factors(std::size_t n_jobs) const {
     }
     vector_exp(e, e, 2 * n_jobs);
     for (std::size_t i = 0; i < n_jobs; ++i) {
-        jobs_[i].a = c_r_ * e[i];
+        jobs_[i].a = c_r_ * e[i] * jobs_[i].b;  // b: the profile's scale until now
         jobs_[i].b = e[n_jobs + i];
     }
 }
@@ -513,8 +470,8 @@ void BoundaryVectorLayer::size_memo(std::size_t slots) const {
     const std::size_t record = static_cast<std::size_t>(reach_) + 1;
     memo_slots_ = slots;
     slot_scale_ = static_cast<double>(slots) / two_pi;
-    memo_weight_.assign((slots + feeds_.size()) * record, 0.0);
-    memo_dir_.assign((slots + feeds_.size()) * record, 0);
+    memo_weight_.assign((slots + jobs_.size()) * record, 0.0);
+    memo_dir_.assign((slots + jobs_.size()) * record, 0);
     for (std::size_t slot = 0; slot < slots; ++slot) memo_weight_[slot * record] = NAN;  // the keys
     slot_batch_.assign(slots, 0);
 }

@@ -163,28 +163,23 @@ private:
     int angular_weights(double azimuth, std::uint16_t* dir, double* weight) const;
     mutable std::vector<double> memo_weight_;
     mutable std::vector<std::uint16_t> memo_dir_;
-    mutable std::vector<std::uint32_t> slot_batch_;  // the batch of feeds that last read each slot
+    mutable std::vector<std::uint32_t> slot_batch_;  // the batch of jobs that last read each slot
     mutable std::uint32_t batch_ = 0;
 
-    // pruned_pass's first phase gives, per return that feeds a row: its range, its record, and its
-    // window (from a block of 8 cells); the second (expand_feeds) lists the rows for the kernel with
-    // the row's kept layers fixed: their elevation factors and first offsets in padded_.
-    struct Feed {
-        double range;
-        std::uint32_t record;
-        std::int32_t first_cell, width;
-    };
-    mutable std::vector<Feed> feeds_;
-    mutable std::vector<double> kept_elev_;
-    mutable std::vector<std::size_t> kept_base_;
-    template <bool unplanned>
-    void expand_feeds(std::size_t n_feeds, int n_kept) const;
-    mutable std::size_t n_jobs_ = 0, n_rows_ = 0;  // jobs and rows listed, not yet added
-    template <bool unplanned>
-    void flush_jobs() const;  // into padded_ (unplanned) or row_sums_
+    // The kernel's jobs, not yet added (n_jobs_), and the records of their own after the memo's slots
+    // (n_direct_); flush_jobs adds them to row_sums_ (planned) or padded_.
+    mutable std::size_t n_jobs_ = 0, n_direct_ = 0;
+    template <bool planned>
+    void flush_jobs() const;
+    // A job evaluated cell by cell, for cells further apart than σ_r.
+    template <bool planned>
+    void add_profile_directly(const kernels::ProfileJob& job) const;
     // A scanner row's sums per direction, Σ A·D over its returns, padded like padded_'s axes; added
     // to each layer it feeds with that layer's elevation factor, then cleared.
     mutable std::vector<double, CacheAligned<double>> row_sums_;
+    // The current row's kept layers: their elevation factors and first offsets in padded_.
+    mutable std::vector<double> kept_elev_;
+    mutable std::vector<std::size_t> kept_base_;
     void add_row_sums(int n_kept) const;
 
     // Scratch for one step (a layer is not shared between threads): the elevation factors of the
@@ -193,12 +188,10 @@ private:
     // and weights.
     mutable std::vector<double> elev_, dropped_e_, row_factor_;
     mutable std::vector<int> kept_layers_, any_layers_;
-    mutable std::vector<kernels::ProfileJob> jobs_;  // until profile_factors: a holds x0 = r - m·Δ
+    mutable std::vector<kernels::ProfileJob> jobs_;
     mutable std::vector<double> exp_args_;
-    // The first n_jobs jobs' a and b from their x0 (two batched exps per return).
+    // The first n_jobs jobs' a and b from their x0 and scale (two batched exps per return).
     void profile_factors(std::size_t n_jobs) const;
-    mutable std::vector<std::uint32_t> job_offset_;
-    mutable std::vector<double> job_weight_;
     mutable std::vector<double> kept_weight_, layer_weight_, far_weight_, dropped_weight_;  // truncation bound
     int axis_stride_ = 0;  // n_per_axis rounded up to 8
     mutable std::vector<double, CacheAligned<double>> padded_;  // sums with padded axes, blocks of 8 cache-aligned

@@ -24,8 +24,9 @@ template <int N, class V>
 // cells is 8/N vectors. Every lane does the same operations whatever N, so the results are the same
 // bits on every instruction set.
 template <int N>
-[[gnu::always_inline]] inline void profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint32_t* offsets,
-                                            const double* weights, const double* decay, double* sums) {
+[[gnu::always_inline]] inline void profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs,
+                                            const double* factors, std::size_t stride, const double* decay,
+                                            double* sums) {
     using V = typename simd::doubles<N>::type;
     constexpr int P = 8 / N;
     for (std::size_t j = 0; j < n_jobs; ++j) {
@@ -36,7 +37,10 @@ template <int N>
         const double b2 = b * b, b4 = b2 * b2, b8 = b4 * b4;
         std::array<V, P> pw = powers<N, V>(b, b2, b4);
         for (int p = 0; p < P; ++p) pw[p] *= a;
-        const int W = job.width, count = job.rows;
+        const int W = job.width, count = dirs[job.record];
+        const std::uint16_t* dir = dirs + job.record + 1;
+        const double* factor = factors + job.record + 1;
+        double* base = sums + job.base;
         for (int n = 0; n < W; n += 8) {
             V u[P];
             for (int p = 0; p < P; ++p) {
@@ -45,8 +49,8 @@ template <int N>
                 u[p] = pw[p] * dec;
             }
             for (int i = 0; i < count; ++i) {
-                double* row = sums + offsets[i] + n;
-                const double w = weights[i];
+                double* row = base + dir[i] * stride + n;
+                const double w = factor[i];
                 for (int p = 0; p < P; ++p) {
                     V r;
                     simd::load(r, row + p * N);
@@ -56,36 +60,34 @@ template <int N>
             }
             for (int p = 0; p < P; ++p) pw[p] *= b8;
         }
-        offsets += count;
-        weights += count;
     }
 }
 
 #if BVC3D_HAVE_DISPATCH
-BVC3D_TARGET_V4 void profiles_v4(const ProfileJob* jobs, std::size_t n_jobs, const std::uint32_t* offsets,
-                                 const double* weights, const double* decay, double* sums) {
-    profiles<8>(jobs, n_jobs, offsets, weights, decay, sums);
+BVC3D_TARGET_V4 void profiles_v4(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs,
+                                 const double* factors, std::size_t stride, const double* decay, double* sums) {
+    profiles<8>(jobs, n_jobs, dirs, factors, stride, decay, sums);
 }
-BVC3D_TARGET_V3 void profiles_v3(const ProfileJob* jobs, std::size_t n_jobs, const std::uint32_t* offsets,
-                                 const double* weights, const double* decay, double* sums) {
-    profiles<4>(jobs, n_jobs, offsets, weights, decay, sums);
+BVC3D_TARGET_V3 void profiles_v3(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs,
+                                 const double* factors, std::size_t stride, const double* decay, double* sums) {
+    profiles<4>(jobs, n_jobs, dirs, factors, stride, decay, sums);
 }
 #endif
 
 }  // namespace
 
-// One call per step for every return (not one per return): the dispatch and the loop setup are paid
-// once, and the profile goes from registers straight into the rows.
-void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint32_t* offsets,
-                           const double* weights, const double* decay, double* sums) {
+// One call per batch of a few hundred returns (not one per return): the dispatch and the loop setup are
+// paid once, and the profile goes from registers straight into the rows.
+void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs,
+                           const double* factors, std::size_t stride, const double* decay, double* sums) {
 #if BVC3D_HAVE_DISPATCH
     switch (simd::isa()) {
-        case simd::Isa::v4: return profiles_v4(jobs, n_jobs, offsets, weights, decay, sums);
-        case simd::Isa::v3: return profiles_v3(jobs, n_jobs, offsets, weights, decay, sums);
+        case simd::Isa::v4: return profiles_v4(jobs, n_jobs, dirs, factors, stride, decay, sums);
+        case simd::Isa::v3: return profiles_v3(jobs, n_jobs, dirs, factors, stride, decay, sums);
         case simd::Isa::baseline: break;
     }
 #endif
-    profiles<2>(jobs, n_jobs, offsets, weights, decay, sums);
+    profiles<2>(jobs, n_jobs, dirs, factors, stride, decay, sums);
 }
 
 BVC3D_DISPATCH

@@ -7,12 +7,12 @@
 
 namespace bvc3d::kernels {
 
-// For each job in turn, in order: sums[offset_i + n] += weight_i·a·b^n·decay[n] for n < width and each
-// of its rows i. Widths are multiples of 8 and decay holds the widest; offsets are multiples of 8 into
-// 64-byte-aligned sums, so each block of 8 cells is one cache line.
-void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint32_t* offsets,
-                           const double* weights, const double* decay, double* sums);
-
+// For each job in turn, in order: sums[base + dir_d·stride + n] += A_d·a·b^n·decay[n] for n < width
+// and each direction d of its record (count at dirs[record], directions at dirs[record + 1 ...],
+// factors A_d at factors[record + 1 ...]). Widths are multiples of 8 and decay holds the widest; base and stride are
+// multiples of 8 and the sums 64-byte aligned, so each block of 8 cells is one cache line.
+void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs,
+                           const double* factors, std::size_t stride, const double* decay, double* sums);
 // For each direction k < n_dir (theta[k] in [0, 2π), padded with NaN to a multiple of 8 entries): the
 // first i < n with the smallest |wrap(azimuth[i] - theta[k])| (azimuth[i] in (-π, π]) into best[k]
 // (n if there is none) and that gap into gap[k]; best and gap have room for the padding.

@@ -5,13 +5,16 @@
 
 namespace bvc3d::kernels {
 
-// One return's distance profile c_r·exp(-(r - (m + n)·Δ)²/2σ²), n < W (its window, from the block of 8
-// cells m starts), evaluated as a·b^n·decay[n] (a = c_r·exp(-h x0²), b = exp(2h x0 Δ), x0 = r - m·Δ,
-// decay[n] = exp(-h n²Δ²)), to be added with a weight to each of `rows` rows; the rows' offsets (into
-// the sums, at m) and weights follow one another in the arrays passed to add_distance_profiles.
+// One return's distance profile s·c_r·exp(-(r - (m + n)·Δ)²/2σ²), n < width (its window, from the block
+// of 8 cells m), evaluated as a·b^n·decay[n] (a = s·c_r·exp(-h x0²), b = exp(2h x0 Δ), x0 = r - m·Δ,
+// decay[n] = exp(-h n²Δ²)), to be added with weight A_d to the row of each direction d its angular
+// record lists: sums[base + dir_d·stride + n]. The record (the BVC layer's memo) is a count and that
+// many directions in one array, a key and the factors A_d in another, both at `record`.
 struct ProfileJob {
-    double a, b;
-    std::int32_t width, rows;
+    double a, b;            // until the layer computes them: x0, and the scale s
+    std::uint32_t base;     // the cell m of direction 0, in the sums
+    std::uint32_t record;
+    std::int32_t width, unused;
 };
 
 }  // namespace bvc3d::kernels

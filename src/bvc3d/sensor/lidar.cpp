@@ -134,8 +134,14 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
     cast_rows_.clear();
     for (std::size_t i = 0; i < n_rows; ++i)
         if (rows.empty() || rows[i]) cast_rows_.push_back(i);
-    set_azimuths(pose.heading);
-    set_beams(pose.heading);
+    // The columns' azimuths and the beams' directions depend on the heading and the rows only: a
+    // walk keeps its heading for several steps, and these are then the last scan's.
+    if (!(pose.heading == beams_heading_) || cast_rows_ != beams_rows_) {
+        set_azimuths(pose.heading);
+        set_beams(pose.heading);
+        beams_heading_ = pose.heading;
+        beams_rows_ = cast_rows_;
+    }
     world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
     if (spec_.range_noise_sd > 0 || spec_.dropout > 0) write_noisy_returns(out, noise);
     else write_returns(out);
@@ -230,6 +236,7 @@ bool Lidar::add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) cons
 }
 
 void Lidar::scan_tilted(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise) const {
+    beams_heading_ = NAN;  // dirs_ and ranges_ are this scan's own
     // The beam table turns with the sensor; each hit's angles are measured in the world frame.
     const Eigen::Matrix3d R = pose.rotation();
     const Vec3 origin = pose.position() + R * Vec3(0.0, 0.0, spec_.height);

@@ -3,6 +3,7 @@
 // Takes: a World and the agent's pose. Gives: the hits as (range, allocentric azimuth, elevation)
 // relative to the sensor (docs/model-reference.md#sensors); beams with no hit within max_range are
 // dropped. return_source.hpp is the seam through which a model step gets its returns.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -123,6 +124,9 @@ private:
     mutable std::vector<Vec2> horizontal_;
     mutable std::vector<double> ranges_, azimuths_;
     mutable std::vector<std::size_t> cast_rows_;
+    // The heading and rows that azimuths_ and dirs_ were set for (NaN: none).
+    mutable double beams_heading_ = NAN;
+    mutable std::vector<std::size_t> beams_rows_;
 };
 
 }  // namespace bvc3d
