@@ -177,7 +177,8 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         }
         run_valid = run_far = 0;
     };
-    if (plan && plan->columns > 0 && plan->columns != memo_slots_ && plan->columns <= max_slots) size_memo(plan->columns);
+    if (plan && plan->columns > 0 && 2 * plan->columns != memo_slots_ && 2 * plan->columns <= max_slots)
+        size_memo(2 * plan->columns);
     const std::size_t record = static_cast<std::size_t>(reach_) + 1;
     // Far-apart cells (spacing > sigma_r) are few per window: evaluate them directly, which also
     // keeps the power recurrence below far from overflow.
@@ -185,6 +186,7 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
     kernels::ProfileJob* jobs = jobs_.data();
     const std::size_t max_jobs = jobs_.size();
     n_jobs_ = n_direct_ = 0;
+    ++batch_;  // no job waits: every slot is free
     auto add_job = [&](const kernels::ProfileJob& job) {
         if (!recurrence) return add_profile_directly<planned>(job);
         jobs[n_jobs_++] = job;
@@ -241,17 +243,15 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         // The directions the azimuth reaches and their angular factors: its memo slot's record, or
         // one of its own after the memo's records. A record stays as it is while a waiting job reads it.
         const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
-        std::size_t at;
-        if (use_memo) {
-            const std::size_t slot = slot_of(azimuth);
-            at = slot * record;
-            if (!(memo_weight_[at] == azimuth)) {
-                if (slot_batch_[slot] == batch_ && n_jobs_ > 0) flush_jobs<planned>();
-                memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
-                memo_weight_[at] = azimuth;
-            }
+        const std::size_t slot = use_memo ? slot_of(azimuth) : 0;
+        std::size_t at = slot * record;
+        if (use_memo && memo_weight_[at] == azimuth) {
             slot_batch_[slot] = batch_;
-        } else {
+        } else if (use_memo && !(recurrence && slot_batch_[slot] == batch_)) {  // a miss: the slot takes it
+            memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
+            memo_weight_[at] = azimuth;
+            slot_batch_[slot] = batch_;
+        } else {  // no memo, or a job waiting for the kernel reads the slot's record: a record of its own
             if (n_direct_ == max_jobs) {  // the room is full: free it (some returns left no job)
                 if (n_jobs_ > 0) flush_jobs<planned>();
                 n_direct_ = 0;
@@ -288,9 +288,11 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         }
         // The kernel adds whole blocks of 8 cells, aligned: a return's loads then meet the previous
         // return's stores at the same addresses, which the CPU forwards (a load straddling two earlier
-        // stores waits for both to reach the cache). The cells this adds get their true terms.
+        // stores waits for both to reach the cache). The cells this adds get their true terms. Cells
+        // evaluated one by one (no recurrence) keep the window as it is: each costs an exp.
         if (memo_dir_[at] == 0) continue;  // an azimuth between directions that reaches none
-        const int m_first = m_lo & ~7, width = ((m_hi + 8) & ~7) - m_first;
+        const int m_first = recurrence ? m_lo & ~7 : m_lo;
+        const int width = recurrence ? ((m_hi + 8) & ~7) - m_first : m_hi - m_lo + 1;
         const double x0 = r - m_first * dd;
         if constexpr (planned) {
             add_job({x0, 1.0, static_cast<std::uint32_t>(m_first), static_cast<std::uint32_t>(at), width, 0});

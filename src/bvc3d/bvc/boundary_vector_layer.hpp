@@ -147,9 +147,10 @@ private:
     // return of a batch. The numbers are the same either way.
     //
     // The slot of an azimuth in (-π, π] is its position on the circle, in memo_slots_ equal parts:
-    // a beam table's evenly spaced columns, as many as the slots or fewer, never share one. A planned
-    // pass makes the slots as many as the sensor's columns, so that a row's records lie side by side
-    // (a few cache lines, which stay in the L1 cache across the rows of a scan).
+    // a beam table's evenly spaced columns, fewer than the slots, never share one (as many, and
+    // rounding could put two in one). A planned pass makes the slots twice the sensor's columns, so
+    // that a row's records lie close together (a few cache lines, which stay in the L1 cache across
+    // the rows of a scan).
     static constexpr std::size_t default_slots = 1024;
     mutable std::size_t memo_slots_ = 0;
     mutable double slot_scale_ = 0;  // memo_slots_ / 2π
