@@ -32,6 +32,7 @@
 #include "bvc3d/recording/pose_file.hpp"
 #include "bvc3d/recording/scan_file.hpp"
 #include "bvc3d/recording/scan_list.hpp"
+#include "../support/temp_dir.hpp"
 
 using namespace bvc3d;
 using namespace bvc3d::recording;
@@ -42,35 +43,7 @@ namespace {
 const double not_a_number = std::numeric_limits<double>::quiet_NaN();
 const double infinity = std::numeric_limits<double>::infinity();
 
-class TempDir {
-public:
-    TempDir()
-        : path_(fs::temp_directory_path() /
-                ("bvc3d-recording-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++))) {
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    fs::path write(const std::string& name, const std::string& bytes) const {
-        const fs::path file = path_ / name;
-        fs::create_directories(file.parent_path());
-        std::ofstream(file, std::ios::binary) << bytes;
-        return file;
-    }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-    const fs::path& path() const { return path_; }
-    // Files in the folder, to check that a failed write left nothing behind.
-    std::size_t file_count() const {
-        return static_cast<std::size_t>(std::distance(fs::directory_iterator(path_), fs::directory_iterator()));
-    }
-
-private:
-    static inline int counter_ = 0;
-    fs::path path_;
-};
+using bvc3d::test::TempDir;
 
 // ---- bytes, built by hand ----
 

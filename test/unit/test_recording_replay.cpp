@@ -3,7 +3,6 @@
 // against the simulator's own rates, gravity alignment of tilted sensors, voxel maps, and the
 // writers' all-or-nothing folders.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -20,26 +19,14 @@
 #include "bvc3d/recording/recording.hpp"
 #include "bvc3d/recording/voxel_map.hpp"
 #include "bvc3d/sensor/recorded_returns.hpp"
+#include "../support/temp_dir.hpp"
 
 using namespace bvc3d;
 namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
-public:
-    TempDir() : path_(fs::temp_directory_path() / ("bvc3d-replay-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++))) {
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-    const fs::path& path() const { return path_; }
-
-private:
-    static inline int counter_ = 0;
-    fs::path path_;
-};
+using bvc3d::test::TempDir;
 
 Eigen::Matrix3d random_rotation(std::mt19937& rng) {
     std::normal_distribution<double> n(0, 1);

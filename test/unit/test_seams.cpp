@@ -9,6 +9,7 @@
 #include <random>
 
 #include "../support/bvc_reference.hpp"
+#include "../support/temp_dir.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
@@ -20,14 +21,9 @@
 
 using namespace bvc3d;
 namespace fs = std::filesystem;
+using bvc3d::test::TempDir;
 
 namespace {
-
-fs::path temp_file(const std::string& name, const std::string& text) {
-    const auto p = fs::temp_directory_path() / ("bvc3d-seams-" + std::to_string(::getpid()) + "-" + name);
-    std::ofstream(p) << text;
-    return p;
-}
 
 // A short trial in the 45° arena following `agent`.
 TrialConfig trial_with(std::shared_ptr<const AgentSpec> agent, const std::string& model, double hours) {
@@ -148,7 +144,8 @@ TEST(Seams, TrajectoryResumesFromACheckpointExactly) {
     auto spec = std::make_shared<TrajectorySpec>(trajectory_steps(t, x, y, {}, h, "arrays"), "arrays");
     const TrialConfig trial = trial_with(spec, "2d", 0.1);
     const GroupResult straight = run_trial_group({trial});
-    const auto ckpt = fs::temp_directory_path() / ("bvc3d-seams-ckpt-" + std::to_string(::getpid()) + ".h5");
+    const TempDir dir("seams");
+    const auto ckpt = dir / "checkpoint.h5";
     std::atomic<bool> stop{true};
     RunControl control;
     control.stop = &stop;
@@ -163,13 +160,14 @@ TEST(Seams, TrajectoryResumesFromACheckpointExactly) {
 }
 
 TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
-    const auto plain = temp_file("plain.txt", "# t x y heading\n0 1 2 0.5\n0.5, 1.1, 2, 0.5\n");
+    const TempDir dir("seams");
+    const auto plain = dir.write("plain.txt", "# t x y heading\n0 1 2 0.5\n0.5, 1.1, 2, 0.5\n");
     const auto steps = read_trajectory_file(plain);
     ASSERT_EQ(steps.size(), 2u);
     EXPECT_EQ(steps[1].t, 0.5);
     EXPECT_EQ(steps[1].pose.x, 1.1);
     EXPECT_EQ(steps[1].pose.z, 0.0);
-    const auto header = temp_file("header.csv", "x,y,z,heading_deg,t\n1,2,0.3,90,10\n1,2.1,0.3,90,11\n");
+    const auto header = dir.write("header.csv", "x,y,z,heading_deg,t\n1,2,0.3,90,10\n1,2.1,0.3,90,11\n");
     const auto h = read_trajectory_file(header);
     EXPECT_EQ(h[0].t, 0.0);  // shifted to start at 0
     EXPECT_EQ(h[1].t, 1.0);
@@ -184,7 +182,7 @@ TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
         {"# nothing\n", "has no rows"},
     };
     for (const auto& [text, reason] : bad) {
-        const auto f = temp_file("bad.txt", text);
+        const auto f = dir.write("bad.txt", text);
         try {
             read_trajectory_file(f);
             ADD_FAILURE() << "accepted: " << text;
@@ -198,9 +196,9 @@ TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
     auto far = std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {100, 101}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
     EXPECT_THROW(run_trial_group({trial_with(far, "2d", 0.0001)}), InputError);
     // In trial YAML, next to the random walk's robot.
-    const auto yaml = temp_file("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.001}\n");
+    const auto yaml = dir.write("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.001}\n");
     EXPECT_EQ(config::load_trial_file(yaml.string()).agent->kind(), "trajectory");
-    const auto both = temp_file("both.yaml", "trajectory: " + header.string() + "\nrobot: {speed: 1}\n");
+    const auto both = dir.write("both.yaml", "trajectory: " + header.string() + "\nrobot: {speed: 1}\n");
     EXPECT_THROW(config::load_trial_file(both.string()), ConfigError);
 }
 
@@ -406,6 +404,7 @@ TEST(Seams, ParameterTablesCheckTheSameWayEverywhere) {
 // What `bvc3d config` prints reads back to the same configuration: equal canonical text (so equal
 // fingerprints and results) and bit-identical numbers, for presets and for awkward values.
 TEST(Seams, CommentedYamlReadsBackToTheSameConfiguration) {
+    const TempDir dir("seams");
     using config::YamlView;
     for (const auto& name : model_preset_names()) {
         const ModelSpec m = model_preset(name);
@@ -461,7 +460,7 @@ TEST(Seams, CommentedYamlReadsBackToTheSameConfiguration) {
     // A world file and a trajectory file, written as absolute paths.
     TrialConfig files;
     files.world = WorldSpec{std::string(BVC3D_SOURCE_DIR) + "/configs/worlds/two-rooms.yaml", std::nullopt, "+x+y"};
-    const auto track = temp_file("config-track.csv", "t,x,y,heading\n0,-3,-1,0\n0.5,-2.9,-1,0\n");
+    const auto track = dir.write("config-track.csv", "t,x,y,heading\n0,-3,-1,0\n0.5,-2.9,-1,0\n");
     files.agent = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(track));
     files.protocol = Protocol{Protocol::Kind::online, 0, 0.001, false};
     read_back(files);

@@ -9,6 +9,7 @@
 #include "bvc3d/recording/ply.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 #include "bvc3d/world/ray_caster.hpp"
+#include "../support/temp_dir.hpp"
 
 using namespace bvc3d;
 namespace fs = std::filesystem;
@@ -17,22 +18,7 @@ namespace {
 
 const fs::path data_dir = fs::path(BVC3D_SOURCE_DIR) / "test" / "data";
 
-class TempDir {
-public:
-    TempDir() : path_(fs::temp_directory_path() / ("bvc3d-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" + std::to_string(counter_++))) {
-        fs::create_directories(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    fs::path write(const std::string& name, const std::string& text) const {
-        std::ofstream(path_ / name) << text;
-        return path_ / name;
-    }
-    const fs::path& path() const { return path_; }
-
-private:
-    static inline int counter_ = 0;
-    fs::path path_;
-};
+using bvc3d::test::TempDir;
 
 // Loading `yaml` fails, and the message names the file, the key and the reason.
 void expect_config_error(const std::string& yaml, const std::string& key, const std::string& reason) {
