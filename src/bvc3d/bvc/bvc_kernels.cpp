@@ -20,6 +20,37 @@ template <int N, class V>
     else return {V{1.0, b}, V{b2, b3}, V{b4, b5}, V{b6, b7}};
 }
 
+// One job's blocks, added to the rows of its record's directions: C of them (C = 0: `count`, read at
+// run time). With the count known at compile time the direction loop is unrolled: no branch inside a
+// block whose outcome changes from job to job (measured 0.93-0.97 of the BVC layer's time).
+template <int N, int C>
+[[gnu::always_inline]] inline void add_blocks(std::array<typename simd::doubles<N>::type, 8 / N> pw, double b8,
+                                              int W, int count, const std::uint16_t* dir, const double* factor,
+                                              std::size_t stride, const double* decay, double* base) {
+    using V = typename simd::doubles<N>::type;
+    constexpr int P = 8 / N;
+    if constexpr (C > 0) count = C;
+    for (int n = 0; n < W; n += 8) {
+        V u[P];
+        for (int p = 0; p < P; ++p) {
+            V dec;
+            simd::load(dec, decay + n + p * N);
+            u[p] = pw[p] * dec;
+        }
+        for (int i = 0; i < count; ++i) {
+            double* row = base + dir[i] * stride + n;
+            const double w = factor[i];
+            for (int p = 0; p < P; ++p) {
+                V r;
+                simd::load(r, row + p * N);
+                r += w * u[p];
+                simd::store(row + p * N, r);
+            }
+        }
+        for (int p = 0; p < P; ++p) pw[p] *= b8;
+    }
+}
+
 // The kernel for vectors of N doubles (8 on AVX-512, 4 on AVX2, 2 on the baseline): each block of 8
 // cells is 8/N vectors. Every lane does the same operations whatever N, so the results are the same
 // bits on every instruction set.
@@ -41,24 +72,11 @@ template <int N>
         const std::uint16_t* dir = dirs + job.record + 1;
         const double* factor = factors + job.record + 1;
         double* base = sums + job.base;
-        for (int n = 0; n < W; n += 8) {
-            V u[P];
-            for (int p = 0; p < P; ++p) {
-                V dec;
-                simd::load(dec, decay + n + p * N);
-                u[p] = pw[p] * dec;
-            }
-            for (int i = 0; i < count; ++i) {
-                double* row = base + dir[i] * stride + n;
-                const double w = factor[i];
-                for (int p = 0; p < P; ++p) {
-                    V r;
-                    simd::load(r, row + p * N);
-                    r += w * u[p];
-                    simd::store(row + p * N, r);
-                }
-            }
-            for (int p = 0; p < P; ++p) pw[p] *= b8;
+        switch (count) {
+            case 1: add_blocks<N, 1>(pw, b8, W, count, dir, factor, stride, decay, base); break;
+            case 2: add_blocks<N, 2>(pw, b8, W, count, dir, factor, stride, decay, base); break;
+            case 3: add_blocks<N, 3>(pw, b8, W, count, dir, factor, stride, decay, base); break;
+            default: add_blocks<N, 0>(pw, b8, W, count, dir, factor, stride, decay, base);
         }
     }
 }
