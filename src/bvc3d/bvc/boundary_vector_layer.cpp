@@ -384,6 +384,14 @@ void BoundaryVectorLayer::copy_sums(const BoundaryVectorLayer& from_layer, std::
     }
 }
 
+double BoundaryVectorLayer::term_bound(double kept, double dropped, double weight, double far) const {
+    return kept * c_r_ * tiny_r + dropped * c_r_ + weight * c_theta_ * c_r_ * tiny_theta + far * c_theta_ * c_r_ * tiny_r;
+}
+
+double BoundaryVectorLayer::elevation_tail(std::size_t returns) const {
+    return p_.elevations.empty() ? 0.0 : static_cast<double>(returns) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
+}
+
 double BoundaryVectorLayer::pruned_bound(std::size_t valid) const {
     // Every pruned term of cell (l, k, m) is one of: a distance factor below tiny_r of a kept
     // (return, layer, direction); an angular factor below tiny_theta of a (return, layer) whose
@@ -395,12 +403,9 @@ double BoundaryVectorLayer::pruned_bound(std::size_t valid) const {
     for (int l = 0; l < L; ++l)
         for (int k = 0; k < K; ++k) {
             const std::size_t lk = static_cast<std::size_t>(l) * K + k;
-            bound = std::max(bound, kept_weight_[lk] * c_r_ * tiny_r + dropped_weight_[lk] * c_r_ +
-                                        layer_weight_[l] * c_theta_ * c_r_ * tiny_theta +
-                                        far_weight_[l] * c_theta_ * c_r_ * tiny_r);
+            bound = std::max(bound, term_bound(kept_weight_[lk], dropped_weight_[lk], layer_weight_[l], far_weight_[l]));
         }
-    if (!p_.elevations.empty()) bound += static_cast<double>(valid) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
-    return bound;
+    return bound + elevation_tail(valid);
 }
 
 double BoundaryVectorLayer::planned_bound(const ScanPlan& plan, const std::vector<Run>& runs) const {
@@ -429,12 +434,9 @@ double BoundaryVectorLayer::planned_bound(const ScanPlan& plan, const std::vecto
     }
     double bound = 0;
     for (int l = 0; l < L; ++l)
-        bound = std::max(bound, kept_weight_[l] * c_r_ * tiny_r + dropped_weight_[l] * c_r_ +
-                                    layer_weight_[l] * c_theta_ * c_r_ * tiny_theta +
-                                    far_weight_[l] * c_theta_ * c_r_ * tiny_r + plan.skipped_bound[l]);
-    const std::size_t n_beams = std::max(valid, plan.beams);
-    if (!p_.elevations.empty()) bound += static_cast<double>(n_beams) * c_phi_ * c_theta_ * c_r_ * tiny_phi;
-    return bound;
+        bound = std::max(bound, term_bound(kept_weight_[l], dropped_weight_[l], layer_weight_[l], far_weight_[l]) +
+                                    plan.skipped_bound[l]);
+    return bound + elevation_tail(std::max(valid, plan.beams));
 }
 
 bool BoundaryVectorLayer::can_share_sums(const BvcParams& o) const {
@@ -460,6 +462,11 @@ bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn>, cons
                                               const BoundaryVectorLayer& summed, std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
     if (!can_share_sums(summed.p_)) throw InputError("BVC layer: cannot read the sums of a layer with other parameters");
+    return planned_rates(plan, summed, out);
+}
+
+bool BoundaryVectorLayer::planned_rates(const ScanPlan& plan, const BoundaryVectorLayer& summed,
+                                        std::span<double> out) const {
     copy_sums(summed, out);
     const double max_raw = kernels::largest(out.data(), out.size());
     if (!(planned_bound(plan, summed.runs_) <= pruned_tolerance * max_raw)) return false;
@@ -623,11 +630,7 @@ bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, con
         return true;
     }
     pruned_pass<true>(returns, &plan);
-    copy_sums(*this, out);
-    const double max_raw = kernels::largest(out.data(), out.size());
-    if (!(planned_bound(plan, runs_) <= pruned_tolerance * max_raw)) return false;
-    normalize(out, max_raw);
-    return true;
+    return planned_rates(plan, *this, out);
 }
 
 BoundaryVectorLayer::ScanPlan BoundaryVectorLayer::plan(const LidarSpec& sensor) const {

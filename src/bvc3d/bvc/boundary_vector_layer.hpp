@@ -120,11 +120,19 @@ private:
     // The bound on every pruned term of a cell: from the exact weights (no plan), or from `runs`
     // and the plan's lattice bound; `valid` returns counted.
     double pruned_bound(std::size_t valid) const;
+    // The terms of one (layer, direction): kept and dropped weights Σ E·A, Σ E of returns that reach
+    // the layer, Σ E of those whose window is empty; and the elevation factors below tiny_phi of
+    // `returns` returns.
+    double term_bound(double kept, double dropped, double weight, double far) const;
+    double elevation_tail(std::size_t returns) const;
     struct Run {
         double elevation;
         std::size_t valid, far;
     };
     double planned_bound(const ScanPlan& plan, const std::vector<Run>& runs) const;
+    // The rates from `summed`'s sums of a planned pass (this layer's own, or a union's), if this
+    // layer's bound for that pass's runs is met.
+    bool planned_rates(const ScanPlan& plan, const BoundaryVectorLayer& summed, std::span<double> out) const;
     // The runs of the last planned pass (sum_pruned's, for the layers reading its sums).
     mutable std::vector<Run> runs_;
     // The nearest_beam reading into `out` (zeroed by the caller). Pruned: only each direction's

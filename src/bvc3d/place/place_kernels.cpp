@@ -64,32 +64,27 @@ template <int N, int P, int T>
         }
 }
 
-// Tiles of TB steps × PB pairs (registers: TB·PB·16/N accumulators), then single pairs, then single
-// steps. One step: PS pairs at a time, so that 6-8 chains are in flight (two FP ports × an add's 3-4
-// cycles of latency).
+// One row of tiles: T steps of every pair, PB pairs at a time, then the pairs left one by one.
+template <int N, int PB, int T>
+[[gnu::always_inline]] inline void tile_row(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride,
+                                            std::size_t n, int pairs, float* out, std::size_t out_stride) {
+    int p = 0;
+    for (; p + PB <= pairs; p += PB)
+        tile<N, PB, T>(W + p * pair_stride, pair_stride, v, v_stride, n, out + 2 * p, out_stride);
+    for (; p < pairs; ++p) tile<N, 1, T>(W + p * pair_stride, pair_stride, v, v_stride, n, out + 2 * p, out_stride);
+}
+
+// Tiles of TB steps × PB pairs (registers: TB·PB·16/N accumulators), then the steps left one by one,
+// PS pairs at a time, so that 6-8 chains are in flight (two FP ports × an add's 3-4 cycles of latency).
 template <int N, int PS, int PB, int TB>
 [[gnu::always_inline]] inline void products(const float* W, std::size_t pair_stride, const float* v,
                                             std::size_t v_stride, std::size_t n, int pairs, int steps, float* out,
                                             std::size_t out_stride) {
     int t = 0;
-    for (; t + TB <= steps && TB > 1; t += TB) {
-        int p = 0;
-        for (; p + PB <= pairs; p += PB)
-            tile<N, PB, TB>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
-                            out_stride);
-        for (; p < pairs; ++p)
-            tile<N, 1, TB>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
-                           out_stride);
-    }
-    for (; t < steps; ++t) {
-        int p = 0;
-        for (; p + PS <= pairs; p += PS)
-            tile<N, PS, 1>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
-                           out_stride);
-        for (; p < pairs; ++p)
-            tile<N, 1, 1>(W + p * pair_stride, pair_stride, v + t * v_stride, v_stride, n, out + t * out_stride + 2 * p,
-                          out_stride);
-    }
+    for (; t + TB <= steps && TB > 1; t += TB)
+        tile_row<N, PB, TB>(W, pair_stride, v + t * v_stride, v_stride, n, pairs, out + t * out_stride, out_stride);
+    for (; t < steps; ++t)
+        tile_row<N, PS, 1>(W, pair_stride, v + t * v_stride, v_stride, n, pairs, out + t * out_stride, out_stride);
 }
 
 #if BVC3D_HAVE_DISPATCH

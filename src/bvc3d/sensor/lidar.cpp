@@ -143,8 +143,8 @@ void Lidar::scan(const World& world, const Pose& pose, Scan& out, const NoiseKey
         beams_rows_ = cast_rows_;
     }
     world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
-    if (spec_.range_noise_sd > 0 || spec_.dropout > 0) write_noisy_returns(out, noise);
-    else write_returns(out);
+    if (spec_.range_noise_sd > 0 || spec_.dropout > 0) write_returns<true>(out, noise);
+    else write_returns<false>(out, noise);
 }
 
 // The beams of the cast rows, column by column: each column's horizontal unit vector (the
@@ -193,33 +193,24 @@ void Lidar::set_azimuths(double heading) const {
     for (std::size_t j = 0; j < n_cols; ++j) azimuths_[j] = wrap_pi(column_label_[(j + roll) % n_cols]);
 }
 
-// The hits of the cast rows (ranges_, column by column) as returns, row by row.
-void Lidar::write_returns(Scan& out) const {
+// The hits of the cast rows (ranges_, column by column) as returns, row by row; noisy: with range
+// noise and dropout, a beam's noise depending on its index in the beam table.
+template <bool noisy>
+void Lidar::write_returns(Scan& out, const NoiseKey& noise) const {
     const std::size_t n_cols = azimuths_.size(), n_cast = cast_rows_.size();
     out.reserve(n_cols * n_cast);
     const double* azimuth = azimuths_.data();
     const double* range = ranges_.data();
     const std::vector<double>& row_label = spec_.row_labels();
     for (std::size_t c = 0; c < n_cast; ++c) {
-        const double elevation = row_label[cast_rows_[c]];
-        for (std::size_t j = 0; j < n_cols; ++j) {
-            const double r = range[j * n_cast + c];
-            if (r != RayCaster::no_hit) out.push_back({r, azimuth[j], elevation});
-        }
-    }
-}
-
-// The same with range noise and dropout: a beam's noise depends on its index in the beam table.
-void Lidar::write_noisy_returns(Scan& out, const NoiseKey& noise) const {
-    const std::size_t n_cols = azimuths_.size(), n_cast = cast_rows_.size();
-    out.reserve(n_cols * n_cast);
-    const std::vector<double>& row_label = spec_.row_labels();
-    for (std::size_t c = 0; c < n_cast; ++c) {
         const std::size_t i = cast_rows_[c];
+        const double elevation = row_label[i];
         for (std::size_t j = 0; j < n_cols; ++j) {
-            double r = ranges_[j * n_cast + c];
-            if (r == RayCaster::no_hit || !add_noise(r, noise, i * n_cols + j)) continue;
-            out.push_back({r, azimuths_[j], row_label[i]});
+            double r = range[j * n_cast + c];
+            if (r == RayCaster::no_hit) continue;
+            if constexpr (noisy)
+                if (!add_noise(r, noise, i * n_cols + j)) continue;
+            out.push_back({r, azimuth[j], elevation});
         }
     }
 }

@@ -111,8 +111,8 @@ private:
     // for them), then the returns from ranges_ into the cleared `out`.
     void set_azimuths(double heading) const;
     void set_beams(double heading) const;
-    void write_returns(Scan& out) const;
-    void write_noisy_returns(Scan& out, const NoiseKey& noise) const;
+    template <bool noisy>
+    void write_returns(Scan& out, const NoiseKey& noise) const;
     // Adds the beam's noise to r; false if the beam drops out or leaves (0, max_range].
     bool add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) const;
 
