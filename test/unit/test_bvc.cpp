@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <random>
 
@@ -10,6 +11,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/bvc/bvc_kernels.hpp"
 
 using namespace bvc3d;
 
@@ -62,6 +64,104 @@ std::vector<BvcParams> all_configs() {
 }
 
 }  // namespace
+
+namespace {
+
+// What the layer reads of each return before its bookkeeping, as the scalar formulas give it: no
+// return (a NaN or +inf range), the azimuth wrapped to (-π, π], its memo slot, and the distance
+// window m_lo..m_hi (cells within r ± cut; empty if m_lo > m_hi), widened to whole blocks of 8.
+struct ScalarReading {
+    bool absent = false;
+    double azimuth = 0, x0 = 0;
+    int slot = 0, first = 0, width = 0;
+};
+
+ScalarReading scalar_reading(const LidarReturn& r, const kernels::ReturnRule& rule) {
+    ScalarReading e;
+    e.absent = std::isnan(r.range) || r.range == INFINITY;
+    if (e.absent) return e;
+    e.azimuth = wrap_pi(r.azimuth);
+    const auto s = static_cast<long>(std::floor((e.azimuth + M_PI) * rule.slot_scale));
+    e.slot = static_cast<int>(std::min<long>(s, rule.slots - 1));
+    int m_lo = 0, m_hi = 0;
+    if (rule.dd > 0) {
+        const double lo = (r.range - rule.cut) * rule.inv_dd, hi = (r.range + rule.cut) * rule.inv_dd;
+        m_lo = lo > 0 ? static_cast<int>(std::floor(std::min(lo, 1e9))) : 0;
+        m_hi = static_cast<int>(std::floor(std::min(hi, rule.cells - 2.0))) + 1;
+    } else {
+        m_lo = r.range > rule.cut ? 1 : 0;
+    }
+    if (m_lo > m_hi) return e;  // width 0
+    e.first = rule.aligned ? m_lo / 8 * 8 : m_lo;
+    e.width = rule.aligned ? (m_hi / 8 + 1) * 8 - e.first : m_hi - m_lo + 1;
+    e.x0 = r.range - e.first * rule.dd;
+    return e;
+}
+
+std::vector<simd::Isa> isas_of_this_cpu() {
+    std::vector<simd::Isa> isas{simd::Isa::baseline};
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("x86-64-v3")) isas.push_back(simd::Isa::v3);
+    if (__builtin_cpu_supports("x86-64-v4")) isas.push_back(simd::Isa::v4);
+    return isas;
+}
+
+}  // namespace
+
+TEST(BvcKernels, ReturnReadingsAreTheScalarFormulasOnEveryInstructionSet) {
+    std::mt19937_64 gen(11);
+    std::uniform_real_distribution<double> range(0.0, 16.0), az(-M_PI, M_PI), el(-1.0, 1.0), turns(-40.0, 40.0);
+    Scan returns;
+    for (int i = 0; i < 1000; ++i) returns.push_back({range(gen), az(gen), el(gen)});
+    // Azimuths a turn out, many turns out, on the boundaries; ranges on window edges, far, absent.
+    for (double a : {M_PI, -M_PI, 2 * M_PI, -2 * M_PI, 3 * M_PI, -3 * M_PI, 2.9 * M_PI, -2.9 * M_PI, 1e6, -1e9, 0.0, -0.0})
+        returns.push_back({3.0, a, 0.1});
+    for (int i = 0; i < 40; ++i) returns.push_back({range(gen), turns(gen), el(gen)});
+    for (double r : {0.0, 0.75, 12.0, 12.0 + 4.5, 1e3, 1e300, static_cast<double>(NAN), static_cast<double>(INFINITY)})
+        returns.push_back({r, az(gen), 0.0});
+    std::shuffle(returns.begin(), returns.end(), gen);
+    for (const bool aligned : {true, false}) {
+        for (const int cells : {60, 120, 1}) {
+            const double dd = cells > 1 ? 12.0 / (cells - 1) : 0.0;
+            const kernels::ReturnRule rule{4.5, dd, dd > 0 ? 1 / dd : 0.0, cells, aligned, 360 / (2 * M_PI), 360};
+            for (const simd::Isa isa : isas_of_this_cpu()) {
+                for (std::size_t j = 0; j < returns.size(); j += kernels::ReturnReadings::size) {
+                    const std::size_t n = std::min(kernels::ReturnReadings::size, returns.size() - j);
+                    kernels::ReturnReadings in;
+                    ASSERT_EQ(kernels::read_returns(&returns[j].range, n, rule, in, isa), n);
+                    for (std::size_t k = 0; k < n; ++k) {
+                        const ScalarReading e = scalar_reading(returns[j + k], rule);
+                        const std::string where = "isa " + std::to_string(static_cast<int>(isa)) + ", cells " +
+                                                  std::to_string(cells) + ", return " + std::to_string(j + k);
+                        ASSERT_EQ(in.absent[k] != 0, e.absent) << where;
+                        if (e.absent) continue;
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(in.azimuth[k]), std::bit_cast<std::uint64_t>(e.azimuth)) << where;
+                        EXPECT_EQ(in.slot[k], e.slot) << where;
+                        EXPECT_EQ(in.width[k], e.width) << where;
+                        if (e.width == 0) continue;
+                        EXPECT_EQ(in.first[k], e.first) << where;
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(in.x0[k]), std::bit_cast<std::uint64_t>(e.x0)) << where;
+                    }
+                }
+            }
+        }
+    }
+    // The first invalid return of a batch is found, wherever it is and whatever comes before it.
+    const kernels::ReturnRule rule{4.5, 0.2, 5.0, 61, true, 360 / (2 * M_PI), 360};
+    for (const LidarReturn bad : {LidarReturn{-1.0, 0.0, 0.0}, LidarReturn{-INFINITY, 0.0, 0.0},
+                                  LidarReturn{1.0, NAN, 0.0}, LidarReturn{1.0, INFINITY, 0.0},
+                                  LidarReturn{1.0, 0.0, NAN}, LidarReturn{1.0, 0.0, -INFINITY}}) {
+        for (const std::size_t at : {0, 5, 8, 37, 63}) {
+            Scan batch(returns.begin(), returns.begin() + 64);
+            batch[at] = bad;
+            if (at + 1 < batch.size()) batch[at + 1] = {-2.0, 0.0, 0.0};  // a later invalid one is not the first
+            for (const simd::Isa isa : isas_of_this_cpu()) {
+                kernels::ReturnReadings in;
+                EXPECT_EQ(kernels::read_returns(&batch[0].range, batch.size(), rule, in, isa), at);
+            }
+        }
+    }
+}
 
 TEST(BoundaryVectorLayer, MatchesTheEquationsOnRandomReturns) {
     std::mt19937_64 gen(7);

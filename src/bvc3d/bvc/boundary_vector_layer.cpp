@@ -208,11 +208,25 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
     const bool use_memo = probe < 64 || changes < 56;
     double last_phi = NAN;
     bool skipped_row = false;
+    // Each return's wrapped azimuth, memo slot and distance window, 64 returns at a time by vector
+    // code: a superset of |r - d_m| <= cut (an extra cell only adds a true term). The kernel adds
+    // whole blocks of 8 cells, aligned: a return's loads then meet the previous return's stores at
+    // the same addresses, which the CPU forwards (a load straddling two earlier stores waits for
+    // both to reach the cache); the cells this adds get their true terms. Cells evaluated one by one
+    // (no recurrence) keep the window as it is: each costs an exp.
+    const kernels::ReturnRule rule{cut_r_, dd, inv_dd, M, recurrence, slot_scale_, static_cast<std::int32_t>(memo_slots_)};
+    static_assert(sizeof(LidarReturn) == 3 * sizeof(double));
+    kernels::ReturnReadings in;
 
     for (std::size_t j = 0; j < returns.size(); ++j) {
+        const std::size_t q = j % kernels::ReturnReadings::size;  // its readings in `in`
+        if (q == 0) {
+            const std::size_t n = std::min(kernels::ReturnReadings::size, returns.size() - j);
+            const std::size_t bad = kernels::read_returns(&returns[j].range, n, rule, in);
+            if (bad < n) check_return(returns[j + bad], j + bad);
+        }
+        if (in.absent[q]) continue;
         const LidarReturn& ret = returns[j];
-        if (is_no_return(ret)) continue;
-        if (!(ret.range >= 0) || !std::isfinite(ret.azimuth) || !std::isfinite(ret.elevation)) check_return(ret, j);
         // Elevation factors, cached across the returns of one scanner row.
         if (!(ret.elevation == last_phi)) {
             end_row();
@@ -242,8 +256,8 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         if (n_any == 0) continue;
         // The directions the azimuth reaches and their angular factors: its memo slot's record, or
         // one of its own after the memo's records. A record stays as it is while a waiting job reads it.
-        const double azimuth = wrap_pi(ret.azimuth);  // any azimuth, however many turns
-        const std::size_t slot = use_memo ? slot_of(azimuth) : 0;
+        const double azimuth = in.azimuth[q];
+        const std::size_t slot = use_memo ? static_cast<std::size_t>(in.slot[q]) : 0;
         std::size_t at = slot * record;
         if (use_memo && memo_weight_[at] == azimuth) {
             slot_batch_[slot] = batch_;
@@ -268,32 +282,15 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
                             dropped_e[l] * memo_weight_[at + 1 + d];
         }
         if (n_kept == 0) continue;
-
-        // Distance window: a superset of |r - d_m| <= cut (an extra cell only adds a true term), so
-        // truncation toward zero serves for floor and ceil (r >= 0; no libm call on baseline x86-64).
-        const double r = ret.range;
-        int m_lo = 0, m_hi = 0;
-        if (dd > 0) {
-            const double lo = (r - cut_r_) * inv_dd, hi = (r + cut_r_) * inv_dd;
-            m_lo = lo > 0 ? static_cast<int>(std::min(lo, 1e9)) : 0;
-            m_hi = static_cast<int>(std::min(hi, static_cast<double>(M - 2))) + 1;
-        } else if (r > cut_r_) {
-            m_lo = 1;  // no cell in reach
-        }
-        if (m_lo > m_hi) {
+        if (in.width[q] == 0) {  // no cell in reach
             if constexpr (planned) ++run_far;
             else
                 for (int i = 0; i < n_kept; ++i) far_weight_[kept_layers_[i]] += kept_elev_[i];
             continue;
         }
-        // The kernel adds whole blocks of 8 cells, aligned: a return's loads then meet the previous
-        // return's stores at the same addresses, which the CPU forwards (a load straddling two earlier
-        // stores waits for both to reach the cache). The cells this adds get their true terms. Cells
-        // evaluated one by one (no recurrence) keep the window as it is: each costs an exp.
         if (memo_dir_[at] == 0) continue;  // an azimuth between directions that reaches none
-        const int m_first = recurrence ? m_lo & ~7 : m_lo;
-        const int width = recurrence ? ((m_hi + 8) & ~7) - m_first : m_hi - m_lo + 1;
-        const double x0 = r - m_first * dd;
+        const int m_first = in.first[q], width = in.width[q];
+        const double x0 = in.x0[q];
         if constexpr (planned) {
             add_job({x0, 1.0, static_cast<std::uint32_t>(m_first), static_cast<std::uint32_t>(at), width, 0});
             row_summed = true;
@@ -607,13 +604,12 @@ void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<do
 void BoundaryVectorLayer::normalize(std::span<double> out, double mx) const {
     if (p_.normalization == BvcNormalization::per_step_max) {
         if (mx > 0) {
-            const double denom = 2.0 * mx;
-            for (double& v : out) v = v / denom;  // exact 0.5 at the maximum
+            kernels::divide(out.data(), out.size(), 2.0 * mx);  // exact 0.5 at the maximum
         } else {
             std::fill(out.begin(), out.end(), 0.0);
         }
     } else if (p_.normalization == BvcNormalization::fixed) {
-        for (double& v : out) v = v / p_.norm_constant;
+        kernels::divide(out.data(), out.size(), p_.norm_constant);
     }
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/simd.hpp"
 
 namespace bvc3d::kernels {
@@ -133,6 +134,78 @@ void nearest_returns(const double* azimuth, std::size_t n, const double* theta, 
     }
 }
 
+namespace {
+
+// The ranges, azimuths and elevations of L returns (3·L consecutive doubles) as vectors of L lanes.
+template <class V>
+[[gnu::always_inline]] inline void fields(const double* p, V& range, V& azimuth, V& elevation) {
+    constexpr int L = sizeof(V) / sizeof(double);
+    if constexpr (L == 8) {
+        V v0, v1, v2;
+        simd::load(v0, p);
+        simd::load(v1, p + 8);
+        simd::load(v2, p + 16);
+        const V r = __builtin_shufflevector(v0, v1, 0, 3, 6, 9, 12, 15, 0, 0);
+        const V a = __builtin_shufflevector(v0, v1, 1, 4, 7, 10, 13, 0, 0, 0);
+        const V e = __builtin_shufflevector(v0, v1, 2, 5, 8, 11, 14, 0, 0, 0);
+        range = __builtin_shufflevector(r, v2, 0, 1, 2, 3, 4, 5, 10, 13);
+        azimuth = __builtin_shufflevector(a, v2, 0, 1, 2, 3, 4, 8, 11, 14);
+        elevation = __builtin_shufflevector(e, v2, 0, 1, 2, 3, 4, 9, 12, 15);
+    } else {
+        for (int k = 0; k < L; ++k) {
+            range[k] = p[3 * k];
+            azimuth[k] = p[3 * k + 1];
+            elevation[k] = p[3 * k + 2];
+        }
+    }
+}
+
+[[gnu::always_inline]] inline std::int32_t slot_of(double wrapped, const ReturnRule& rule) {
+    const auto s = static_cast<std::int32_t>((wrapped + std::numbers::pi) * rule.slot_scale);
+    return s < rule.slots ? s : rule.slots - 1;
+}
+
+// read_returns, compiled for each instruction set (see read_returns.inc).
+#if BVC3D_HAVE_DISPATCH
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v4")
+namespace v4 {
+constexpr int lanes = 8;
+#include "bvc3d/bvc/read_returns.inc"
+}  // namespace v4
+#pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v3")
+namespace v3 {
+constexpr int lanes = 4;
+#include "bvc3d/bvc/read_returns.inc"
+}  // namespace v3
+#pragma GCC pop_options
+#endif
+namespace baseline {
+constexpr int lanes = 2;
+#include "bvc3d/bvc/read_returns.inc"
+}  // namespace baseline
+}  // namespace
+
+std::size_t read_returns(const double* returns, std::size_t n, const ReturnRule& rule, ReturnReadings& out) {
+    return read_returns(returns, n, rule, out, simd::isa());
+}
+
+std::size_t read_returns(const double* returns, std::size_t n, const ReturnRule& rule, ReturnReadings& out,
+                         simd::Isa isa) {
+#if BVC3D_HAVE_DISPATCH
+    switch (isa) {
+        case simd::Isa::v4: return v4::read_returns(returns, n, rule, out);
+        case simd::Isa::v3: return v3::read_returns(returns, n, rule, out);
+        case simd::Isa::baseline: break;
+    }
+#else
+    (void)isa;
+#endif
+    return baseline::read_returns(returns, n, rule, out);
+}
+
 BVC3D_DISPATCH
 double largest(const double* v, std::size_t n) {
     if (n == 0) return 0.0;
@@ -147,6 +220,11 @@ double largest(const double* v, std::size_t n) {
     for (int k = 1; k < 8; ++k) best = m[k] > best ? m[k] : best;
     for (; i < n; ++i) best = v[i] > best ? v[i] : best;
     return best;
+}
+
+BVC3D_DISPATCH
+void divide(double* v, std::size_t n, double by) {
+    for (std::size_t j = 0; j < n; ++j) v[j] = v[j] / by;
 }
 
 }  // namespace bvc3d::kernels

@@ -60,28 +60,27 @@ void PlaceCellNetwork::inputs(std::span<const double> bvc_rates, float* vb) cons
 
 void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, std::vector<int>* learned) {
     const float k = static_cast<float>(p_.dt_over_tau);
-    // Inhibition uses the BVC total and the place cells' previous rates.
+    // Inhibition uses the BVC total and the place cells' previous rates, summed in index order. Only
+    // the cells that were active can have a rate other than ±0, and adding ±0 to a sum that is not −0
+    // leaves it as it is (a sum of floats from +0 is never −0): summing the active ones is the sum.
+    float previous = 0;
+    for (int i : active_) previous += v_[i];
     const float inhibition = static_cast<float>(p_.gamma_pb) * kernels::sum8(vb, stride_) +
-                             static_cast<float>(p_.gamma_pp) * [&] {
-                                 float s = 0;
-                                 for (float v : v_) s += v;
-                                 return s;
-                             }();
-    const float gain = static_cast<float>(p_.gain);
-    for (int i = 0; i < p_.n_place; ++i) {
-        s_[i] = s_[i] + k * (-s_[i] + drive[i] - inhibition);
-        // tanh(g·[s]+), but for a silent cell (the argument ±0, or NaN) the argument is its own tanh.
-        const float x = gain * std::max(s_[i], 0.0f);
-        v_[i] = s_[i] > 0.0f ? std::tanh(x) : x;
-    }
+                             static_cast<float>(p_.gamma_pp) * previous;
+    // tanh(g·[s]+); for a silent cell (the argument ±0, or NaN) the argument is its own tanh.
+    bool finite = false;
+    active_.resize(s_.size());
+    active_.resize(kernels::membrane_step(s_.data(), drive, s_.size(), k, inhibition, static_cast<float>(p_.gain),
+                                          v_.data(), active_.data(), &finite));
+    for (int i : active_) v_[i] = std::tanh(v_[i]);
     // Weights that ran away (a learning rate far too large) show up here first: stop early.
-    if (!std::isfinite(inhibition) || !std::all_of(s_.begin(), s_.end(), [](float x) { return std::isfinite(x); }))
+    if (!std::isfinite(inhibition) || !finite)
         throw InputError("place cells diverged (non-finite membrane potentials): the weights ran away; is the "
                          "learning rate eta = " + std::to_string(p_.eta) + " too large?");
     if (!learn || !(p_.eta > 0)) return;
     // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
     const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
-    for (int i = 0; i < p_.n_place; ++i) {
+    for (int i : active_) {
         const float vi = v_[i];
         if (vi == 0.0f) continue;
         kernels::oja_row(row(i), vb, eta * vi, vi * inv_alpha, tiny_operand, stride_);
@@ -144,12 +143,16 @@ void PlaceCellNetwork::set_weights(std::span<const float> w) {
 void PlaceCellNetwork::reset() {
     std::fill(s_.begin(), s_.end(), 0.0f);
     std::fill(v_.begin(), v_.end(), 0.0f);
+    active_.clear();
 }
 
 void PlaceCellNetwork::set_state(std::span<const float> membrane, std::span<const float> rates) {
     if (membrane.size() != s_.size() || rates.size() != v_.size()) throw InputError("place cells: state has the wrong size");
     std::copy(membrane.begin(), membrane.end(), s_.begin());
     std::copy(rates.begin(), rates.end(), v_.begin());
+    active_.clear();  // any cell may be active: every rate other than ±0
+    for (std::size_t i = 0; i < v_.size(); ++i)
+        if (v_[i] != 0.0f) active_.push_back(static_cast<int>(i));
 }
 
 }  // namespace bvc3d

@@ -75,6 +75,7 @@ private:
     PlaceParams p_;
     std::vector<float, CacheAligned<float>> w_;
     std::vector<float> s_, v_, vb_, drive_;
+    std::vector<int> active_;         // the cells whose rate may be other than ±0 (s > 0 at the last step)
     std::vector<float> block_rates_;  // step_block's results
     std::vector<int> learned_;        // rows Oja's rule changed within a block
     std::vector<char> is_learned_;

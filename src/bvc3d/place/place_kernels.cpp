@@ -128,17 +128,19 @@ float paired_row_product(const float* w, const float* v, std::size_t n) {
 BVC3D_DISPATCH
 std::size_t to_floats(const double* in, float* out, std::size_t n, float tiny) {
     const f8 lo = {tiny, tiny, tiny, tiny, tiny, tiny, tiny, tiny}, zero = {0, 0, 0, 0, 0, 0, 0, 0};
+    simd::d8 bad = {0, 0, 0, 0, 0, 0, 0, 0};  // x − x: 0 for a finite x, NaN otherwise
     std::size_t j = 0;
     for (; j + 8 <= n; j += 8) {
         simd::d8 x;
         simd::load(x, in + j);
-        const simd::d8 finite = x - x;  // 0 for a finite x, NaN otherwise
-        if (!(finite[0] == 0 && finite[1] == 0 && finite[2] == 0 && finite[3] == 0 && finite[4] == 0 &&
-              finite[5] == 0 && finite[6] == 0 && finite[7] == 0))
-            break;
+        bad += x - x;
         const f8 f = __builtin_convertvector(x, f8);
         simd::store(out + j, (f < lo) & (f > -lo) ? zero : f);
     }
+    const bool finite = bad[0] == 0 && bad[1] == 0 && bad[2] == 0 && bad[3] == 0 && bad[4] == 0 && bad[5] == 0 &&
+                        bad[6] == 0 && bad[7] == 0;
+    for (std::size_t i = 0; i < j && !finite; ++i)
+        if (!(in[i] - in[i] == 0)) return i;
     for (; j < n; ++j) {
         if (!(in[j] - in[j] == 0)) return j;
         const float f = static_cast<float>(in[j]);
@@ -156,6 +158,37 @@ float sum8(const float* v, std::size_t n) {
         acc += a;
     }
     return reduce8(acc, 0);
+}
+
+BVC3D_DISPATCH
+std::size_t membrane_step(float* __restrict s, const float* __restrict drive, std::size_t n, float k, float inhibition,
+                          float gain, float* __restrict v, int* __restrict positive, bool* finite) {
+    f8 bad = {0, 0, 0, 0, 0, 0, 0, 0};  // s − s: 0 for a finite s, NaN otherwise
+    const f8 zero = bad;
+    std::size_t j = 0;
+    for (; j + 8 <= n; j += 8) {
+        f8 x, d;
+        simd::load(x, s + j);
+        simd::load(d, drive + j);
+        x = x + k * (-x + d - inhibition);
+        simd::store(s + j, x);
+        bad += x - x;
+        simd::store(v + j, gain * (x < zero ? zero : x));  // std::max(x, 0): NaN and −0 stay
+    }
+    bool ok = bad[0] == 0 && bad[1] == 0 && bad[2] == 0 && bad[3] == 0 && bad[4] == 0 && bad[5] == 0 &&
+              bad[6] == 0 && bad[7] == 0;
+    for (; j < n; ++j) {
+        s[j] = s[j] + k * (-s[j] + drive[j] - inhibition);
+        ok = ok && s[j] - s[j] == 0;
+        v[j] = gain * (s[j] < 0.0f ? 0.0f : s[j]);
+    }
+    *finite = ok;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        positive[count] = static_cast<int>(i);
+        count += s[i] > 0.0f;
+    }
+    return count;
 }
 
 BVC3D_DISPATCH
