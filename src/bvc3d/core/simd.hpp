@@ -3,6 +3,9 @@
 // and the baseline, and the loader picks the best the CPU runs. The binary still runs on any
 // x86-64. Kernels under this attribute keep lanes independent and the build forbids FMA
 // contraction (-ffp-contract=off), so every clone computes bit-identical results.
+// GCC 12 lowers vector comparisons lane by lane in target_clones and in bodies inlined into a target
+// function; a kernel built on them is compiled once per instruction set under `#pragma GCC target`
+// instead (bvc/read_returns.inc).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(BVC3D_NO_DISPATCH)
 #define BVC3D_DISPATCH __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #define BVC3D_TARGET_V4 __attribute__((target("arch=x86-64-v4")))
