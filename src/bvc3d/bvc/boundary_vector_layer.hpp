@@ -161,11 +161,7 @@ private:
     // the rows of a scan).
     static constexpr std::size_t default_slots = 1024;
     mutable std::size_t memo_slots_ = 0;
-    mutable double slot_scale_ = 0;  // memo_slots_ / 2π
-    std::size_t slot_of(double azimuth) const {
-        const auto s = static_cast<std::size_t>((azimuth + 3.14159265358979323846) * slot_scale_);
-        return s < memo_slots_ ? s : memo_slots_ - 1;
-    }
+    mutable double slot_scale_ = 0;  // memo_slots_ / 2π (kernels::read_returns gives each return its slot)
     void size_memo(std::size_t slots) const;
     int reach_ = 0;
     // The directions `azimuth` reaches and their angular factors; returns how many (at most reach_).

@@ -3,9 +3,9 @@
 // and the baseline, and the loader picks the best the CPU runs. The binary still runs on any
 // x86-64. Kernels under this attribute keep lanes independent and the build forbids FMA
 // contraction (-ffp-contract=off), so every clone computes bit-identical results.
-// GCC 12 lowers vector comparisons lane by lane in target_clones and in bodies inlined into a target
-// function; a kernel built on them is compiled once per instruction set under `#pragma GCC target`
-// instead (bvc/read_returns.inc).
+// GCC 12 can lower vector comparisons lane by lane under target_clones or in a body inlined into a
+// target function (it did for read_returns' 64-bit masks); such a kernel is compiled once per
+// instruction set under `#pragma GCC target` instead (bvc/read_returns.inc). Check with objdump.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(BVC3D_NO_DISPATCH)
 #define BVC3D_DISPATCH __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #define BVC3D_TARGET_V4 __attribute__((target("arch=x86-64-v4")))
@@ -15,6 +15,8 @@
 #define BVC3D_DISPATCH
 #define BVC3D_HAVE_DISPATCH 0
 #endif
+
+#include <cstddef>
 
 namespace bvc3d::simd {
 
@@ -35,6 +37,14 @@ template <class V, class T>
 inline void load(V& v, const T* p) { __builtin_memcpy(&v, p, sizeof v); }
 template <class V, class T>
 inline void store(T* p, const V& v) { __builtin_memcpy(p, &v, sizeof v); }
+
+// Whether every lane of v is 0 (a NaN lane is not), lane by lane: once per call, after a loop.
+template <class V>
+inline bool all_zero(const V& v) {
+    bool all = true;
+    for (std::size_t k = 0; k < sizeof v / sizeof v[0]; ++k) all = all && v[k] == 0;
+    return all;
+}
 
 // The instruction set target_clones would pick on this CPU, for kernels that instantiate a
 // width-generic body per instruction set themselves (BVC3D_TARGET_V4/V3 functions).

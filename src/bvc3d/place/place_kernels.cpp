@@ -137,8 +137,7 @@ std::size_t to_floats(const double* in, float* out, std::size_t n, float tiny) {
         const f8 f = __builtin_convertvector(x, f8);
         simd::store(out + j, (f < lo) & (f > -lo) ? zero : f);
     }
-    const bool finite = bad[0] == 0 && bad[1] == 0 && bad[2] == 0 && bad[3] == 0 && bad[4] == 0 && bad[5] == 0 &&
-                        bad[6] == 0 && bad[7] == 0;
+    const bool finite = simd::all_zero(bad);
     for (std::size_t i = 0; i < j && !finite; ++i)
         if (!(in[i] - in[i] == 0)) return i;
     for (; j < n; ++j) {
@@ -175,8 +174,7 @@ std::size_t membrane_step(float* __restrict s, const float* __restrict drive, st
         bad += x - x;
         simd::store(v + j, gain * (x < zero ? zero : x));  // std::max(x, 0): NaN and −0 stay
     }
-    bool ok = bad[0] == 0 && bad[1] == 0 && bad[2] == 0 && bad[3] == 0 && bad[4] == 0 && bad[5] == 0 &&
-              bad[6] == 0 && bad[7] == 0;
+    bool ok = simd::all_zero(bad);
     for (; j < n; ++j) {
         s[j] = s[j] + k * (-s[j] + drive[j] - inhibition);
         ok = ok && s[j] - s[j] == 0;
