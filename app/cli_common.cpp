@@ -5,13 +5,13 @@
 
 #include <cerrno>
 #include <charconv>
-#include <cstdlib>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <vector>
 
-#include "bvc3d/core/angles.hpp"
 #include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/memory.hpp"
@@ -66,8 +66,9 @@ const CLI::Validator non_negative_check(
     [](std::string& s) -> std::string {
         double v = 0;
         const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-        return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(v) && v >= 0 ? ""
-                                                                                                  : "must be a number >= 0";
+        return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(v) && v >= 0
+                   ? ""
+                   : "must be a number >= 0";
     },
     "NUMBER>=0");
 
@@ -89,7 +90,8 @@ Pose parse_pose(const std::string& text) {
             parts.push_back(text.substr(start, i - start));
             start = i + 1;
         }
-    if (parts.size() != 3) throw InputError("--pose expects X,Y,HEADING (three comma-separated numbers), got '" + text + "'");
+    if (parts.size() != 3)
+        throw InputError("--pose expects X,Y,HEADING (three comma-separated numbers), got '" + text + "'");
     Pose p;  // on the floor, level
     p.x = parse_number(parts[0], "--pose: X");
     p.y = parse_number(parts[1], "--pose: Y");
@@ -107,8 +109,9 @@ namespace {
 
 // Text as one shell word: as it is when safe, else single-quoted.
 std::string shell_word(const std::string& s) {
-    const bool safe = !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-                                                         "_-./:=+,@%") == std::string::npos;
+    const bool safe = !s.empty() && s.find_first_not_of(
+                                        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                        "_-./:=+,@%") == std::string::npos;
     if (safe) return s;
     std::string q = "'";
     for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -151,8 +154,7 @@ int run_python_module(const std::string& module, const std::vector<std::string>&
         ::_exit(127);
     }
     int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
@@ -194,16 +196,17 @@ void apply_extent(const ExtentOption& e, TrialConfig& t) {
 
 int check_jobs(int jobs) {
     if (jobs < 0) throw InputError("--jobs must be >= 0 (0: one per core), got " + std::to_string(jobs));
-    if (jobs > max_jobs) throw InputError("--jobs " + std::to_string(jobs) + " is more than the limit of " + std::to_string(max_jobs));
+    if (jobs > max_jobs)
+        throw InputError("--jobs " + std::to_string(jobs) + " is more than the limit of " + std::to_string(max_jobs));
     return jobs;
 }
 
-const char* const no_memory_check_help =
-    "Run even when the estimated memory exceeds what the machine has available";
+const char* const no_memory_check_help = "Run even when the estimated memory exceeds what the machine has available";
 
 void check_run_memory(const std::vector<TrialConfig>& trials, int jobs, bool skip) {
     if (skip) return;
-    const std::string what = trials.size() == 1 ? "this trial" : "this run (" + std::to_string(trials.size()) + " trials)";
+    const std::string what =
+        trials.size() == 1 ? "this trial" : "this run (" + std::to_string(trials.size()) + " trials)";
     check_memory(estimate_memory(trials, jobs), what,
                  "shorten sample_hours, use fewer --jobs or smaller models, or pass --no-memory-check to try anyway");
 }

@@ -5,12 +5,12 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
-#include <string_view>
 #include <string>
+#include <string_view>
 #include <vector>
 
-#include "bvc3d/core/geometry.hpp"
 #include "bvc3d/analysis/types.hpp"
+#include "bvc3d/core/geometry.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 
 namespace bvc3d::cli {
@@ -108,7 +108,7 @@ void add_experiment_commands(CLI::App& app);
 void add_sweep_command(CLI::App& app);
 void add_flight_command(CLI::App& app);
 void add_recording_commands(CLI::App& app);
-void add_view_command(CLI::App& app);  // view/cmd_view.cpp
+void add_view_command(CLI::App& app);      // view/cmd_view.cpp
 void add_adaptive_command(CLI::App& app);  // cmd_adaptive.cpp
 
 }  // namespace bvc3d::cli

@@ -42,7 +42,8 @@ std::pair<int, int> parse_layers(const std::string& text) {
     const auto dash = text.find('-');
     const auto whole = [&](const std::string& s) {
         const double v = parse_number(s, "--layers");
-        if (v != static_cast<int>(v) || v < 1) throw InputError("--layers: '" + text + "' is not N or MIN-MAX with whole numbers >= 1");
+        if (v != static_cast<int>(v) || v < 1)
+            throw InputError("--layers: '" + text + "' is not N or MIN-MAX with whole numbers >= 1");
         return static_cast<int>(v);
     };
     if (dash == std::string::npos) return {whole(text), whole(text)};
@@ -106,7 +107,8 @@ void choose(const ChooseOptions& o) {
     p.validate(base.bvc.n_dir);
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
     // Fail before minutes of work, not after.
-    if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty()) ensure_writable_directory(folder);
+    if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty())
+        ensure_writable_directory(folder);
     const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
     const auto sets = o.sets.empty() ? std::vector<std::vector<double>>{} : parse_sets(o.sets);
     InterruptGuard guard;
@@ -122,8 +124,9 @@ void choose(const ChooseOptions& o) {
             const std::string name = o.world.empty() ? "cross" : o.world;
             const World world(config::resolve_world(name, o.tilt, o.lean));
             agent->check_world(world.description());
-            std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n", name.c_str(), format_number(p.explore_minutes).c_str(),
-                        static_cast<unsigned long long>(p.seed), elevations_text(p.candidate_elevations()).c_str());
+            std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n",
+                        name.c_str(), format_number(p.explore_minutes).c_str(), static_cast<unsigned long long>(p.seed),
+                        elevations_text(p.candidate_elevations()).c_str());
             c = sets.empty() ? choose_elevations(world, base, *agent, p, analysis)
                              : choose_from_sets(world, base, *agent, sets, p, analysis);
         }
@@ -132,17 +135,19 @@ void choose(const ChooseOptions& o) {
         std::exit(130);
     }
     std::printf("%zu walk steps; criterion = MSAI of the network on the walk (lower is better)\n", c.walk_steps);
-    std::printf("%5s  %-28s %10s %8s %10s %9s\n", "round", "elevations (rad)", "n_per_axis", "MSAI", "MI>1 frac", "BVC MSAI");
+    std::printf("%5s  %-28s %10s %8s %10s %9s\n", "round", "elevations (rad)", "n_per_axis", "MSAI", "MI>1 frac",
+                "BVC MSAI");
     for (const auto& s : c.candidates)
-        std::printf("%5d  %-28s %10d %8.4f %10.3f %9.4f\n", s.round, elevations_text(s.elevations).c_str(), s.n_per_axis, s.msai,
-                    s.frac_multimodal, s.bvc_msai);
-    std::printf("chosen: %s rad, %d per axis (MSAI %.4f)\n", elevations_text(c.chosen.elevations).c_str(), c.chosen.n_per_axis,
-                c.chosen.msai);
+        std::printf("%5d  %-28s %10d %8.4f %10.3f %9.4f\n", s.round, elevations_text(s.elevations).c_str(),
+                    s.n_per_axis, s.msai, s.frac_multimodal, s.bvc_msai);
+    std::printf("chosen: %s rad, %d per axis (MSAI %.4f)\n", elevations_text(c.chosen.elevations).c_str(),
+                c.chosen.n_per_axis, c.chosen.msai);
     AtomicFile file(o.out);
     file.stream() << "# chosen by bvc3d choose-elevations: " << exploration.text << ", sensor " << sensor << ", "
-                  << (exploration.recorded ? std::string("recorded walk") : format_number(p.explore_minutes) + " min walk")
-                  << ", seed " << p.seed << ", budget " << p.budget << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai)
-                  << "\n"
+                  << (exploration.recorded ? std::string("recorded walk")
+                                           : format_number(p.explore_minutes) + " min walk")
+                  << ", seed " << p.seed << ", budget " << p.budget
+                  << "\n# criterion (MSAI of the network on the walk): " << format_number(c.chosen.msai) << "\n"
                   << config::model_to_yaml(c.model);
     file.commit();
     std::printf("wrote %s\n", o.out.c_str());
@@ -152,8 +157,8 @@ void choose(const ChooseOptions& o) {
 
 void add_adaptive_command(CLI::App& app) {
     auto o = std::make_shared<ChooseOptions>();
-    auto* cmd = app.add_subcommand("choose-elevations",
-                                   "Choose the BVC layers' elevations from a short exploratory walk; write the model YAML");
+    auto* cmd = app.add_subcommand(
+        "choose-elevations", "Choose the BVC layers' elevations from a short exploratory walk; write the model YAML");
     cmd->add_option("--world", o->world, "World preset or YAML file (default: cross)");
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
@@ -172,13 +177,14 @@ void add_adaptive_command(CLI::App& app) {
     cmd->add_option("--layers", o->layers, "Number of layers: N or MIN-MAX")->capture_default_str();
     cmd->add_option("--min-elevation", o->elevation_min,
                     "Lowest candidate elevation, rad (default: 0 on the ground, -(max elevation) when flying)");
-    cmd->add_option("--max-elevation", o->params.elevation_max, "Highest candidate elevation, rad")->capture_default_str();
-    cmd->add_option("--elevation-step", o->params.elevation_step, "Spacing of the candidate elevations, rad")->capture_default_str();
+    cmd->add_option("--max-elevation", o->params.elevation_max, "Highest candidate elevation, rad")
+        ->capture_default_str();
+    cmd->add_option("--elevation-step", o->params.elevation_step, "Spacing of the candidate elevations, rad")
+        ->capture_default_str();
     cmd->add_option("--explore-minutes", o->params.explore_minutes, "Simulated minutes of the exploratory walk")
         ->capture_default_str();
     cmd->add_option("--seed", o->params.seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
-    cmd->add_option("--sets", o->sets,
-                    "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
+    cmd->add_option("--sets", o->sets, "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
     cmd->add_option("--jobs", o->params.jobs, "Threads sharing the candidates; 0 (the default): one per core");
     cmd->add_option("--out", o->out, "Model YAML file to write")->required();
     cmd->callback([o] { choose(*o); });

@@ -19,11 +19,11 @@
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
-#include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/config/sweep_yaml.hpp"
+#include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
-#include "bvc3d/core/output_lock.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/output_lock.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 #include "bvc3d/report/summary.hpp"
@@ -90,8 +90,7 @@ ReportRun run_report(const PythonCommand& command, const std::filesystem::path& 
     }
     ::close(pipe_fds[0]);
     int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
     run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     std::string tail = text;
     while (!tail.empty() && (tail.back() == '\n' || tail.back() == '\r')) tail.pop_back();
@@ -121,8 +120,8 @@ std::vector<std::filesystem::path> remove_partial_report(const std::filesystem::
             const auto name = e.path().filename().string();
             // The report's own temporaries ("report.md.tmp") and ours ("x.csv.tmp<pid>-<n>").
             const auto at = name.rfind(".tmp");
-            const bool temporary = at != std::string::npos &&
-                                   name.find_first_not_of("0123456789-", at + 4) == std::string::npos;
+            const bool temporary =
+                at != std::string::npos && name.find_first_not_of("0123456789-", at + 4) == std::string::npos;
             const bool broken_png = e.path().extension() == ".png" && !png_complete(e.path());
             if (e.is_regular_file(ec) && (temporary || broken_png) && std::filesystem::remove(e.path(), ec))
                 removed.push_back(e.path());
@@ -301,7 +300,8 @@ void run_one(const TrialConfig& t, const std::filesystem::path& out, double chec
     const auto& r = done.result;
     std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), r.t.size(),
                 (r.stats.explore_steps + r.stats.sample_steps) / wall);
-    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics)) std::printf("  %-16s %g\n", name.c_str(), v);
+    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics))
+        std::printf("  %-16s %g\n", name.c_str(), v);
 }
 
 void add_run(CLI::App& app) {
@@ -314,8 +314,9 @@ void add_run(CLI::App& app) {
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
     cmd->add_option("--trajectory", o->trajectory,
                     "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
-    cmd->add_option("--agent", o->agent,
-                    "random_walk or ground (the ground robot, default), flight or flying (the flying agent; docs/flying.md)");
+    cmd->add_option(
+        "--agent", o->agent,
+        "random_walk or ground (the ground robot, default), flight or flying (the flying agent; docs/flying.md)");
     cmd->add_option("--seed", o->seed, "Random seed, 0 .. 2^64 - 1 (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
@@ -331,8 +332,8 @@ void add_run(CLI::App& app) {
     cmd->footer("Ctrl-C checkpoints and stops; running the same command again resumes and gives the same file.");
     cmd->callback([o] {
         const TrialConfig t = run_config(*o);
-        const std::filesystem::path out = o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
-                                                         : std::filesystem::path(o->out);
+        const std::filesystem::path out =
+            o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5") : std::filesystem::path(o->out);
         require_not_directory(out, "--out");
         ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
         const OutputLock lock(file_lock_path(out), "trial file '" + out.string() + "'");
@@ -364,13 +365,15 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
     std::vector<std::string> choices = paper_preset(o.preset).choices;
     for (const auto& c : split(o.choices)) choices.push_back(c);
-    const double n_trials = static_cast<double>(o.seeds) * static_cast<double>(models.size()) * static_cast<double>(tilts.size());
+    const double n_trials =
+        static_cast<double>(o.seeds) * static_cast<double>(models.size()) * static_cast<double>(tilts.size());
     if (o.seeds < 1) throw InputError("--seeds must be >= 1, got " + std::to_string(o.seeds));
     if (n_trials > config::max_trials)
         throw InputError("--seeds " + std::to_string(o.seeds) + " × " + std::to_string(models.size()) + " models × " +
                          std::to_string(tilts.size()) + " tilts = " + num(n_trials) + " trials; the limit is " +
                          std::to_string(static_cast<long long>(config::max_trials)));
-    if (o.hours && (!(*o.hours > 0) || !std::isfinite(*o.hours))) throw InputError("--hours must be a positive number of hours");
+    if (o.hours && (!(*o.hours > 0) || !std::isfinite(*o.hours)))
+        throw InputError("--hours must be a positive number of hours");
     const ExtentOption extent = parse_extent(o.extent.empty() ? "data" : o.extent);
     std::vector<TrialConfig> trials;
     for (int seed = 0; seed < o.seeds; ++seed)
@@ -390,7 +393,8 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
 }
 
 void add_paper(CLI::App& app) {
-    auto* cmd = app.add_subcommand("paper", "Run the paper's experiment: models x tilted worlds x seeds, summary, figures");
+    auto* cmd =
+        app.add_subcommand("paper", "Run the paper's experiment: models x tilted worlds x seeds, summary, figures");
     auto o = std::make_shared<PaperOptions>();
     cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
     cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
@@ -403,9 +407,9 @@ void add_paper(CLI::App& app) {
     for (const auto& p : paper_presets()) presets += "\n  " + p.name + ": " + p.description;
     for (const auto& c : authors_choices()) choice_names += "\n  " + c.name + ": " + c.description;
     cmd->add_option("--preset", o->preset, "The experiment's configuration:" + presets)->capture_default_str();
-    cmd->add_option("--authors-choices", o->choices,
-                    "Comma-separated authors' choices to switch on besides the preset's (docs/reproduction.md):" +
-                        choice_names);
+    cmd->add_option(
+        "--authors-choices", o->choices,
+        "Comma-separated authors' choices to switch on besides the preset's (docs/reproduction.md):" + choice_names);
     cmd->add_option("--extent", o->extent, extent_help);
     cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
                     "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
@@ -413,7 +417,8 @@ void add_paper(CLI::App& app) {
     cmd->add_flag("--no-memory-check", o->no_memory_check, no_memory_check_help);
     cmd->footer(
         "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and the figures and report.md (the\n"
-        "Python module bvc3d.report, run with " BVC3D_PYTHON " or $BVC3D_PYTHON). Completed trials are skipped on\n"
+        "Python module bvc3d.report, run with " BVC3D_PYTHON
+        " or $BVC3D_PYTHON). Completed trials are skipped on\n"
         "a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
         check_jobs(o->jobs);
@@ -426,7 +431,8 @@ void add_paper(CLI::App& app) {
             run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, o->no_memory_check, {}});
         print_outcome(trials.size(), o->out, outcome);
         summarize(o->out, outcome.files, !o->no_report);
-        std::printf("summary: %s/summary.md%s\n", o->out.c_str(), o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
+        std::printf("summary: %s/summary.md%s\n", o->out.c_str(),
+                    o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
     });
 }
 
@@ -445,17 +451,21 @@ void add_analyze(CLI::App& app) {
     cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
     cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
     cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
-    cmd->add_option("--mi-quantile", o->mi_quantile, "Rate-map threshold quantile of the modality index (-1: --quantile's)");
+    cmd->add_option("--mi-quantile", o->mi_quantile,
+                    "Rate-map threshold quantile of the modality index (-1: --quantile's)");
     cmd->add_option("--skip-samples", o->skip_samples, "Recorded samples to leave out at the start");
-    cmd->add_option("--msai-bins", o->msai_bins, "Divide SAI and MSAI by this fixed number of bins (0: each trial's own)");
+    cmd->add_option("--msai-bins", o->msai_bins,
+                    "Divide SAI and MSAI by this fixed number of bins (0: each trial's own)");
     cmd->add_option("--extent", o->extent, extent_help);
-    cmd->add_option("--decoding-templates", o->templates,
-                    "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
+    cmd->add_option(
+        "--decoding-templates", o->templates,
+        "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
     cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
-    cmd->footer("Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
-                "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20 (10 for flying agents'\n"
-                "3-D files), d-th 2, decoding templates rate_maps, mi-quantile -1, skip-samples 0, msai-bins 0;\n"
-                "docs/analysis.md, docs/flying.md).");
+    cmd->footer(
+        "Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
+        "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20 (10 for flying agents'\n"
+        "3-D files), d-th 2, decoding templates rate_maps, mi-quantile -1, skip-samples 0, msai-bins 0;\n"
+        "docs/analysis.md, docs/flying.md).");
     cmd->callback([o] {
         const bool new_extent = !o->extent.empty();
         const ExtentOption extent = parse_extent(new_extent ? o->extent : "data");
@@ -519,7 +529,8 @@ void add_analyze(CLI::App& app) {
                 AtomicFile f(o->cells);
                 // field_area is m² of hexagons in 2-D, m³ of voxels in 3-D; isotropy only for 3-D files.
                 const bool three = m.dims == 3;
-                f.stream() << "cell,modality,peak_rate,mean_rate,field_area,spatial_info" << (three ? ",isotropy\n" : "\n");
+                f.stream() << "cell,modality,peak_rate,mean_rate,field_area,spatial_info"
+                           << (three ? ",isotropy\n" : "\n");
                 for (std::size_t c = 0; c < m.modality.size(); ++c) {
                     f.stream() << c << ',' << m.modality[c] << ',' << num(m.cells.peak_rate[c]) << ','
                                << num(m.cells.mean_rate[c]) << ',' << num(m.cells.field_area[c]) << ','
@@ -534,7 +545,8 @@ void add_analyze(CLI::App& app) {
 }
 
 void add_summarize(CLI::App& app) {
-    auto* cmd = app.add_subcommand("summarize", "Write trials.csv, summary.csv/.md and the figures for a folder of trial files");
+    auto* cmd = app.add_subcommand("summarize",
+                                   "Write trials.csv, summary.csv/.md and the figures for a folder of trial files");
     struct Options {
         std::string dir;
         bool no_report = false, skip_unreadable = false, allow_mixed = false;
@@ -542,14 +554,16 @@ void add_summarize(CLI::App& app) {
     auto o = std::make_shared<Options>();
     cmd->add_option("folder", o->dir, "Folder of trial files")->required();
     cmd->add_flag("--no-report", o->no_report, "Skip the figures");
-    cmd->add_flag("--skip-unreadable", o->skip_unreadable,
-                  "Leave out .h5 files that are not readable trial files (each named on standard error) instead of stopping");
+    cmd->add_flag(
+        "--skip-unreadable", o->skip_unreadable,
+        "Leave out .h5 files that are not readable trial files (each named on standard error) instead of stopping");
     cmd->add_flag("--allow-mixed", o->allow_mixed,
                   "Put trials of different protocols, durations or analysis parameters into one table");
     cmd->callback([o] {
         std::error_code ec;
         if (!std::filesystem::is_directory(o->dir, ec))
-            throw InputError("'" + o->dir + "' is not a folder" + (std::filesystem::exists(o->dir, ec) ? "" : " (it does not exist)"));
+            throw InputError("'" + o->dir + "' is not a folder" +
+                             (std::filesystem::exists(o->dir, ec) ? "" : " (it does not exist)"));
         const OutputLock lock(folder_lock_path(o->dir), "output folder '" + o->dir + "'");
         std::vector<std::filesystem::path> candidates, files;
         for (const auto& e : std::filesystem::directory_iterator(o->dir))

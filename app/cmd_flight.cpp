@@ -11,7 +11,8 @@ namespace bvc3d::cli {
 namespace {
 
 struct FlightOptions {
-    std::string out = "results/flight", models = "fly-up,fly-5l,fly-9l", worlds = "flight-room,atrium,cross-60", protocol;
+    std::string out = "results/flight", models = "fly-up,fly-5l,fly-9l", worlds = "flight-room,atrium,cross-60",
+                protocol;
     int seeds = 1, jobs = 0;
     std::optional<double> hours, explore_hours, sample_hours;
     double checkpoint_minutes = 0;
@@ -29,8 +30,8 @@ std::vector<std::string> split_list(const std::string& s) {
 // Models × worlds × seeds, seeds slowest; the protocol of docs/flying.md (8 h + 8 h) unless shortened.
 std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
     if (o.seeds < 1) throw InputError("--seeds must be >= 1");
-    for (const auto& [h, name] : {std::pair{o.hours, "--hours"}, {o.explore_hours, "--explore-hours"},
-                                  {o.sample_hours, "--sample-hours"}})
+    for (const auto& [h, name] :
+         {std::pair{o.hours, "--hours"}, {o.explore_hours, "--explore-hours"}, {o.sample_hours, "--sample-hours"}})
         if (h && !(*h > 0 || (*h == 0 && std::string(name) == "--explore-hours")))
             throw InputError(std::string(name) + " must be a positive number of hours");
     std::vector<ModelSpec> models;
@@ -85,7 +86,8 @@ void add_flight_command(CLI::App& app) {
         "and report.md. Completed trials are skipped on a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
         const auto trials = flight_trials(*o);
-        const ExperimentOutcome outcome = run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, false, {}});
+        const ExperimentOutcome outcome =
+            run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, false, {}});
         print_outcome(trials.size(), o->out, outcome);
         summarize(o->out, outcome.files, !o->no_report);
         std::printf("summary: %s/summary.md%s\n", o->out.c_str(),

@@ -40,8 +40,7 @@ void add_bvc(CLI::App& app) {
         std::optional<double> tilt;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--model", o->model, "Model preset (" + preset_list() + ") or model YAML")
-        ->capture_default_str();
+    cmd->add_option("--model", o->model, "Model preset (" + preset_list() + ") or model YAML")->capture_default_str();
     cmd->add_option("--world", o->world, "World preset or YAML file")->capture_default_str();
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's central walls in degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
@@ -90,12 +89,14 @@ void add_bvc(CLI::App& app) {
 }
 
 void add_config(CLI::App& app) {
-    auto* cmd = app.add_subcommand("config", "Print a trial, model or sensor as YAML: every key, its value and meaning");
+    auto* cmd =
+        app.add_subcommand("config", "Print a trial, model or sensor as YAML: every key, its value and meaning");
     struct Options {
         std::string trial, model, sensor;
     };
     auto o = std::make_shared<Options>();
-    auto* trial = cmd->add_option("--trial", o->trial, "A trial YAML file, every key filled in (default: the default trial)");
+    auto* trial =
+        cmd->add_option("--trial", o->trial, "A trial YAML file, every key filled in (default: the default trial)");
     auto* model = cmd->add_option("--model", o->model, "A model preset (" + preset_list() + ") or model YAML file");
     auto* sensor = cmd->add_option("--sensor", o->sensor, "A sensor: horizontal, spherical or a sensor YAML file");
     trial->excludes(model)->excludes(sensor);

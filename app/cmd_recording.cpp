@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
-#include <map>
 #include <sstream>
 
 #include "bvc3d/agent/random_walk.hpp"
@@ -20,10 +20,10 @@
 #include "bvc3d/experiment/pipeline.hpp"
 #include "bvc3d/experiment/replay.hpp"
 #include "bvc3d/recording/extrinsics.hpp"
+#include "bvc3d/recording/pcd.hpp"
+#include "bvc3d/recording/ply.hpp"
 #include "bvc3d/recording/recording.hpp"
 #include "bvc3d/recording/voxel_map.hpp"
-#include "bvc3d/recording/ply.hpp"
-#include "bvc3d/recording/pcd.hpp"
 #include "cli_common.hpp"
 #include "recording_options.hpp"
 
@@ -76,16 +76,19 @@ struct SourceOptions {
         cmd.add_option("--poses", poses, "Pose file of the scans (KITTI, TUM or 4x4 rows)");
         recording.add_to(cmd);
         cmd.add_option("--world", world, "Instead of a recording: a world (preset or YAML) to simulate a sensor in");
-        cmd.add_option("--trajectory", trajectory,
-                       "With --world: the sensor's path, rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
-        cmd.add_option("--sensor", sensor, "With --world: the simulated sensor (horizontal, spherical or a sensor YAML)");
+        cmd.add_option(
+            "--trajectory", trajectory,
+            "With --world: the sensor's path, rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
+        cmd.add_option("--sensor", sensor,
+                       "With --world: the simulated sensor (horizontal, spherical or a sensor YAML)");
         preprocess.add_to(cmd);
     }
     ReplaySource get() const {
         const bool recorded = !scans.empty() || !poses.empty();
         const bool simulated = !world.empty() || !trajectory.empty() || !sensor.empty();
         if (recorded == simulated)
-            throw InputError("give either a recording (--scans and --poses) or a simulation (--world, --trajectory, --sensor)");
+            throw InputError(
+                "give either a recording (--scans and --poses) or a simulation (--world, --trajectory, --sensor)");
         if (recorded) {
             if (scans.empty()) throw InputError("--poses needs --scans");
             return recorded_source(recording.open(scans, poses), preprocess.get());
@@ -114,7 +117,8 @@ std::shared_ptr<const InitialWeights> weights_from(const std::string& file) {
 // replay
 
 void add_replay(CLI::App& app) {
-    auto* cmd = app.add_subcommand("replay", "Run a recording's scans through a model; write a trial file with every scan's rates");
+    auto* cmd = app.add_subcommand(
+        "replay", "Run a recording's scans through a model; write a trial file with every scan's rates");
     struct Options {
         SourceOptions source;
         std::string model, weights, out;
@@ -126,7 +130,8 @@ void add_replay(CLI::App& app) {
     cmd->add_option("--model", o->model, "Model preset or model YAML")->required();
     cmd->add_flag("--learn", o->learn, "Place cells learn while replaying (Oja's rule); default: frozen");
     cmd->add_option("--weights", o->weights, "Start from the trained weights of this trial file (same model)");
-    cmd->add_option("--seed", o->seed, "Seed of the initial weights when no --weights is given")->capture_default_str()
+    cmd->add_option("--seed", o->seed, "Seed of the initial weights when no --weights is given")
+        ->capture_default_str()
         ->check(seed_check);
     cmd->add_option("--out", o->out, "Trial file to write (default results/<recording>_<model>.h5)");
     cmd->footer(
@@ -136,8 +141,10 @@ void add_replay(CLI::App& app) {
         "first time is the attribute recording_t0), its BVC rates and place-cell rates (docs/recordings.md).");
     cmd->callback([o] {
         const ReplaySource source = o->source.get();
-        const TrialConfig t = replay_trial(source, config::resolve_model(o->model), o->learn, weights_from(o->weights), o->seed);
-        const fs::path out = o->out.empty() ? fs::path("results") / (t.world_label() + "_" + t.model.name + ".h5") : fs::path(o->out);
+        const TrialConfig t =
+            replay_trial(source, config::resolve_model(o->model), o->learn, weights_from(o->weights), o->seed);
+        const fs::path out =
+            o->out.empty() ? fs::path("results") / (t.world_label() + "_" + t.model.name + ".h5") : fs::path(o->out);
         ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
         const std::size_t n = source.path->steps().size();
         ProgressLine line;
@@ -158,7 +165,7 @@ void add_replay(CLI::App& app) {
 
 // One side of a localization (templates or queries): a trial file, or a recording to replay.
 struct Side {
-    std::string file;   // a trial file (may hold {model})
+    std::string file;  // a trial file (may hold {model})
     std::shared_ptr<const recording::Recording> recording;
     std::vector<std::size_t> keep;  // scans of the recording used (all when empty)
 };
@@ -176,7 +183,8 @@ std::string with_model(const std::string& pattern, const std::string& model) {
     return s;
 }
 
-SideRates rows_of(const analysis::RowMatrixXf& rates, const analysis::Points& xyz, const std::vector<std::size_t>& keep) {
+SideRates rows_of(const analysis::RowMatrixXf& rates, const analysis::Points& xyz,
+                  const std::vector<std::size_t>& keep) {
     SideRates r;
     if (keep.empty()) {
         r.rates = rates;
@@ -196,7 +204,8 @@ SideRates rows_of(const analysis::RowMatrixXf& rates, const analysis::Points& xy
 
 SideRates side_from_file(const std::string& file, const ModelSpec& model, bool bvc) {
     const TrialRates t = read_trial_rates(file, bvc);
-    const std::size_t expected = bvc ? static_cast<std::size_t>(model.bvc.n_cells()) : static_cast<std::size_t>(model.place.n_place);
+    const std::size_t expected =
+        bvc ? static_cast<std::size_t>(model.bvc.n_cells()) : static_cast<std::size_t>(model.place.n_place);
     if (t.n_cells != expected)
         throw InputError("trial file '" + file + "' has " + std::to_string(t.n_cells) + " cells per sample; model '" +
                          model.name + "' has " + std::to_string(expected));
@@ -206,7 +215,8 @@ SideRates side_from_file(const std::string& file, const ModelSpec& model, bool b
         const auto k = static_cast<std::size_t>(i);
         xyz.row(i) << t.x[k], t.y[k], t.z[k];
     }
-    return rows_of(Eigen::Map<const analysis::RowMatrixXf>(t.rates.data(), n, static_cast<Eigen::Index>(t.n_cells)), xyz, {});
+    return rows_of(Eigen::Map<const analysis::RowMatrixXf>(t.rates.data(), n, static_cast<Eigen::Index>(t.n_cells)),
+                   xyz, {});
 }
 
 struct LocalizeRow {
@@ -227,19 +237,23 @@ void write_localization(const fs::path& dir, const std::vector<LocalizeRow>& row
         "model,rates,queries,templates,undecoded,median_m,mean_m,within_1m,within_2m,vertical_median_m,vertical_mean_m,"
         "chance_median_m,chance_mean_m,chance_within_1m,chance_within_2m,nearest_median_m,nearest_mean_m,"
         "nearest_within_1m,nearest_within_2m\n";
-    std::string queries = "model,query,x,y,z,decoded,decoded_x,decoded_y,decoded_z,similarity,error_m,vertical_error_m,nearest_m\n";
+    std::string queries =
+        "model,query,x,y,z,decoded,decoded_x,decoded_y,decoded_z,similarity,error_m,vertical_error_m,nearest_m\n";
     std::string templates = "model,template,x,y,z\n";
-    std::string md = "| model | rates | queries | templates | median (m) | mean (m) | ≤ 1 m | ≤ 2 m | chance median | chance ≤ 2 m | "
-                     "nearest median | nearest ≤ 1 m |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    std::string md =
+        "| model | rates | queries | templates | median (m) | mean (m) | ≤ 1 m | ≤ 2 m | chance median | chance ≤ 2 m "
+        "| "
+        "nearest median | nearest ≤ 1 m |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& row : rows) {
         const auto& r = row.result;
         const auto& s = r.decoded_summary;
         summary += row.model + "," + rates + "," + std::to_string(row.queries.rates.rows()) + "," +
-                   std::to_string(row.templates.rates.rows()) + "," + std::to_string(r.n_undecoded) + "," + num(s.median) + "," +
-                   num(s.mean) + "," + num(s.within_1m) + "," + num(s.within_2m) + "," + num(r.vertical_median) + "," +
-                   num(r.vertical_mean) + "," + num(r.chance.median) + "," + num(r.chance.mean) + "," +
-                   num(r.chance.within_1m) + "," + num(r.chance.within_2m) + "," + num(r.nearest.median) + "," +
-                   num(r.nearest.mean) + "," + num(r.nearest.within_1m) + "," + num(r.nearest.within_2m) + "\n";
+                   std::to_string(row.templates.rates.rows()) + "," + std::to_string(r.n_undecoded) + "," +
+                   num(s.median) + "," + num(s.mean) + "," + num(s.within_1m) + "," + num(s.within_2m) + "," +
+                   num(r.vertical_median) + "," + num(r.vertical_mean) + "," + num(r.chance.median) + "," +
+                   num(r.chance.mean) + "," + num(r.chance.within_1m) + "," + num(r.chance.within_2m) + "," +
+                   num(r.nearest.median) + "," + num(r.nearest.mean) + "," + num(r.nearest.within_1m) + "," +
+                   num(r.nearest.within_2m) + "\n";
         md += "| " + row.model + " | " + rates + " | " + std::to_string(row.queries.rates.rows()) + " | " +
               std::to_string(row.templates.rates.rows()) + " | " + f3(s.median) + " | " + f3(s.mean) + " | " +
               f3(s.within_1m) + " | " + f3(s.within_2m) + " | " + f3(r.chance.median) + " | " + f3(r.chance.within_2m) +
@@ -250,17 +264,17 @@ void write_localization(const fs::path& dir, const std::vector<LocalizeRow>& row
             queries += row.model + "," + std::to_string(row.queries.index[i]) + "," + num(row.queries.xyz(q, 0)) + "," +
                        num(row.queries.xyz(q, 1)) + "," + num(row.queries.xyz(q, 2)) + ",";
             if (d >= 0)
-                queries += std::to_string(row.templates.index[static_cast<std::size_t>(d)]) + "," + num(row.templates.xyz(d, 0)) +
-                           "," + num(row.templates.xyz(d, 1)) + "," + num(row.templates.xyz(d, 2)) + ",";
-            else
-                queries += ",,,,";
+                queries += std::to_string(row.templates.index[static_cast<std::size_t>(d)]) + "," +
+                           num(row.templates.xyz(d, 0)) + "," + num(row.templates.xyz(d, 1)) + "," +
+                           num(row.templates.xyz(d, 2)) + ",";
+            else queries += ",,,,";
             queries += num(r.similarity[i]) + "," + num(r.error[i]) + "," + num(r.vertical_error[i]) + "," +
                        num(r.nearest_error[i]) + "\n";
         }
         for (Eigen::Index j = 0; j < row.templates.xyz.rows(); ++j)
             templates += row.model + "," + std::to_string(row.templates.index[static_cast<std::size_t>(j)]) + "," +
-                         num(row.templates.xyz(j, 0)) + "," + num(row.templates.xyz(j, 1)) + "," + num(row.templates.xyz(j, 2)) +
-                         "\n";
+                         num(row.templates.xyz(j, 0)) + "," + num(row.templates.xyz(j, 1)) + "," +
+                         num(row.templates.xyz(j, 2)) + "\n";
     }
     write_file_atomically(dir / "localization.csv", summary);
     write_file_atomically(dir / "queries.csv", queries);
@@ -279,7 +293,8 @@ void add_localize(CLI::App& app) {
         PreprocessOptions preprocess;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--templates", o->templates, "Templates: a trial file ({model} stands for each model's name) or a scan folder/list");
+    cmd->add_option("--templates", o->templates,
+                    "Templates: a trial file ({model} stands for each model's name) or a scan folder/list");
     cmd->add_option("--template-poses", o->template_poses, "Pose file of the template scans");
     cmd->add_option("--queries", o->queries, "Queries: a trial file (may contain {model}) or a scan folder/list");
     cmd->add_option("--query-poses", o->query_poses, "Pose file of the query scans");
@@ -319,7 +334,8 @@ void add_localize(CLI::App& app) {
             for (std::size_t i = 0; i < rec->size(); ++i)
                 (i % static_cast<std::size_t>(o->split) == 1 ? queries : templates).keep.push_back(i);
         } else {
-            if (o->templates.empty() || o->queries.empty()) throw InputError("give --templates and --queries (or --scans with --split)");
+            if (o->templates.empty() || o->queries.empty())
+                throw InputError("give --templates and --queries (or --scans with --split)");
             auto side = [&](const std::string& what, const std::string& poses) {
                 Side s;
                 if (fs::path(what).extension() == ".h5") {
@@ -348,7 +364,9 @@ void add_localize(CLI::App& app) {
                 trials.push_back(replay_trial(source, specs[k], false,
                                               bvc ? nullptr : weights_from(with_model(o->weights, specs[k].name))));
             if (!bvc && o->weights.empty())
-                std::fprintf(stderr, "bvc3d: warning: place-cell rates without --weights come from untrained (seed 0) weights\n");
+                std::fprintf(
+                    stderr,
+                    "bvc3d: warning: place-cell rates without --weights come from untrained (seed 0) weights\n");
             RunControl control;
             control.progress_every = 1;
             const std::string what = s->recording->name + " scan";
@@ -372,8 +390,9 @@ void add_localize(CLI::App& app) {
             rows.push_back(std::move(row));
         }
         write_localization(o->out, rows, bvc);
-        std::printf("%-12s %7s %9s %8s %8s %6s %6s | %14s %12s | %14s %13s\n", "model", "queries", "templates", "median_m",
-                    "mean_m", "<=1m", "<=2m", "chance_median", "chance_<=2m", "nearest_median", "nearest_<=1m");
+        std::printf("%-12s %7s %9s %8s %8s %6s %6s | %14s %12s | %14s %13s\n", "model", "queries", "templates",
+                    "median_m", "mean_m", "<=1m", "<=2m", "chance_median", "chance_<=2m", "nearest_median",
+                    "nearest_<=1m");
         for (const auto& row : rows) {
             const auto& r = row.result;
             std::printf("%-12s %7ld %9ld %8.3f %8.3f %6.3f %6.3f | %14.3f %12.3f | %14.3f %13.3f\n", row.model.c_str(),
@@ -381,7 +400,8 @@ void add_localize(CLI::App& app) {
                         r.decoded_summary.median, r.decoded_summary.mean, r.decoded_summary.within_1m,
                         r.decoded_summary.within_2m, r.chance.median, r.chance.within_2m, r.nearest.median,
                         r.nearest.within_1m);
-            if (r.n_undecoded) std::printf("  %s: %zu queries undecoded (no positive similarity)\n", row.model.c_str(), r.n_undecoded);
+            if (r.n_undecoded)
+                std::printf("  %s: %zu queries undecoded (no positive similarity)\n", row.model.c_str(), r.n_undecoded);
         }
         if (!o->no_figure && run_python_module("bvc3d.localization_figure", {o->out}) != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
@@ -395,7 +415,8 @@ void add_localize(CLI::App& app) {
 // map
 
 void add_map(CLI::App& app) {
-    auto* cmd = app.add_subcommand("map", "Build a point map from a recording: its scans in the world frame, voxel-downsampled");
+    auto* cmd = app.add_subcommand(
+        "map", "Build a point map from a recording: its scans in the world frame, voxel-downsampled");
     struct Options {
         std::string scans, poses, out;
         recording::VoxelMapParams params;
@@ -406,10 +427,14 @@ void add_map(CLI::App& app) {
     cmd->add_option("--scans", o->scans, "Scan folder, scan list file or one scan")->required();
     cmd->add_option("--poses", o->poses, "Pose file of the scans")->required();
     o->recording.add_to(*cmd);
-    cmd->add_option("--voxel", o->params.voxel, "m, voxel edge: one point (the mean) per occupied voxel")->capture_default_str();
-    cmd->add_option("--min-range", o->params.min_range, "m: nearer points are left out (the carrier)")->capture_default_str();
-    cmd->add_option("--max-range", o->params.max_range, "m: farther points are left out (0: no limit)")->capture_default_str();
-    cmd->add_option("--min-points", o->params.min_points, "Voxels with fewer points are left out")->capture_default_str();
+    cmd->add_option("--voxel", o->params.voxel, "m, voxel edge: one point (the mean) per occupied voxel")
+        ->capture_default_str();
+    cmd->add_option("--min-range", o->params.min_range, "m: nearer points are left out (the carrier)")
+        ->capture_default_str();
+    cmd->add_option("--max-range", o->params.max_range, "m: farther points are left out (0: no limit)")
+        ->capture_default_str();
+    cmd->add_option("--min-points", o->params.min_points, "Voxels with fewer points are left out")
+        ->capture_default_str();
     cmd->add_option("--out", o->out, "Map to write: .ply (binary, float) or .pcd (binary, float)")->required();
     cmd->footer(
         "The map is a point cloud in the recording's world frame; a world YAML draws it as spheres with a\n"
@@ -448,11 +473,16 @@ void add_export_scans(CLI::App& app) {
     auto o = std::make_shared<Options>();
     cmd->add_option("--world", o->world, "Preset or world YAML")->capture_default_str();
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
-    cmd->add_option("--trajectory", o->trajectory, "Path: rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
+    cmd->add_option("--trajectory", o->trajectory,
+                    "Path: rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
     cmd->add_option("--hours", o->hours, "Instead of --trajectory: this many hours of the seeded random walk");
-    cmd->add_option("--seed", o->seed, "Seed of the random walk and of the sensor's noise")->capture_default_str()->check(seed_check);
-    cmd->add_option("--sensor", o->sensor, "horizontal, spherical (upper half) or a sensor YAML")->capture_default_str();
-    cmd->add_option("--format", o->format, "pcd (float32), pcd-f8 (float64), ply or kitti (.bin)")->capture_default_str();
+    cmd->add_option("--seed", o->seed, "Seed of the random walk and of the sensor's noise")
+        ->capture_default_str()
+        ->check(seed_check);
+    cmd->add_option("--sensor", o->sensor, "horizontal, spherical (upper half) or a sensor YAML")
+        ->capture_default_str();
+    cmd->add_option("--format", o->format, "pcd (float32), pcd-f8 (float64), ply or kitti (.bin)")
+        ->capture_default_str();
     cmd->add_option("--out", o->out, "Folder to write: 000000.<ext> ..., poses.txt, scans.txt")->required();
     cmd->footer(
         "Each scan holds the hits in the sensor's own frame (x forward, z up; tilted with the pose's pitch and\n"

@@ -5,11 +5,11 @@
 #include <memory>
 #include <optional>
 
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/memory.hpp"
-#include "bvc3d/agent/random_walk.hpp"
 #include "cli_common.hpp"
 
 namespace bvc3d::cli {
@@ -38,7 +38,8 @@ void emit(const std::string& out, const std::string& header, WriteRows&& write_r
         std::cout << header << "\n";
         write_rows(std::cout);
         std::cout.flush();
-        if (!std::cout) throw InputError(std::string("cannot write to standard output: ") + std::strerror(errno ? errno : EIO));
+        if (!std::cout)
+            throw InputError(std::string("cannot write to standard output: ") + std::strerror(errno ? errno : EIO));
         return;
     }
     AtomicFile file(out);
@@ -74,7 +75,8 @@ void add_scan(CLI::App& app) {
 }
 
 void add_walk(CLI::App& app) {
-    auto* cmd = app.add_subcommand("walk", "Run the seeded random walk and write its model steps: t, x, y, heading, bumped");
+    auto* cmd =
+        app.add_subcommand("walk", "Run the seeded random walk and write its model steps: t, x, y, heading, bumped");
     auto world = std::make_shared<WorldOptions>();
     auto hours = std::make_shared<double>(1.0);
     auto seed = std::make_shared<std::uint64_t>(0);

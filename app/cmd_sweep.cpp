@@ -123,8 +123,10 @@ void add_sweep_command(CLI::App& app) {
     cmd->add_option("sweep", o->file, "Sweep YAML file (docs/sweeps.md)")->required();
     cmd->add_option("--out", o->out, "Output folder (default results/<sweep name>)");
     cmd->add_option("--hours", o->hours, "Shorten both phases of every trial to H simulated hours");
-    cmd->add_option("--jobs", o->jobs, "Threads (per rank under MPI); 0 (the default): one per core, or 1 per rank under MPI");
-    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes, "Checkpoint running trials every M simulated minutes");
+    cmd->add_option("--jobs", o->jobs,
+                    "Threads (per rank under MPI); 0 (the default): one per core, or 1 per rank under MPI");
+    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
+                    "Checkpoint running trials every M simulated minutes");
     cmd->add_flag("--no-report", o->no_report, "Skip the figures");
     cmd->add_flag("--dry-run", o->dry_run, "List the trials and exit");
     cmd->add_flag("--verbose", o->verbose, "Print a line for every finished trial (with its MPI rank)");
@@ -153,16 +155,17 @@ void add_sweep_command(CLI::App& app) {
         } else
 #else
         if (launched_by_mpi())
-            throw InputError("this bvc3d was built without MPI, so under mpirun every rank would run every trial: "
-                             "rebuild with MPI (libopenmpi-dev) or run `bvc3d sweep` without mpirun");
+            throw InputError(
+                "this bvc3d was built without MPI, so under mpirun every rank would run every trial: "
+                "rebuild with MPI (libopenmpi-dev) or run `bvc3d sweep` without mpirun");
 #endif
         {
             const OutputLock lock(folder_lock_path(out), "output folder '" + out.string() + "'");
             copy_sweep_file(o->file, out);
             static const int rank = 0;
-            outcome = run_local_experiment(sweep.trials, out,
-                                           LocalRun{o->jobs, o->checkpoint_minutes, o->no_memory_check,
-                                                    trial_printer(o->verbose, rank)});
+            outcome = run_local_experiment(
+                sweep.trials, out,
+                LocalRun{o->jobs, o->checkpoint_minutes, o->no_memory_check, trial_printer(o->verbose, rank)});
             print_outcome(sweep.trials.size(), out, outcome);
             summarize(out, outcome.files, !o->no_report);
             std::printf("summary: %s/summary.md\n", out.c_str());

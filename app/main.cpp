@@ -24,8 +24,9 @@ int usage_error(const CLI::App& app, const CLI::ParseError& e, int argc, char** 
         std::string list;
         for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; }))
             list += (list.empty() ? "" : ", ") + sub->get_name();
-        message = argv[1][0] != '-' ? std::string("unknown command '") + argv[1] + "' (commands: " + list + ")"
-                                    : std::string("unknown option '") + argv[1] + "': give a command first (" + list + ")";
+        message = argv[1][0] != '-'
+                      ? std::string("unknown command '") + argv[1] + "' (commands: " + list + ")"
+                      : std::string("unknown option '") + argv[1] + "': give a command first (" + list + ")";
     }
     const std::string help = command ? "bvc3d " + command->get_name() + " --help" : std::string("bvc3d --help");
     std::cerr << "bvc3d: usage error: " << bvc3d::cli::printable(message) << "\n(see '" << help << "')\n";

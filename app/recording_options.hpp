@@ -24,8 +24,9 @@ struct RecordingOptions {
     void add_to(CLI::App& cmd) {
         cmd.add_option("--pose-format", pose_format, "Pose file format: auto, kitti, tum or matrix (4x4 rows)")
             ->capture_default_str();
-        cmd.add_option("--extrinsics", extrinsics,
-                       "Sensor mounting (base-from-sensor): a file, or 12 or 16 numbers; the poses are then the base's");
+        cmd.add_option(
+            "--extrinsics", extrinsics,
+            "Sensor mounting (base-from-sensor): a file, or 12 or 16 numbers; the poses are then the base's");
         cmd.add_option("--time-tolerance", time_tolerance, "Seconds within which a scan pairs with a pose by time")
             ->capture_default_str();
     }

@@ -7,8 +7,8 @@
 
 int main() {
     using namespace bvc3d;
-    const World world = World::cross({.tilt_deg = 45});   // the paper's arena, walls leaning 45°
-    const ModelSpec model = model_preset("3d-0.2");        // Table I: spherical scanner, layers 0 and 0.2 rad
+    const World world = World::cross({.tilt_deg = 45});  // the paper's arena, walls leaning 45°
+    const ModelSpec model = model_preset("3d-0.2");      // Table I: spherical scanner, layers 0 and 0.2 rad
     const Scan scan = Lidar(model.sensor).scan(world, Pose::on_floor(1.0, 2.0, 0.5));
     const BoundaryVectorLayer layer(model.bvc);
     std::vector<double> bvc(layer.n_cells());

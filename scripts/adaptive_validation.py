@@ -107,14 +107,17 @@ def main():
             sd = np.std(trials[tilt][s], ddof=1) if len(trials[tilt][s]) > 1 else 0.0
             points.append(dict(tilt=tilt, full=f, full_sd=sd, crit=cr, bvc=b))
             print(f"| {tilt:g}° | {', '.join(f'{e:g}' for e in s)} | {f:.4f} ± {sd:.4f} ({len(trials[tilt][s])}) "
-                  f"| {' / '.join(f'{c[s][0]:.4f}' for c in per_seed)} | {' / '.join(f'{c[s][1]:.4f}' for c in per_seed)} |")
+                  f"| {' / '.join(f'{c[s][0]:.4f}' for c in per_seed)} "
+                  f"| {' / '.join(f'{c[s][1]:.4f}' for c in per_seed)} |")
         rho = spearmanr(crit, full).statistic
         rho_each = [spearmanr([c[s][0] for s in sets], full).statistic for c in per_seed]
         rho_bvc = spearmanr(bvc, full).statistic
         best_full, best_crit = sets[int(np.argmin(full))], sets[int(np.argmin(crit))]
-        summary.append((tilt, len(sets), rho, rho_each, rho_bvc, best_full, best_crit, full[int(np.argmin(crit))], full.min()))
+        summary.append((tilt, len(sets), rho, rho_each, rho_bvc, best_full, best_crit, full[int(np.argmin(crit))],
+                        full.min()))
     print()
-    print("| tilt | configurations | Spearman ρ (mean criterion) | ρ per walk | ρ of the BVC MSAI | best by full trials "
+    print("| tilt | configurations | Spearman ρ (mean criterion) | ρ per walk | ρ of the BVC MSAI "
+          "| best by full trials "
           "| chosen by criterion | its full-trial MSAI vs the best |")
     print("|---|---|---|---|---|---|---|---|")
     for tilt, n, rho, each, rb, bf, bc, fc, fb in summary:

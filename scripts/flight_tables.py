@@ -131,7 +131,8 @@ def main():
         g = groups[key]
         print(f"| {key[0]} | {key[1]} | " + " | ".join(cell([r[m] for r in g], d) for m, d in digits.items()) + " |")
     print("\nStacked fields of multimodal cells (per trial with pairs):\n")
-    print("| world | model | seed | pairs | median horizontal (m) | median vertical (m) | stacked | z lower / upper (m) |")
+    print("| world | model | seed | pairs | median horizontal (m) | median vertical (m) | stacked "
+          "| z lower / upper (m) |")
     print("|---|---|---|---|---|---|---|---|")
     for s in stacked:
         if s["pairs"]:

@@ -163,7 +163,8 @@ def main():
     folder = os.path.join(args.results, "authors")
     if os.path.isdir(folder):
         with Pool(args.jobs) as pool:
-            thin_rows = pool.map(thinned, sorted(os.path.join(folder, n) for n in os.listdir(folder) if n.endswith(".h5")))
+            thin_rows = pool.map(thinned, sorted(os.path.join(folder, n) for n in os.listdir(folder)
+                                                 if n.endswith(".h5")))
         thin(args.out, thin_rows)
 
 
@@ -195,7 +196,8 @@ def comparison(out, published, trials):
             s_mean, s_sd, _, _, s_n = stats([float(r[m]) for r in spec.get(key, [])])
             rows.append({"model": key[0], "tilt_deg": key[1], "metric": m, "published": value, "authors_mean": mean,
                          "authors_sd": sd, "authors_min": lo, "authors_max": hi, "authors_seeds": n,
-                         "within_2sd": bool(abs(value - mean) <= 2 * sd), "z": (value - mean) / sd if sd > 0 else math.nan,
+                         "within_2sd": bool(abs(value - mean) <= 2 * sd),
+                         "z": (value - mean) / sd if sd > 0 else math.nan,
                          "spec_mean": s_mean, "spec_sd": s_sd, "spec_seeds": s_n})
     write_csv(os.path.join(out, "comparison.csv"), rows, list(rows[0]))
     print("\n## published vs bvc3d authors (mean ± sd) vs SPEC (mean ± sd)\n")

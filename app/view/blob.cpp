@@ -46,8 +46,8 @@ std::string encode_blob(nlohmann::json header, const std::vector<BlobArray>& arr
     header["arrays"] = nlohmann::json::array();
     std::size_t offset = 0;
     for (const auto& a : arrays) {
-        header["arrays"].push_back({{"name", a.name}, {"dtype", a.dtype}, {"shape", a.shape}, {"offset", offset},
-                                    {"bytes", a.bytes.size()}});
+        header["arrays"].push_back(
+            {{"name", a.name}, {"dtype", a.dtype}, {"shape", a.shape}, {"offset", offset}, {"bytes", a.bytes.size()}});
         offset += padded(a.bytes.size());
     }
     std::string text = header.dump();

@@ -28,7 +28,8 @@ std::vector<std::string> list_trials(const fs::path& root, const fs::path& folde
         if (e.is_regular_file() && is_trial_name(e.path())) out.push_back(view::relative_name(root, e.path()));
     };
     if (recursive)
-        for (const auto& e : fs::recursive_directory_iterator(folder, fs::directory_options::skip_permission_denied)) take(e);
+        for (const auto& e : fs::recursive_directory_iterator(folder, fs::directory_options::skip_permission_denied))
+            take(e);
     else
         for (const auto& e : fs::directory_iterator(folder)) take(e);
     std::sort(out.begin(), out.end());
@@ -70,7 +71,8 @@ view::ViewTarget make_target(const std::vector<std::string>& args, const std::st
         const fs::path p(a);
         std::error_code ec;
         if (fs::is_directory(p, ec)) {
-            if (args.size() > 1) throw InputError("'" + a + "' is a folder: compare two trial files, or view one folder");
+            if (args.size() > 1)
+                throw InputError("'" + a + "' is a folder: compare two trial files, or view one folder");
             t.root = fs::canonical(p);
             t.trials = list_trials(t.root, t.root, true);
             if (t.trials.empty()) throw InputError("'" + a + "' holds no trial files (*.h5)");
@@ -92,13 +94,16 @@ view::ViewTarget make_target(const std::vector<std::string>& args, const std::st
             } else {
                 std::string names;
                 for (const auto& n : presets) names += (names.empty() ? "" : ", ") + n;
-                throw InputError("'" + a + "' does not exist (expected a trial file, a results folder, a world YAML or "
-                                 "a world preset: " + names + ")");
+                throw InputError("'" + a +
+                                 "' does not exist (expected a trial file, a results folder, a world YAML or "
+                                 "a world preset: " +
+                                 names + ")");
             }
         }
     }
     if (!files.empty()) {
-        t.root = files.size() == 2 ? common_folder(files[0].parent_path(), files[1].parent_path()) : files[0].parent_path();
+        t.root =
+            files.size() == 2 ? common_folder(files[0].parent_path(), files[1].parent_path()) : files[0].parent_path();
         for (const auto& f : files) {
             auto listed = list_trials(t.root, f.parent_path(), false);
             for (auto& l : listed)
@@ -137,9 +142,12 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--port", o->port, "Port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
     cmd->add_option("--scans", o->scans, "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");
-    cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")->capture_default_str();
-    cmd->add_option("--export", o->export_dir, "Write the page as static files into this (new) folder instead of serving it");
-    cmd->add_option("--export-steps", o->export_steps, "Samples per trial (or scans) whose returns and rates are exported")
+    cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")
+        ->capture_default_str();
+    cmd->add_option("--export", o->export_dir,
+                    "Write the page as static files into this (new) folder instead of serving it");
+    cmd->add_option("--export-steps", o->export_steps,
+                    "Samples per trial (or scans) whose returns and rates are exported")
         ->capture_default_str()
         ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
     cmd->footer(

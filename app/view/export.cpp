@@ -144,7 +144,8 @@ ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::pat
     index["worlds"] = shown.world.empty() ? json::array() : json::array({shown.world});
     write_text(temp / "data" / "index.js",
                "window.BVC3D_EXPORT = {files: " + w.files().dump() + ", steps: " + step_index.dump() +
-                   ", index: " + index.dump() + ", data: {}, loaded(key, status, type, b64) { this.data[key] = {status, type, b64}; }};\n");
+                   ", index: " + index.dump() +
+                   ", data: {}, loaded(key, status, type, b64) { this.data[key] = {status, type, b64}; }};\n");
     for (const char* f : {"viewer.js", "viewer.css"}) write_text(temp / f, read_text(web_dir / f));
     std::string html = read_text(web_dir / "index.html");
     const std::string marker = "<!--export-data-->";

@@ -34,22 +34,33 @@ json value_json(const params::Value& v) {
 
 // A stored array as float32 (or int32 for integers), under `name`.
 BlobArray array_blob(const std::string& name, const NamedArray& a) {
-    if (const auto* d = std::get_if<std::vector<double>>(&a.data)) return f32_array(name, std::span<const double>(*d), a.shape);
-    if (const auto* f = std::get_if<std::vector<float>>(&a.data)) return f32_array(name, std::span<const float>(*f), a.shape);
+    if (const auto* d = std::get_if<std::vector<double>>(&a.data))
+        return f32_array(name, std::span<const double>(*d), a.shape);
+    if (const auto* f = std::get_if<std::vector<float>>(&a.data))
+        return f32_array(name, std::span<const float>(*f), a.shape);
     return i32_array(name, std::get<std::vector<std::int64_t>>(a.data), a.shape);
 }
 
 json sensor_json(const LidarSpec& s) {
-    return {{"name", s.name}, {"rows", s.elevations.size()}, {"elevations", s.elevations},
-            {"azimuth_count", s.azimuth_count}, {"height", s.height}, {"max_range", s.max_range}};
+    return {{"name", s.name},
+            {"rows", s.elevations.size()},
+            {"elevations", s.elevations},
+            {"azimuth_count", s.azimuth_count},
+            {"height", s.height},
+            {"max_range", s.max_range}};
 }
 
 json model_json(const ModelSpec& m) {
     const auto& b = m.bvc;
     return {{"name", m.name},
             {"sensor", sensor_json(m.sensor)},
-            {"bvc", {{"elevations", b.elevations}, {"n_layers", b.n_layers()}, {"n_dir", b.n_dir},
-                     {"n_per_axis", b.n_per_axis}, {"max_dist", b.max_dist}, {"n_cells", b.n_cells()}}},
+            {"bvc",
+             {{"elevations", b.elevations},
+              {"n_layers", b.n_layers()},
+              {"n_dir", b.n_dir},
+              {"n_per_axis", b.n_per_axis},
+              {"max_dist", b.max_dist},
+              {"n_cells", b.n_cells()}}},
             {"n_place", m.place.n_place}};
 }
 
@@ -94,8 +105,9 @@ std::string world_blob(const WorldDescription& w, const std::string& source, con
     json walkable = json::array(), starts = json::array();
     for (const auto& p : w.walkable.points) walkable.push_back({p.x(), p.y()});
     for (const auto& p : w.start.points) starts.push_back({p.x(), p.y()});
-    json header = {{"kind", "world"}, {"name", w.name}, {"source", source}, {"triangles", w.mesh.size()},
-                   {"walkable", walkable}, {"start_points", starts}, {"points", points.size() / 3}};
+    json header = {
+        {"kind", "world"},      {"name", w.name},         {"source", source},           {"triangles", w.mesh.size()},
+        {"walkable", walkable}, {"start_points", starts}, {"points", points.size() / 3}};
     if (w.tilt_deg) header["tilt_deg"] = *w.tilt_deg;
     // Where the page first probes the world: a start point, or the middle of the walkable region.
     // As text, so that the page asks for exactly this pose (an export holds the reply under it).
@@ -104,7 +116,8 @@ std::string world_blob(const WorldDescription& w, const std::string& source, con
         header["probe"] = {{"x", format_number(at.x())}, {"y", format_number(at.y())}, {"heading", "0"}};
     }
     if (!box.isEmpty())
-        header["bounds"] = {{box.min().x(), box.min().y(), box.min().z()}, {box.max().x(), box.max().y(), box.max().z()}};
+        header["bounds"] = {{box.min().x(), box.min().y(), box.min().z()},
+                            {box.max().x(), box.max().y(), box.max().z()}};
     std::vector<BlobArray> arrays{f32_array("triangles", std::span<const float>(tri), {w.mesh.size() * 3, 3})};
     if (!points.empty()) arrays.push_back(f32_array("points", std::span<const float>(points), {points.size() / 3, 3}));
     return encode_blob(std::move(header), arrays);
@@ -118,7 +131,8 @@ LidarSpec drawn_sensor(const LidarSpec& model_sensor) {
     all.azimuth_offset = model_sensor.azimuth_offset;
     // Keep the model's own rows if it has some the preset lacks (a custom table named spherical).
     for (double e : model_sensor.elevations)
-        if (std::none_of(all.elevations.begin(), all.elevations.end(), [&](double a) { return std::abs(a - e) < 1e-9; }))
+        if (std::none_of(all.elevations.begin(), all.elevations.end(),
+                         [&](double a) { return std::abs(a - e) < 1e-9; }))
             return model_sensor;
     if (model_sensor.azimuth_count != all.azimuth_count) return model_sensor;
     return all;
@@ -207,20 +221,22 @@ void TrialScene::encode(const fs::path& file) {
     for (float r : data_.rates) rate_max = std::max(rate_max, r);
     header["rate_max"] = rate_max;
 
-    std::vector<BlobArray> arrays{f32_array("x", std::span<const double>(data_.x)),
-                                  f32_array("y", std::span<const double>(data_.y)),
-                                  f32_array("heading", std::span<const double>(heading_)),
-                                  f32_array("t", std::span<const double>(t_))};
+    std::vector<BlobArray> arrays{
+        f32_array("x", std::span<const double>(data_.x)), f32_array("y", std::span<const double>(data_.y)),
+        f32_array("heading", std::span<const double>(heading_)), f32_array("t", std::span<const double>(t_))};
     if (!data_.z.empty()) arrays.push_back(f32_array("z", std::span<const double>(data_.z)));
     for (const char* name : {"bin_centers", "bin_counts", "rate_maps", "sai", "modality", "spatial_info", "peak_rate"})
-        if (const auto a = read_trial_array(file, std::string("metrics/") + name)) arrays.push_back(array_blob(name, *a));
+        if (const auto a = read_trial_array(file, std::string("metrics/") + name))
+            arrays.push_back(array_blob(name, *a));
 
     // The hexagons' size, for drawing maps as the figures do: the grid the analysis fits.
-    const auto centers = std::find_if(arrays.begin(), arrays.end(), [](const BlobArray& a) { return a.name == "bin_centers"; });
+    const auto centers =
+        std::find_if(arrays.begin(), arrays.end(), [](const BlobArray& a) { return a.name == "bin_centers"; });
     if (centers != arrays.end() && centers->shape.size() == 2 && centers->shape[1] == 2 && n > 0) {
         int gridsize = 50;
         for (const auto& [name, v] : data_.metric_attributes)
-            if (name == "gridsize" && std::holds_alternative<long long>(v)) gridsize = static_cast<int>(std::get<long long>(v));
+            if (name == "gridsize" && std::holds_alternative<long long>(v))
+                gridsize = static_cast<int>(std::get<long long>(v));
         std::optional<analysis::Extent> extent;
         if (data_.extent && data_.extent->size() == 4)
             extent = analysis::Extent{(*data_.extent)[0], (*data_.extent)[1], (*data_.extent)[2], (*data_.extent)[3]};
@@ -263,23 +279,31 @@ std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model,
 }
 
 std::string probe_blob(const World& world, const ModelSpec& model, const Pose& p) {
-    json header = {{"kind", "probe"}, {"x", p.x}, {"y", p.y}, {"z", p.z}, {"heading", p.heading},
-                   {"model", model_json(model)}, {"drawn_sensor", sensor_json(drawn_sensor(model.sensor))}};
+    json header = {{"kind", "probe"},
+                   {"x", p.x},
+                   {"y", p.y},
+                   {"z", p.z},
+                   {"heading", p.heading},
+                   {"model", model_json(model)},
+                   {"drawn_sensor", sensor_json(drawn_sensor(model.sensor))}};
     auto arrays = sensed_arrays(world, model, p, header);
     return encode_blob(std::move(header), arrays);
 }
 
 std::string TrialScene::step_blob(std::size_t i) const {
-    if (i >= samples()) throw InputError("sample " + std::to_string(i) + " is past the trial's " + std::to_string(samples()));
+    if (i >= samples())
+        throw InputError("sample " + std::to_string(i) + " is past the trial's " + std::to_string(samples()));
     const Pose p = pose(i);
-    json header = {{"kind", "step"}, {"sample", i}, {"t", t_[i]}, {"x", p.x}, {"y", p.y}, {"z", p.z}, {"heading", p.heading}};
+    json header = {{"kind", "step"}, {"sample", i}, {"t", t_[i]},          {"x", p.x},
+                   {"y", p.y},       {"z", p.z},    {"heading", p.heading}};
     std::vector<BlobArray> arrays;
     if (world_ && model_) {
         arrays = sensed_arrays(*world_, *model_, p, header);
     } else {
         const std::vector<float> none;
-        arrays = {f32_array("points", std::span<const float>(none), {0, 3}), f32_array("range", std::span<const float>(none)),
-                  u8_array("kept", {}), f32_array("bvc", std::span<const float>(none))};
+        arrays = {f32_array("points", std::span<const float>(none), {0, 3}),
+                  f32_array("range", std::span<const float>(none)), u8_array("kept", {}),
+                  f32_array("bvc", std::span<const float>(none))};
     }
     arrays.push_back(f32_array("place", std::span<const float>(data_.rates.data() + i * data_.n_place, data_.n_place)));
     return encode_blob(std::move(header), arrays);
@@ -287,7 +311,8 @@ std::string TrialScene::step_blob(std::size_t i) const {
 
 // ---- recordings ----
 
-RecordingScene::RecordingScene(const fs::path& scans, const fs::path& poses, ModelSpec model) : model_(std::move(model)) {
+RecordingScene::RecordingScene(const fs::path& scans, const fs::path& poses, ModelSpec model)
+    : model_(std::move(model)) {
     scans_ = recording::list_scans(scans);
     const auto all_poses = recording::read_poses(poses);
     const auto pairing = recording::pair_scans_with_poses(recording::scan_times(scans_), all_poses);
@@ -302,10 +327,11 @@ RecordingScene::RecordingScene(const fs::path& scans, const fs::path& poses, Mod
         names.push_back(scans_[i].path.filename().string());
         times.push_back(poses_[i].time ? json(*poses_[i].time) : json(nullptr));
     }
-    json header = {{"kind", "recording"}, {"scans", scans_.size()}, {"names", names}, {"times", times},
-                   {"model", model_json(model_)}, {"paired_by_time", pairing.by_time}};
-    blob_ = encode_blob(std::move(header), {f32_array("position", std::span<const float>(position), {scans_.size(), 3}),
-                                            f32_array("rotation", std::span<const float>(rotation), {scans_.size(), 9})});
+    json header = {{"kind", "recording"}, {"scans", scans_.size()},      {"names", names},
+                   {"times", times},      {"model", model_json(model_)}, {"paired_by_time", pairing.by_time}};
+    blob_ =
+        encode_blob(std::move(header), {f32_array("position", std::span<const float>(position), {scans_.size(), 3}),
+                                        f32_array("rotation", std::span<const float>(rotation), {scans_.size(), 9})});
 }
 
 std::string RecordingScene::map_blob() const {
@@ -329,7 +355,8 @@ std::string RecordingScene::map_blob() const {
 }
 
 std::string RecordingScene::scan_blob(std::size_t i) const {
-    if (i >= scans_.size()) throw InputError("scan " + std::to_string(i) + " is past the recording's " + std::to_string(scans_.size()));
+    if (i >= scans_.size())
+        throw InputError("scan " + std::to_string(i) + " is past the recording's " + std::to_string(scans_.size()));
     const auto cloud = recording::read_scan(scans_[i].path);
     const auto& T = poses_[i].world_from_sensor;
     std::vector<float> xyz, range;
@@ -348,8 +375,8 @@ std::string RecordingScene::scan_blob(std::size_t i) const {
         for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(w[k]));
         range.push_back(static_cast<float>(r));
         const bool near_layer = psi.empty() || std::any_of(psi.begin(), psi.end(), [&](double e) {
-            return std::abs(ret.elevation - e) <= window;
-        });
+                                    return std::abs(ret.elevation - e) <= window;
+                                });
         kept.push_back(near_layer ? 1 : 0);
     }
     const BoundaryVectorLayer layer(model_.bvc);
@@ -357,8 +384,11 @@ std::string RecordingScene::scan_blob(std::size_t i) const {
     layer.rates(returns, rates);
     const std::vector<float> bvc(rates.begin(), rates.end());
     const Vec3 origin = T.translation();
-    json header = {{"kind", "scan"}, {"scan", i}, {"name", scans_[i].path.filename().string()},
-                   {"returns", returns.size()}, {"sensor_origin", {origin.x(), origin.y(), origin.z()}},
+    json header = {{"kind", "scan"},
+                   {"scan", i},
+                   {"name", scans_[i].path.filename().string()},
+                   {"returns", returns.size()},
+                   {"sensor_origin", {origin.x(), origin.y(), origin.z()}},
                    {"dropped_nonfinite", cloud.dropped_nonfinite}};
     if (poses_[i].time) header["t"] = *poses_[i].time;
     return encode_blob(std::move(header), {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),

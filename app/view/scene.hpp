@@ -20,13 +20,13 @@ namespace bvc3d::view {
 
 // A world as the page draws it: triangles, the walkable outline, start points, and any point
 // cloud (a recording's map).
-std::string world_blob(const WorldDescription& world, const std::string& source,
-                       const std::vector<float>& points = {});
+std::string world_blob(const WorldDescription& world, const std::string& source, const std::vector<float>& points = {});
 
 // What a model's scanner sees at a pose: the drawn scan's points (world frame), their ranges, which
 // of them are in rows the model keeps, and the model's BVC rates (arrays points, range, kept, bvc);
 // the header gains returns, model_returns and sensor_origin.
-std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model, const Pose& pose, nlohmann::json& header);
+std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model, const Pose& pose,
+                                     nlohmann::json& header);
 // The same at a pose of the page's choosing, in a world shown on its own.
 std::string probe_blob(const World& world, const ModelSpec& model, const Pose& pose);
 

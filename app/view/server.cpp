@@ -30,11 +30,20 @@ std::string escape_html(const std::string& s) {
     std::string out;
     for (char c : s) {
         switch (c) {
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '&': out += "&amp;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '&':
+                out += "&amp;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -43,15 +52,16 @@ std::string escape_html(const std::string& s) {
 void error_page(httplib::Response& res, int status, const std::string& message) {
     res.status = status;
     res.set_content("<!doctype html><meta charset=utf-8><title>bvc3d view: error " + std::to_string(status) +
-                        "</title><body style=\"font-family:sans-serif\"><h1>bvc3d view: error " + std::to_string(status) +
-                        "</h1><p id=\"error\">" + escape_html(message) + "</p></body>",
+                        "</title><body style=\"font-family:sans-serif\"><h1>bvc3d view: error " +
+                        std::to_string(status) + "</h1><p id=\"error\">" + escape_html(message) + "</p></body>",
                     "text/html; charset=utf-8");
 }
 
 // The page loads nothing from elsewhere: say so to the browser too.
 void common_headers(httplib::Response& res) {
-    res.set_header("Content-Security-Policy",
-                   "default-src 'self'; img-src 'self' data: blob:; style-src 'self' 'unsafe-inline'; connect-src 'self'");
+    res.set_header(
+        "Content-Security-Policy",
+        "default-src 'self'; img-src 'self' data: blob:; style-src 'self' 'unsafe-inline'; connect-src 'self'");
     res.set_header("X-Content-Type-Options", "nosniff");
     res.set_header("Cache-Control", "no-store");
 }
@@ -93,7 +103,8 @@ void serve(ViewData& data, const fs::path& web_dir, int port, const std::atomic<
         if (!file) return error_page(res, 403, "'" + req.path + "' is outside the viewer's folder");
         std::string body;
         std::error_code ec;
-        if (!fs::is_regular_file(*file, ec) || !read_file(*file, body)) return error_page(res, 404, "no such page: '" + req.path + "'");
+        if (!fs::is_regular_file(*file, ec) || !read_file(*file, body))
+            return error_page(res, 404, "no such page: '" + req.path + "'");
         res.set_content(body, content_type_of(*file).c_str());
     });
     // Read-only: every other method is refused.

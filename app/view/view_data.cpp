@@ -50,7 +50,8 @@ Reply blob_reply(std::string body) { return Reply{200, "application/octet-stream
 
 ViewData::ViewData(ViewTarget target) : target_(std::move(target)) {
     if (target_.scans && target_.poses)  // read the lists now: a bad recording fails before serving
-        recording_ = std::make_unique<RecordingScene>(*target_.scans, *target_.poses, config::resolve_model(target_.model));
+        recording_ =
+            std::make_unique<RecordingScene>(*target_.scans, *target_.poses, config::resolve_model(target_.model));
 }
 
 Reply ViewData::get(const std::string& endpoint, const Query& query) {
@@ -79,20 +80,23 @@ Reply ViewData::route(const std::string& endpoint, const Query& query) {
         const auto scene = trial(param(query, "path"));
         const std::size_t i = index_param(query, "i");
         if (i >= scene->samples())
-            throw RequestError(404, "sample " + std::to_string(i) + " is past the trial's " + std::to_string(scene->samples()));
+            throw RequestError(
+                404, "sample " + std::to_string(i) + " is past the trial's " + std::to_string(scene->samples()));
         return blob_reply(scene->step_blob(i));
     }
     if (endpoint == "world") return blob_reply(world_reply(query));
     if (endpoint == "probe") {
         const auto world = world_by_source(param(query, "source"));
-        const Pose pose = Pose::on_floor(number_param(query, "x"), number_param(query, "y"), number_param(query, "heading"));
+        const Pose pose =
+            Pose::on_floor(number_param(query, "x"), number_param(query, "y"), number_param(query, "heading"));
         return blob_reply(probe_blob(*world, config::resolve_model(target_.model), pose));
     }
     if (endpoint == "recording") return blob_reply(recording().blob());
     if (endpoint == "scan") {
         const std::size_t i = index_param(query, "i");
         if (i >= recording().size())
-            throw RequestError(404, "scan " + std::to_string(i) + " is past the recording's " + std::to_string(recording().size()));
+            throw RequestError(
+                404, "scan " + std::to_string(i) + " is past the recording's " + std::to_string(recording().size()));
         return blob_reply(recording().scan_blob(i));
     }
     throw RequestError(404, "no such data: '" + endpoint + "'");

@@ -17,13 +17,13 @@
 namespace bvc3d::view {
 
 struct ViewTarget {
-    std::filesystem::path root;        // the served folder: requests name files inside it
-    std::vector<std::string> trials;   // trial files, relative to root, in listing order
-    std::vector<std::string> open;     // the trials opened first (a second one is shown beside)
-    std::string world;                 // a world opened first: a preset or a YAML file relative to root
-    std::vector<std::string> worlds;   // the worlds offered: presets and YAML files under root
+    std::filesystem::path root;       // the served folder: requests name files inside it
+    std::vector<std::string> trials;  // trial files, relative to root, in listing order
+    std::vector<std::string> open;    // the trials opened first (a second one is shown beside)
+    std::string world;                // a world opened first: a preset or a YAML file relative to root
+    std::vector<std::string> worlds;  // the worlds offered: presets and YAML files under root
     std::optional<std::filesystem::path> scans, poses;  // a recording
-    std::string model = "3d-0.2";      // the model whose BVCs a recording's page shows
+    std::string model = "3d-0.2";                       // the model whose BVCs a recording's page shows
 };
 
 struct Reply {
@@ -40,7 +40,8 @@ public:
     const ViewTarget& target() const { return target_; }
 
     // index, trial?path=, step?path=&i=, world?source= | world?trial= | world?recording=1,
-    // probe?source=&x=&y=&heading= (the default model's view at that pose), recording, scan?i=. Errors are replies with a status and {"error": message}: 400 bad
+    // probe?source=&x=&y=&heading= (the default model's view at that pose), recording, scan?i=. Errors are replies with
+    // a status and {"error": message}: 400 bad
     // request, 403 a path outside the served folder, 404 missing, 422 a file that cannot be read.
     Reply get(const std::string& endpoint, const Query& query);
 

@@ -202,9 +202,11 @@ def scan_to_map(rec, work):
     (work / "hall-map.yaml").write_text(
         "name: hall-map\nobjects:\n"
         f"  - point_cloud: {{file: {map_file.name}, radius: {SPHERE}}}\n"
-        "walkable: {rect: [%g, %g, %g, %g]}\n" % (grid[:, 0].min(), grid[:, 1].min(), grid[:, 0].max(), grid[:, 1].max()))
+        "walkable: {rect: [%g, %g, %g, %g]}\n" % (grid[:, 0].min(), grid[:, 1].min(), grid[:, 0].max(),
+                                                  grid[:, 1].max()))
     facts = {
-        "map_points": len(points), "ring_spacing_deg": delta, "ring_lowest_deg": rings[0], "ring_highest_deg": rings[-1],
+        "map_points": len(points), "ring_spacing_deg": delta, "ring_lowest_deg": rings[0],
+        "ring_highest_deg": rings[-1],
         "far_points_for_rings": n_far, "floor_cells": len(cells), "templates": len(grid), "inside_geometry": blocked,
         "floor_slope_x": plane[0], "floor_slope_y": plane[1], "floor_z0": plane[2],
         "floor_residual_p5": np.percentile(residual, 5), "floor_residual_p95": np.percentile(residual, 95),
@@ -431,7 +433,8 @@ def place_cells(rec, work):
                      ("simulated", "bvc", bvc["templates"], simulated)] + cases
         for queries_kind, rates, t, q in cases:
             r = bvc3d.localize(t, grid, q, qxyz)
-            rows.append(summary_row(f"{hours:g}", name, rates, r) + [queries_kind, f"{np.mean(q.max(axis=1) == 0):.3f}"])
+            rows.append(summary_row(f"{hours:g}", name, rates, r) +
+                        [queries_kind, f"{np.mean(q.max(axis=1) == 0):.3f}"])
             per_query += [[name, hours, rates, queries_kind, i, *qxyz[i, :2], r["decoded"][i], r["error"][i]]
                           for i in range(len(q))]
         walks[-1] += [f"{np.mean(place_t.max(axis=0) > 0):.3f}", f"{np.mean(place_t.max(axis=1) == 0):.3f}"]
@@ -450,7 +453,8 @@ def place_cells(rec, work):
         w.writerows(per_query)
     with open(HERE / "place-cells-walks.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["model", "walk_hours", "steps", "bumps", "templates_within_0.5m_of_walk", "place_cells_active_on_templates",
+        w.writerow(["model", "walk_hours", "steps", "bumps", "templates_within_0.5m_of_walk",
+                    "place_cells_active_on_templates",
                     "silent_templates"])
         w.writerows(walks)
     log("wrote", HERE / "place-cells.csv")

@@ -25,13 +25,15 @@ std::optional<an::Extent> extent_of(const MaybeExtent& e) {
 }
 
 std::span<const double> span1d(const ArrayD& a, const char* name) {
-    if (a.ndim() != 1) throw InputError(std::string(name) + " must be 1-D, got " + std::to_string(a.ndim()) + " dimensions");
+    if (a.ndim() != 1)
+        throw InputError(std::string(name) + " must be 1-D, got " + std::to_string(a.ndim()) + " dimensions");
     return {a.data(), static_cast<std::size_t>(a.shape(0))};
 }
 
 template <class T>
 Eigen::Map<const an::RowMatrixX<T>> matrix(const Array<T>& a, const char* name) {
-    if (a.ndim() != 2) throw InputError(std::string(name) + " must be 2-D, got " + std::to_string(a.ndim()) + " dimensions");
+    if (a.ndim() != 2)
+        throw InputError(std::string(name) + " must be 2-D, got " + std::to_string(a.ndim()) + " dimensions");
     return {a.data(), a.shape(0), a.shape(1)};
 }
 
@@ -43,7 +45,9 @@ Eigen::Map<const an::Points> centers_of(const ArrayD& a) {
 
 pyb::array_t<double> numpy_of(const an::RowMatrixXd& m) { return to_numpy(m.data(), {m.rows(), m.cols()}); }
 template <class T>
-pyb::array_t<T> numpy_of(const std::vector<T>& v) { return to_numpy(v.data(), {static_cast<pyb::ssize_t>(v.size())}); }
+pyb::array_t<T> numpy_of(const std::vector<T>& v) {
+    return to_numpy(v.data(), {static_cast<pyb::ssize_t>(v.size())});
+}
 
 pyb::dict decoding_dict(const an::DecodingResult& d) {
     pyb::dict r;
@@ -146,7 +150,8 @@ void bind_sample_functions(pyb::module_& a) {
             interruptible([&](const std::atomic<bool>&) {
                 m = an::rate_maps<T>(xs, ys, r, {gridsize, quantile, extent_of(extent)});
             });
-            return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean), numpy_of(m.bins.counts));
+            return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean),
+                                   numpy_of(m.bins.counts));
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
         pyb::arg("extent"));
@@ -156,11 +161,10 @@ void bind_sample_functions(pyb::module_& a) {
            double quantile, const std::string& templates) {
             const auto xs = span1d(x, "x"), ys = span1d(y, "y");
             const auto r = matrix<T>(rates, "rates");
-            const an::DecodingParams params{gridsize, quantile, extent_of(extent), an::parse_decoding_templates(templates)};
+            const an::DecodingParams params{gridsize, quantile, extent_of(extent),
+                                            an::parse_decoding_templates(templates)};
             an::DecodingResult d;
-            interruptible([&](const std::atomic<bool>&) {
-                d = an::decoding_error<T>(xs, ys, r, params);
-            });
+            interruptible([&](const std::atomic<bool>&) { d = an::decoding_error<T>(xs, ys, r, params); });
             return decoding_dict(d);
         },
         pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("extent"),
@@ -197,15 +201,13 @@ void bind_sample_functions(pyb::module_& a) {
             params.skip_samples = skip_samples;
             params.msai_bins = msai_bins;
             an::TrialMetrics m;
-            interruptible([&](const std::atomic<bool>&) {
-                m = an::analyze_trial<T>(xs, ys, r, params);
-            });
+            interruptible([&](const std::atomic<bool>&) { m = an::analyze_trial<T>(xs, ys, r, params); });
             pyb::dict d = trial_analysis_dict(m, "bin_area_m2", decoding_dict(m.decoding));
             return d;
         },
-        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"),
-        pyb::arg("eps"), pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"),
-        pyb::arg("decoding_templates"), pyb::arg("mi_quantile"), pyb::arg("skip_samples"), pyb::arg("msai_bins"));
+        pyb::arg("x"), pyb::arg("y"), values_arg("rates"), pyb::arg("gridsize"), pyb::arg("quantile"), pyb::arg("eps"),
+        pyb::arg("min_samples"), pyb::arg("d_th"), pyb::arg("extent"), pyb::arg("decoding_templates"),
+        pyb::arg("mi_quantile"), pyb::arg("skip_samples"), pyb::arg("msai_bins"));
 }
 
 // 3-D (flying agents): voxel rate maps and the whole analysis of N × 3 positions.
@@ -227,7 +229,8 @@ void bind_voxel_functions(pyb::module_& a) {
                 auto grid = std::make_shared<an::VoxelGrid>(an::VoxelGrid::fit(p, voxel, box_of(volume)));
                 m = an::rate_maps<T>(grid, p, r, quantile);
             }
-            return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean), numpy_of(m.bins.counts));
+            return pyb::make_tuple(numpy_of(m.bins.centers), numpy_of(m.map), numpy_of(m.mean),
+                                   numpy_of(m.bins.counts));
         },
         pyb::arg("positions"), values_arg("rates"), pyb::arg("voxel"), pyb::arg("volume"), pyb::arg("quantile"));
     a.def(
@@ -298,7 +301,9 @@ void bind_analysis(pyb::module_& m) {
         "dbscan_cluster_count",
         [](const ArrayD& points, double eps, int min_samples) {
             const auto p = centers_of(points);
-            return interruptible([&](const std::atomic<bool>&) { return an::dbscan_cluster_count(p, {eps, min_samples}); });
+            return interruptible([&](const std::atomic<bool>&) {
+                return an::dbscan_cluster_count(p, {eps, min_samples});
+            });
         },
         pyb::arg("points"), pyb::arg("eps"), pyb::arg("min_samples"));
     a.def(
@@ -306,9 +311,7 @@ void bind_analysis(pyb::module_& m) {
         [](const ArrayD& points, double eps) {
             const auto p = centers_of(points);
             an::Neighborhoods nb;
-            interruptible([&](const std::atomic<bool>&) {
-                nb = an::sklearn_radius_neighbors(p, eps);
-            });
+            interruptible([&](const std::atomic<bool>&) { nb = an::sklearn_radius_neighbors(p, eps); });
             return pyb::make_tuple(numpy_of(nb.offsets), numpy_of(nb.indices));
         },
         pyb::arg("points"), pyb::arg("eps"));
@@ -318,9 +321,7 @@ void bind_analysis(pyb::module_& m) {
             const auto c = centers_of(centers);
             const auto mp = matrix<double>(maps, "maps");
             std::vector<int> mi;
-            interruptible([&](const std::atomic<bool>&) {
-                mi = an::modality(c, mp, {eps, min_samples});
-            });
+            interruptible([&](const std::atomic<bool>&) { mi = an::modality(c, mp, {eps, min_samples}); });
             return numpy_of(mi);
         },
         pyb::arg("centers"), pyb::arg("maps"), pyb::arg("eps"), pyb::arg("min_samples"));
@@ -344,9 +345,7 @@ void bind_analysis(pyb::module_& m) {
             const auto c = centers_of(centers);
             const auto mp = matrix<double>(maps, "maps");
             an::AliasingResult r;
-            interruptible([&](const std::atomic<bool>&) {
-                r = an::spatial_aliasing(c, mp, d_th);
-            });
+            interruptible([&](const std::atomic<bool>&) { r = an::spatial_aliasing(c, mp, d_th); });
             return pyb::make_tuple(to_numpy(r.sai.data(), {r.sai.size()}), r.msai);
         },
         pyb::arg("centers"), pyb::arg("maps"), pyb::arg("d_th"));

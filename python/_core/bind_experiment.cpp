@@ -42,7 +42,8 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     t.world = WorldSpec{world, tilt_deg, t.world.lean};
     t.seed = seed_of(seed, "seed");
     const bool flying = kwargs.contains("agent") && agent_by_name(pyb::str(kwargs["agent"]))->kind() == "flight";
-    if (kwargs.contains("flight") && !flying) throw InputError("flight= (the flying agent's parameters) needs agent='flight'");
+    if (kwargs.contains("flight") && !flying)
+        throw InputError("flight= (the flying agent's parameters) needs agent='flight'");
     if (flying) {
         FlightParams flight;
         if (kwargs.contains("flight") && !kwargs["flight"].is_none())
@@ -57,7 +58,8 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     }
     if (kwargs.contains("authors_choices"))
         apply_authors_choices(t, kwargs["authors_choices"].cast<std::vector<std::string>>());
-    apply_kwargs(t.protocol, Protocol::table(), kwargs, {"trajectory", "protocol", "agent", "flight", "authors_choices"});
+    apply_kwargs(t.protocol, Protocol::table(), kwargs,
+                 {"trajectory", "protocol", "agent", "flight", "authors_choices"});
     if (kwargs.contains("protocol")) t.protocol.kind = parse_protocol(pyb::str(kwargs["protocol"]));  // = kind
     t.validate();
     t.agent->check_world(t.world.resolve());
@@ -98,7 +100,8 @@ pyb::dict choice_to_dict(const ElevationChoice& c) {
     for (const auto& s : c.candidates)
         candidates.append(pyb::dict(pyb::arg("elevations") = s.elevations, pyb::arg("n_per_axis") = s.n_per_axis,
                                     pyb::arg("round") = s.round, pyb::arg("msai") = s.msai,
-                                    pyb::arg("frac_multimodal") = s.frac_multimodal, pyb::arg("bvc_msai") = s.bvc_msai));
+                                    pyb::arg("frac_multimodal") = s.frac_multimodal,
+                                    pyb::arg("bvc_msai") = s.bvc_msai));
     return pyb::dict(pyb::arg("elevations") = c.chosen.elevations, pyb::arg("n_per_axis") = c.chosen.n_per_axis,
                      pyb::arg("msai") = c.chosen.msai, pyb::arg("candidates") = candidates,
                      pyb::arg("walk_steps") = c.walk_steps, pyb::arg("model_yaml") = config::model_to_yaml(c.model));
@@ -152,9 +155,9 @@ Protocol keywords and their defaults:
                 for (const auto& [k, v] : kwargs) {
                     const std::string key = pyb::str(k);
                     if (!ChooserParams::table().find(key) && !RecordedReturnParams::table().find(key))
-                        throw InputError("choose_elevations: unknown argument '" + key + "' (accepted: " +
-                                         listed(ChooserParams::table().keys()) + ", and on a recording " +
-                                         listed(preprocess_keys) + ")");
+                        throw InputError("choose_elevations: unknown argument '" + key +
+                                         "' (accepted: " + listed(ChooserParams::table().keys()) +
+                                         ", and on a recording " + listed(preprocess_keys) + ")");
                 }
             ChooserParams p;
             apply_kwargs(p, ChooserParams::table(), kwargs, recorded ? preprocess_keys : std::vector<std::string>{});
@@ -172,7 +175,9 @@ Protocol keywords and their defaults:
             }
             const ElevationChoice c = interruptible([&](const std::atomic<bool>& stop) {
                 p.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
-                if (source) return choose_elevations_on(*source, base, p, analysis, sets.value_or(std::vector<std::vector<double>>{}));
+                if (source)
+                    return choose_elevations_on(*source, base, p, analysis,
+                                                sets.value_or(std::vector<std::vector<double>>{}));
                 const World w(config::resolve_world(world.value_or(WorldSpec{}.source), tilt_deg));
                 agent->check_world(w.description());
                 return sets ? choose_from_sets(w, base, *agent, *sets, p, analysis)
@@ -181,8 +186,8 @@ Protocol keywords and their defaults:
             return choice_to_dict(c);
         },
         pyb::arg("world") = pyb::none(), pyb::arg("tilt_deg") = pyb::none(), pyb::arg("agent") = "ground",
-        pyb::arg("sensor") = pyb::none(), pyb::arg("seed") = 0, pyb::arg("sets") = pyb::none(), pyb::arg("jobs") = ChooserParams{}.jobs,
-        pyb::arg("recording") = pyb::none(),
+        pyb::arg("sensor") = pyb::none(), pyb::arg("seed") = 0, pyb::arg("sets") = pyb::none(),
+        pyb::arg("jobs") = ChooserParams{}.jobs, pyb::arg("recording") = pyb::none(),
         (R"doc(The agent's choice of BVC elevations from its own exploratory walk, as `bvc3d choose-elevations`
 does it: the criterion (MSAI of the place-cell network on the walk, lower is better) of each
 candidate set of the greedy search, or of the given `sets` (lists of elevations, rad). Returns a

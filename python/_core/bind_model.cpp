@@ -48,35 +48,43 @@ pyb::dict preferred(const BoundaryVectorLayer& l) {
 }
 
 void bind_layer(pyb::module_& m) {
-    auto cls = pyb::class_<BoundaryVectorLayer>(m, "BoundaryVectorLayer", (R"doc(
+    auto cls = pyb::class_<BoundaryVectorLayer>(m, "BoundaryVectorLayer",
+                                                (R"doc(
 Boundary vector cells tuned to distance, allocentric azimuth and elevation (docs/model-reference.md).
 Cell i = (l, k, m) sits at index (l·n_dir + k)·n_per_axis + m. elevations=None or [] is the 2-D model.
 Keyword arguments and their defaults (the `3d-0.2` model's layer):
-)doc" + describe(BvcParams::table(), BvcParams{})).c_str());
+)doc" + describe(BvcParams::table(), BvcParams{}))
+                                                    .c_str());
     cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
-                BvcParams p;
-                apply_args(p, BvcParams::table(), args, kwargs);
-                return BoundaryVectorLayer(p);
-            }))
+           BvcParams p;
+           apply_args(p, BvcParams::table(), args, kwargs);
+           return BoundaryVectorLayer(p);
+       }))
         .def_static(
             "preset", [](const std::string& name) { return BoundaryVectorLayer(config::resolve_model(name).bvc); },
             pyb::arg("name"), "The BVC layer of a model preset (2d, 3d-0.1, 3d-0.2, 3d-3l, 2d-8beam) or model YAML")
-        .def("rates", [](const BoundaryVectorLayer& l, const pyb::object& r) { return compute(l, r, true); },
-             pyb::arg("returns"), "Normalized rates (n_cells,) for an (N, 3) array of returns")
-        .def("raw", [](const BoundaryVectorLayer& l, const pyb::object& r) { return compute(l, r, false); },
-             pyb::arg("returns"), "Unnormalized sums (n_cells,)")
+        .def(
+            "rates", [](const BoundaryVectorLayer& l, const pyb::object& r) { return compute(l, r, true); },
+            pyb::arg("returns"), "Normalized rates (n_cells,) for an (N, 3) array of returns")
+        .def(
+            "raw", [](const BoundaryVectorLayer& l, const pyb::object& r) { return compute(l, r, false); },
+            pyb::arg("returns"), "Unnormalized sums (n_cells,)")
         .def_property_readonly("n_cells", &BoundaryVectorLayer::n_cells)
-        .def_property_readonly("preferred", &preferred, "dict of arrays: each cell's preferred elevation, azimuth and distance");
+        .def_property_readonly("preferred", &preferred,
+                               "dict of arrays: each cell's preferred elevation, azimuth and distance");
     for (const auto& f : BvcParams::table().fields())
         cls.def_property_readonly(
-            f.key.c_str(), [get = f.get](const BoundaryVectorLayer& l) { return from_value(get(l.params())); }, f.doc.c_str());
+            f.key.c_str(), [get = f.get](const BoundaryVectorLayer& l) { return from_value(get(l.params())); },
+            f.doc.c_str());
 }
 
 void bind_network(pyb::module_& m) {
-    auto cls = pyb::class_<PlaceCellNetwork>(m, "PlaceCellNetwork", (R"doc(
+    auto cls = pyb::class_<PlaceCellNetwork>(m, "PlaceCellNetwork",
+                                             (R"doc(
 Place cells driven by BVCs, with Oja learning (docs/model-reference.md#place-cell-network).
 PlaceCellNetwork(n_bvc, seed=0, **params); params and their defaults:
-)doc" + describe(PlaceParams::table(), PlaceParams{})).c_str());
+)doc" + describe(PlaceParams::table(), PlaceParams{}))
+                                                 .c_str());
     cls.def(pyb::init([](int n_bvc, const pyb::object& seed, const pyb::kwargs& kwargs) {
                 PlaceParams p;
                 apply_kwargs(p, PlaceParams::table(), kwargs);
@@ -107,17 +115,21 @@ PlaceCellNetwork(n_bvc, seed=0, **params); params and their defaults:
                 net.set_weights({w.data(), static_cast<std::size_t>(w.size())});
             },
             "(n_place, n_bvc) float32 weights; assign to restore a trained network")
-        .def_property_readonly("rates", [](const PlaceCellNetwork& n) {
-            return to_numpy(n.rates().data(), {static_cast<pyb::ssize_t>(n.rates().size())});
-        })
-        .def_property_readonly("membrane", [](const PlaceCellNetwork& n) {
-            return to_numpy(n.membrane().data(), {static_cast<pyb::ssize_t>(n.membrane().size())});
-        })
+        .def_property_readonly("rates",
+                               [](const PlaceCellNetwork& n) {
+                                   return to_numpy(n.rates().data(), {static_cast<pyb::ssize_t>(n.rates().size())});
+                               })
+        .def_property_readonly("membrane",
+                               [](const PlaceCellNetwork& n) {
+                                   return to_numpy(n.membrane().data(),
+                                                   {static_cast<pyb::ssize_t>(n.membrane().size())});
+                               })
         .def_property_readonly("n_bvc", &PlaceCellNetwork::n_bvc)
         .def("reset", &PlaceCellNetwork::reset, "Membrane and rates back to zero; weights kept");
     for (const auto& f : PlaceParams::table().fields())
         cls.def_property_readonly(
-            f.key.c_str(), [get = f.get](const PlaceCellNetwork& n) { return from_value(get(n.params())); }, f.doc.c_str());
+            f.key.c_str(), [get = f.get](const PlaceCellNetwork& n) { return from_value(get(n.params())); },
+            f.doc.c_str());
 }
 
 }  // namespace

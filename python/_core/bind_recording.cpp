@@ -93,30 +93,33 @@ array and the scan's (N, 3) points in the sensor frame (docs/recordings.md).)doc
                 }
                 return std::make_shared<recording::Recording>(recording::open_recording(scans, poses, o));
             },
-            pyb::arg("scans"), pyb::arg("poses"), pyb::arg("pose_format") = "auto", pyb::arg("extrinsics") = pyb::none(),
+            pyb::arg("scans"), pyb::arg("poses"), pyb::arg("pose_format") = "auto",
+            pyb::arg("extrinsics") = pyb::none(),
             pyb::arg("time_tolerance") = recording::RecordingOptions{}.time_tolerance,
             "extrinsics: base_from_sensor as a file or 12/16 numbers; the poses are then the base's")
         .def_property_readonly("name", [](const recording::Recording& r) { return r.name; })
         .def("__len__", &recording::Recording::size)
-        .def_property_readonly("poses",
-                               [](const recording::Recording& r) {
-                                   pyb::array_t<double> a({static_cast<pyb::ssize_t>(r.size()), pyb::ssize_t{4}, pyb::ssize_t{4}});
-                                   auto v = a.mutable_unchecked<3>();
-                                   for (std::size_t i = 0; i < r.size(); ++i) {
-                                       const Eigen::Matrix4d mm = r.poses[i].world_from_sensor.matrix();
-                                       for (int j = 0; j < 4; ++j)
-                                           for (int k = 0; k < 4; ++k) v(i, j, k) = mm(j, k);
-                                   }
-                                   return a;
-                               },
-                               "(n, 4, 4) world_from_sensor poses")
-        .def_property_readonly("times",
-                               [](const recording::Recording& r) {
-                                   std::vector<double> t;
-                                   for (std::size_t i = 0; i < r.size(); ++i) t.push_back(r.time(i).value_or(NAN));
-                                   return to_numpy(t.data(), {static_cast<pyb::ssize_t>(t.size())});
-                               },
-                               "(n,) scan times in seconds (NaN where the recording has none)")
+        .def_property_readonly(
+            "poses",
+            [](const recording::Recording& r) {
+                pyb::array_t<double> a({static_cast<pyb::ssize_t>(r.size()), pyb::ssize_t{4}, pyb::ssize_t{4}});
+                auto v = a.mutable_unchecked<3>();
+                for (std::size_t i = 0; i < r.size(); ++i) {
+                    const Eigen::Matrix4d mm = r.poses[i].world_from_sensor.matrix();
+                    for (int j = 0; j < 4; ++j)
+                        for (int k = 0; k < 4; ++k) v(i, j, k) = mm(j, k);
+                }
+                return a;
+            },
+            "(n, 4, 4) world_from_sensor poses")
+        .def_property_readonly(
+            "times",
+            [](const recording::Recording& r) {
+                std::vector<double> t;
+                for (std::size_t i = 0; i < r.size(); ++i) t.push_back(r.time(i).value_or(NAN));
+                return to_numpy(t.data(), {static_cast<pyb::ssize_t>(t.size())});
+            },
+            "(n,) scan times in seconds (NaN where the recording has none)")
         .def_property_readonly("scan_paths",
                                [](const recording::Recording& r) {
                                    std::vector<std::string> p;
@@ -156,16 +159,19 @@ array and the scan's (N, 3) points in the sensor frame (docs/recordings.md).)doc
             pyb::arg("i"), pyb::arg("model") = "3d-0.2",
             (std::string(R"doc(Scan i's returns as `model` reads them: an (N, 3) array of range, allocentric azimuth,
 elevation (gravity-aligned by the scan's pose; the 3-D presets keep the upper half, 2-D models the
-horizontal slice). )doc") + preprocess_doc + describe(RecordedReturnParams::table(), RecordedReturnParams{}))
+horizontal slice). )doc") +
+             preprocess_doc + describe(RecordedReturnParams::table(), RecordedReturnParams{}))
                 .c_str())
         .def(
             "replay",
-            [](const RecordingPtr& r, const std::string& model, bool learn, const pyb::object& weights, std::uint64_t seed,
-               const pyb::kwargs& kwargs) {
+            [](const RecordingPtr& r, const std::string& model, bool learn, const pyb::object& weights,
+               std::uint64_t seed, const pyb::kwargs& kwargs) {
                 return run(recorded_source(r, preprocess_of(kwargs, {})), model, learn, weights, seed);
             },
-            pyb::arg("model") = "3d-0.2", pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(), pyb::arg("seed") = 0,
-            (std::string(R"doc(Every scan through `model`, as `bvc3d replay` does it: a dict of arrays t, x, y, z, heading
+            pyb::arg("model") = "3d-0.2", pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(),
+            pyb::arg("seed") = 0,
+            (std::string(
+                 R"doc(Every scan through `model`, as `bvc3d replay` does it: a dict of arrays t, x, y, z, heading
 (n,), bvc_rates (n, n_bvc), rates (n, n_place) and the final weights. learn: place cells learn
 (online); weights: a trial file or an array to start from (default: the seed's draw). )doc") +
              preprocess_doc + describe(RecordedReturnParams::table(), RecordedReturnParams{}))
@@ -185,7 +191,8 @@ void bind_recording(pyb::module_& m) {
            bool learn, const pyb::object& weights, std::uint64_t seed, const pyb::kwargs& kwargs) {
             std::shared_ptr<const TrajectorySpec> path;
             if (pyb::isinstance<pyb::str>(trajectory) || pyb::hasattr(trajectory, "__fspath__")) {
-                path = std::make_shared<const TrajectorySpec>(TrajectorySpec::from_file(pyb::str(trajectory).cast<std::string>()));
+                path = std::make_shared<const TrajectorySpec>(
+                    TrajectorySpec::from_file(pyb::str(trajectory).cast<std::string>()));
             } else {
                 const auto d = trajectory.cast<pyb::dict>();
                 auto column = [&](const char* key) {
@@ -201,9 +208,9 @@ void bind_recording(pyb::module_& m) {
                     "arrays");
             }
             const LidarSpec s = pyb::isinstance<pyb::str>(sensor) ? config::resolve_sensor(sensor.cast<std::string>())
-                                                                   : sensor.cast<LidarSpec>();
-            return run(simulated_source(WorldSpec{world, std::nullopt, "+x+y"}, path, s, preprocess_of(kwargs, {})), model,
-                       learn, weights, seed);
+                                                                  : sensor.cast<LidarSpec>();
+            return run(simulated_source(WorldSpec{world, std::nullopt, "+x+y"}, path, s, preprocess_of(kwargs, {})),
+                       model, learn, weights, seed);
         },
         pyb::arg("world"), pyb::arg("trajectory"), pyb::arg("sensor"), pyb::arg("model") = "3d-0.2",
         pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(), pyb::arg("seed") = 0,

@@ -45,21 +45,24 @@ pyb::dict steps_to_dict(const std::vector<ModelStep>& steps) {
 }
 
 void bind_sensor(pyb::module_& m) {
-    auto cls = pyb::class_<LidarSpec>(m, "Sensor", (R"doc(
+    auto cls = pyb::class_<LidarSpec>(m, "Sensor",
+                                      (R"doc(
 A range scanner: a table of beam elevations (rows) × azimuth_count columns (docs/worlds.md#sensors).
 Sensor.horizontal() and Sensor.spherical() are the paper's two scanners; Sensor(**keys) any other:
-)doc" + describe(LidarSpec::table(), LidarSpec{})).c_str());
+)doc" + describe(LidarSpec::table(), LidarSpec{}))
+                                          .c_str());
     cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
-                LidarSpec s;
-                s.name = "custom";
-                apply_args(s, LidarSpec::table(), args, kwargs);
-                return s;
-            }))
+           LidarSpec s;
+           s.name = "custom";
+           apply_args(s, LidarSpec::table(), args, kwargs);
+           return s;
+       }))
         .def_static("horizontal", &LidarSpec::horizontal, "The paper's 2-D scanner: 720 beams at 0.08 m")
         .def_static("spherical", &LidarSpec::spherical, pyb::arg("upper_only") = true,
                     "The paper's 90×180 range image at 0.18 m; upper_only keeps rows 0-44 (elevation > 0)")
-        .def_static("spherical_as_authors", &LidarSpec::spherical_as_authors, pyb::arg("upper_only") = true,
-                    "The spherical image labeled as the authors' code labels it (angle labels, whole-column heading roll)")
+        .def_static(
+            "spherical_as_authors", &LidarSpec::spherical_as_authors, pyb::arg("upper_only") = true,
+            "The spherical image labeled as the authors' code labels it (angle labels, whole-column heading roll)")
         .def_static("from_yaml", &config::resolve_sensor, pyb::arg("path"))
         .def_property_readonly("beam_count", &LidarSpec::beam_count)
         .def("__repr__", [](const LidarSpec& s) {
@@ -70,7 +73,8 @@ Sensor.horizontal() and Sensor.spherical() are the paper's two scanners; Sensor(
 }
 
 void bind_world(pyb::module_& m) {
-    pyb::class_<World>(m, "World", "A 3-D world: triangles, a walkable floor region and a start region (docs/worlds.md)")
+    pyb::class_<World>(m, "World",
+                       "A 3-D world: triangles, a walkable floor region and a start region (docs/worlds.md)")
         .def_static(
             "cross",
             [](double tilt_deg, const std::string& lean) {
@@ -82,36 +86,41 @@ void bind_world(pyb::module_& m) {
             pyb::arg("tilt_deg") = CrossArenaParams{}.tilt_deg, pyb::arg("lean") = CrossArenaParams{}.lean,
             "The paper's cross arena")
         .def_static(
-            "from_yaml", [](const std::filesystem::path& path) { return World(config::load_world_file(path.string())); },
+            "from_yaml",
+            [](const std::filesystem::path& path) { return World(config::load_world_file(path.string())); },
             pyb::arg("path"))
         .def_static(
             "preset",
-            [](const std::string& name, std::optional<double> tilt_deg) { return World(config::resolve_world(name, tilt_deg)); },
+            [](const std::string& name, std::optional<double> tilt_deg) {
+                return World(config::resolve_world(name, tilt_deg));
+            },
             pyb::arg("name"), pyb::arg("tilt_deg") = pyb::none(),
-            "A preset name (cross, cross-30, ..., cross-webots, flight-room, atrium) or a world YAML file; tilt_deg for cross and cross-webots")
+            "A preset name (cross, cross-30, ..., cross-webots, flight-room, atrium) or a world YAML file; tilt_deg "
+            "for cross and cross-webots")
         .def_property_readonly("name", &World::name)
-        .def_property_readonly("triangles",
-                               [](const World& w) {
-                                   const auto& mesh = w.mesh();
-                                   pyb::array_t<double> a({static_cast<pyb::ssize_t>(mesh.size()), pyb::ssize_t{3},
-                                                           pyb::ssize_t{3}});
-                                   auto v = a.mutable_unchecked<3>();
-                                   for (std::size_t t = 0; t < mesh.size(); ++t) {
-                                       const auto c = mesh.corners(t);
-                                       for (int i = 0; i < 3; ++i)
-                                           for (int k = 0; k < 3; ++k) v(t, i, k) = c[i][k];
-                                   }
-                                   return a;
-                               },
-                               "(T, 3, 3) array of triangle corners")
-        .def_property_readonly("walkable",
-                               [](const World& w) {
-                                   const auto& p = w.description().walkable.points;
-                                   std::vector<double> flat;
-                                   for (const auto& q : p) flat.insert(flat.end(), {q.x(), q.y()});
-                                   return to_numpy(flat.data(), {static_cast<pyb::ssize_t>(p.size()), 2});
-                               },
-                               "(K, 2) polygon the robot's body stays inside (empty in a flight-only world)")
+        .def_property_readonly(
+            "triangles",
+            [](const World& w) {
+                const auto& mesh = w.mesh();
+                pyb::array_t<double> a({static_cast<pyb::ssize_t>(mesh.size()), pyb::ssize_t{3}, pyb::ssize_t{3}});
+                auto v = a.mutable_unchecked<3>();
+                for (std::size_t t = 0; t < mesh.size(); ++t) {
+                    const auto c = mesh.corners(t);
+                    for (int i = 0; i < 3; ++i)
+                        for (int k = 0; k < 3; ++k) v(t, i, k) = c[i][k];
+                }
+                return a;
+            },
+            "(T, 3, 3) array of triangle corners")
+        .def_property_readonly(
+            "walkable",
+            [](const World& w) {
+                const auto& p = w.description().walkable.points;
+                std::vector<double> flat;
+                for (const auto& q : p) flat.insert(flat.end(), {q.x(), q.y()});
+                return to_numpy(flat.data(), {static_cast<pyb::ssize_t>(p.size()), 2});
+            },
+            "(K, 2) polygon the robot's body stays inside (empty in a flight-only world)")
         .def_property_readonly(
             "flight_volume",
             [](const World& w) -> pyb::object {
@@ -128,8 +137,8 @@ void bind_world(pyb::module_& m) {
             "The flight volume as a dict (region (K, 2) polygon, z_min, z_max), or None for a ground-only world")
         .def(
             "scan",
-            [](const World& w, const pyb::object& sensor, double x, double y, double heading, const pyb::object& noise_seed,
-               const pyb::object& scan_index, double z, double pitch, double roll) {
+            [](const World& w, const pyb::object& sensor, double x, double y, double heading,
+               const pyb::object& noise_seed, const pyb::object& scan_index, double z, double pitch, double roll) {
                 const Lidar lidar(sensor_of(sensor));
                 const NoiseKey key{seed_of(noise_seed, "noise_seed"), seed_of(scan_index, "scan_index")};
                 Scan s;

@@ -47,7 +47,8 @@ pyb::dict samples_to_dict(const GroupResult& r, bool with_bvc);
 // and boolean arrays are refused (a cast would drop imaginary parts or invent numbers).
 ArrayD real_array(const pyb::handle& obj, const std::string& name);
 // The same as float32 (the dtype of weights and rates), with the same refusals.
-pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(const pyb::handle& obj, const std::string& name);
+pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(const pyb::handle& obj,
+                                                                                const std::string& name);
 
 // A seed: a Python integer 0 .. 2^64 - 1 (InputError naming `name` otherwise; no bools, no floats).
 std::uint64_t seed_of(const pyb::handle& obj, const std::string& name);
@@ -139,7 +140,8 @@ template <class S>
 std::string describe(const params::Table<S>& table, const S& defaults) {
     std::string out;
     for (const auto& f : table.fields())
-        out += "  " + f.key + "=" + params::to_text(f.get(defaults)) + "  " + f.doc + (f.radians ? " (radians)" : "") + "\n";
+        out += "  " + f.key + "=" + params::to_text(f.get(defaults)) + "  " + f.doc + (f.radians ? " (radians)" : "") +
+               "\n";
     return out;
 }
 
@@ -147,7 +149,8 @@ std::string describe(const params::Table<S>& table, const S& defaults) {
 template <class S, class C>
 void def_fields(C& cls) {
     for (const auto& f : S::table().fields())
-        cls.def_property_readonly(f.key.c_str(), [get = f.get](const S& s) { return from_value(get(s)); }, f.doc.c_str());
+        cls.def_property_readonly(
+            f.key.c_str(), [get = f.get](const S& s) { return from_value(get(s)); }, f.doc.c_str());
 }
 
 void bind_simulator(pyb::module_& m);

@@ -13,13 +13,15 @@ params::Value to_value(const pyb::handle& obj, params::Kind kind, const std::str
     const auto wrong = [&](const char* what) { return InputError("'" + key + "' must be " + what); };
     switch (kind) {
         case Kind::real:
-            if (pyb::isinstance<pyb::bool_>(obj) || !(pyb::isinstance<pyb::float_>(obj) || pyb::isinstance<pyb::int_>(obj) ||
-                                                      pyb::hasattr(obj, "__float__")))
+            if (pyb::isinstance<pyb::bool_>(obj) ||
+                !(pyb::isinstance<pyb::float_>(obj) || pyb::isinstance<pyb::int_>(obj) ||
+                  pyb::hasattr(obj, "__float__")))
                 throw wrong("a number");
             // numpy scalars: real kinds only (a complex one would lose its imaginary part).
             if (PyComplex_Check(obj.ptr()) ||
-                (pyb::hasattr(obj, "dtype") && std::string("iuf").find(pyb::str(obj.attr("dtype").attr("kind")).cast<std::string>()) ==
-                                                   std::string::npos))
+                (pyb::hasattr(obj, "dtype") &&
+                 std::string("iuf").find(pyb::str(obj.attr("dtype").attr("kind")).cast<std::string>()) ==
+                     std::string::npos))
                 throw wrong("a real number");
             return obj.cast<double>();
         case Kind::integer: {
@@ -50,12 +52,12 @@ params::Value to_value(const pyb::handle& obj, params::Kind kind, const std::str
 
 namespace {
 template <class T>
-pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast> real_array_as(const pyb::handle& obj, const std::string& name) {
+pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast> real_array_as(const pyb::handle& obj,
+                                                                           const std::string& name) {
     pyb::array a;
     try {
         a = pyb::array::ensure(obj);
-    } catch (const pyb::error_already_set&) {
-    }
+    } catch (const pyb::error_already_set&) {}
     if (!a) throw InputError(name + " must be an array of numbers");
     const char kind = a.dtype().kind();
     if (kind != 'i' && kind != 'u' && kind != 'f')
@@ -65,7 +67,8 @@ pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast> real_array_as(const
 }  // namespace
 
 ArrayD real_array(const pyb::handle& obj, const std::string& name) { return real_array_as<double>(obj, name); }
-pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(const pyb::handle& obj, const std::string& name) {
+pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(const pyb::handle& obj,
+                                                                                const std::string& name) {
     return real_array_as<float>(obj, name);
 }
 

@@ -219,8 +219,8 @@ def aliasing(centers, maps, d_th=2.0):
 
     ``SAI_i = (1/N) * sum over j != i with |c_i - c_j| > d_th of cos(a_i, a_j)`` where a_i is row i
     of ``maps`` (the population vector of bin i), cos = 0 when either vector is zero and N is the
-    number of bins; distances are Euclidean over the centers' 2 or 3 coordinates. Returns ``(sai (B,), msai)``, msai = mean
-    SAI (NaN for no bins).
+    number of bins; distances are Euclidean over the centers' 2 or 3 coordinates. Returns ``(sai (B,), msai)``,
+    msai = mean SAI (NaN for no bins).
     """
     c, m, _ = _centers_maps(centers, maps)
     sai, msai = _an.aliasing(c, m, _d_th(d_th))
@@ -294,7 +294,8 @@ def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_t
     eps, min_samples = _dbscan_params(eps, min_samples)
     out = dict(_an.analyze(x, y, r, _gridsize(gridsize), _quantile(quantile), eps, min_samples, _d_th(d_th),
                            _extent(extent), _templates(decoding_templates, "decoding_templates"),
-                           -1.0 if mi_quantile is None else _quantile(mi_quantile), _count(skip_samples, "skip_samples"),
+                           -1.0 if mi_quantile is None else _quantile(mi_quantile),
+                           _count(skip_samples, "skip_samples"),
                            _count(msai_bins, "msai_bins")))
     out["decoding"] = dict(out["decoding"])
     out["modality_summary"] = dict(out["modality_summary"])

@@ -157,7 +157,8 @@ def trajectory_figure(folder, minutes=20):
     ax2.set_ylabel("z, the body's center (m)")
     ax2.set_xlabel("model steps")
     ax2.set_title(f"Heights of all {len(z)} steps of the {hours:.2g} h sampling phase", fontsize=9)
-    fig.suptitle(f"The flying agent's random walk: {world}, seed {seed} (trial {os.path.basename(path)[:-3]})", fontsize=10)
+    fig.suptitle(f"The flying agent's random walk: {world}, seed {seed} (trial {os.path.basename(path)[:-3]})",
+                 fontsize=10)
     fig.tight_layout()
     return fig
 
@@ -175,7 +176,8 @@ def isotropy_figure(folder):
                     with h5py.File(path, "r") as f:
                         iso = f["metrics/isotropy"][:]
                     values.extend(iso[np.isfinite(iso) & (iso > 0)])
-            ax.hist(np.clip(values, bins[0], bins[-1]), bins=bins, histtype="step", lw=1.3, label=f"{m} ({len(values)})")
+            ax.hist(np.clip(values, bins[0], bins[-1]), bins=bins, histtype="step", lw=1.3,
+                    label=f"{m} ({len(values)})")
         ax.axvline(1.0, color="k", ls="--", lw=1, label=f"1: round ({BATS})")
         ax.set_xscale("log")
         ax.set_xlabel("isotropy: sd z / mean sd x, y")
@@ -247,7 +249,8 @@ def worlds_figure(folder):
         lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
         # Leave out floor and ceiling, as the paper's figure shows its arena open.
         keep = ~(np.all(np.isclose(tri[:, :, 2], hi[2]), axis=1) | np.all(np.isclose(tri[:, :, 2], lo[2]), axis=1))
-        ax.add_collection3d(Poly3DCollection(tri[keep], facecolor="tab:orange", edgecolor="k", linewidth=0.1, alpha=0.35))
+        ax.add_collection3d(Poly3DCollection(tri[keep], facecolor="tab:orange", edgecolor="k", linewidth=0.1,
+                                             alpha=0.35))
         fv = world.flight_volume
         if fv is not None:
             r, z0, z1 = fv["region"], fv["z_min"], fv["z_max"]
@@ -294,13 +297,15 @@ def make_flight_report(folder, figdir):
         "onto the three planes and slices through the peak voxel, axes in meters.", lambda: fields_figure(folder))
     add("frac_unimodal.png", f"Fraction of place cells with exactly one 3-D field (MI = 1). {bars}",
         lambda: report.bars_figure(folder, "frac_unimodal"))
-    add("frac_multimodal.png", f"Fraction of multimodal place cells (MI > 1): cells that fire in several places. {bars}",
+    add("frac_multimodal.png",
+        f"Fraction of multimodal place cells (MI > 1): cells that fire in several places. {bars}",
         lambda: report.bars_figure(folder, "frac_multimodal"))
     add("mi_mean.png", f"Mean modality index of the active cells (1: a single field). {bars}",
         lambda: report.bars_figure(folder, "mean_mi_active"))
     add("isotropy.png", f"Median isotropy of the single fields (sd along z over the mean sd along x and y); the dashed "
         f"line is a round field, as the bats' fields were. {bars}", lambda: isotropy_bars(folder))
-    add("isotropy_hist.png", "The isotropy of every single field, all seeds pooled: the distribution behind the medians.",
+    add("isotropy_hist.png",
+        "The isotropy of every single field, all seeds pooled: the distribution behind the medians.",
         lambda: isotropy_figure(folder))
     add("msai.png", f"Mean spatial aliasing index over voxels (d_th 2 m in 3-D): lower is better. {bars}",
         lambda: report.bars_figure(folder, "msai"))

@@ -102,7 +102,8 @@ class Folder:
         self.path = path
         for name in ("trials.csv", "summary.csv"):
             if not os.path.exists(os.path.join(path, name)):
-                raise SystemExit(f"bvc3d.report: {path} has no {name}; run `bvc3d paper` (or `bvc3d summarize {path}`) first")
+                raise SystemExit(f"bvc3d.report: {path} has no {name}; run `bvc3d paper` "
+                                 f"(or `bvc3d summarize {path}`) first")
         self.trials = read_csv(os.path.join(path, "trials.csv"))
         self.summary = read_csv(os.path.join(path, "summary.csv"))
         self.models = list(dict.fromkeys(r["model"] for r in self.summary))
@@ -162,7 +163,8 @@ class Folder:
             path = os.path.join(self.path, r["name"] + ".h5")
             try:
                 with h5py.File(path, "r") as f:
-                    out.append((protocol_text(f.attrs), analysis_text(f["metrics"]), int(f.attrs.get("seed", r["seed"]))))
+                    out.append((protocol_text(f.attrs), analysis_text(f["metrics"]),
+                                int(f.attrs.get("seed", r["seed"]))))
             except (OSError, KeyError) as e:
                 out.append((f"unreadable ({os.path.basename(path)}: {e})", "unreadable", int(r["seed"])))
         return out
@@ -412,7 +414,8 @@ def environments_figure(folder):
         walls = tri[keep]
         inner = np.array([np.abs(t[:, :2]).max() < 4.9 for t in walls])
         ax.add_collection3d(Poly3DCollection(walls[~inner], facecolor="lightgray", edgecolor="none", alpha=0.25))
-        ax.add_collection3d(Poly3DCollection(walls[inner], facecolor="tab:orange", edgecolor="k", linewidth=0.2, alpha=0.9))
+        ax.add_collection3d(Poly3DCollection(walls[inner], facecolor="tab:orange", edgecolor="k", linewidth=0.2,
+                                             alpha=0.9))
         ax.set_xlim(-5, 5)
         ax.set_ylim(-5, 5)
         ax.set_zlim(0, 2.5)
@@ -520,9 +523,11 @@ def setting_lines(folder):
         per = folder.seeds_per_condition
         count = f"{per[0]}" if len(per) == 1 else f"{per[0]} to {per[-1]}"
         lines.append(f"- **Seeds**: {seed_list(seeds)} ({count} per condition). Tables and bars show the mean over "
-                     f"seeds ± the sample standard deviation; error bars of quantities that cannot be negative stop at 0.")
+                     f"seeds ± the sample standard deviation; error bars of quantities that cannot be negative "
+                     f"stop at 0.")
     else:
-        lines.append(f"- **Seeds**: {seed_list(seeds)}, one trial per condition: every value in the table and the figures "
+        lines.append(f"- **Seeds**: {seed_list(seeds)}, one trial per condition: every value in the table "
+                     f"and the figures "
                      f"is a single trial's (no means, no spreads; run more seeds with `--seeds N` for those).")
     return lines
 
@@ -572,7 +577,8 @@ def make_report(path):
     bars = f"Bars: {folder.spread_text()}."
     add("environments.png", "The arenas in 3-D (ceiling and floor left out): the central cross walls lean toward the "
         "+x,+y corner by the given tilt while their footprint stays put.", lambda p: fig_environments(folder, p))
-    add("trajectory.png", f"The robot's random walk during the sampling phase of one trial ({folder.worlds[0]}, {one}): "
+    add("trajectory.png", f"The robot's random walk during the sampling phase of one trial "
+        f"({folder.worlds[0]}, {one}): "
         "coverage of the arena.", lambda p: fig_trajectory(folder, p))
     add("place_fields.png", f"Rate maps of two example place cells at the largest tilt ({one}): a multimodal (aliased, "
         "MI > 1) cell of the first model and a unimodal (MI = 1) cell of the last model. A model without a cell of "

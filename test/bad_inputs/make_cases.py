@@ -99,7 +99,8 @@ MESH_CASES = {
     "ply-binary-index.ply": (ply_binary(faces=CUBE_F[:-1] + [(3, 4, 99)]), "refers to vertex 99"),
     "ply-binary-big-endian-index.ply": (ply_binary(faces=CUBE_F[:-1] + [(3, 4, 99)], big=True), "refers to vertex 99"),
     "ply-binary-extra.ply": (ply_binary() + b"\0" * 7, "data after"),
-    "ply-list-length.ply": (ply_binary().replace(struct.pack("<B3i", 3, *CUBE_F[5]), struct.pack("<B3i", 200, *CUBE_F[5])),
+    "ply-list-length.ply": (ply_binary().replace(struct.pack("<B3i", 3, *CUBE_F[5]),
+                                                 struct.pack("<B3i", 200, *CUBE_F[5])),
                             "refers to vertex 259"),
     "ply-unknown-format.ply": (ply_ascii().replace(b"format ascii", b"format utf8"), "unknown encoding"),
     "ply-unknown-type.ply": (ply_ascii().replace(b"property float y", b"property quad y"), "unknown property type"),
@@ -154,8 +155,10 @@ RECORDING_CASES = {
     "pcd-x-int.pcd": (pcd(type_="I F F"), "scan", "x"),
     "pcd-huge-points.pcd": (pcd(width=10 ** 12, points=10 ** 12, data="binary", body=b""), "scan", ""),
     "ply-cloud-short.ply": (cloud_ply(b"0 0 0\n1 1 1\n", n=3), "scan", ""),
-    "ply-cloud-binary-short.ply": (cloud_ply(struct.pack("<5f", *range(5)), n=2, fmt="binary_little_endian"), "scan", ""),
-    "ply-cloud-no-vertex.ply": (b"ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+    "ply-cloud-binary-short.ply": (cloud_ply(struct.pack("<5f", *range(5)), n=2, fmt="binary_little_endian"),
+                                   "scan", ""),
+    "ply-cloud-no-vertex.ply": (b"ply\nformat ascii 1.0\nelement face 0\n"
+                                b"property list uchar int vertex_indices\nend_header\n",
                                 "scan", "vertex"),
     "kitti-odd-size.bin": (struct.pack("<5f", *range(5)), "scan", "16"),
     "kitti-empty.bin": (b"", "scan", "empty"),
@@ -182,7 +185,8 @@ RECORDING_CASES = {
 def main():
     MESHES.mkdir(exist_ok=True)
     RECORDINGS.mkdir(exist_ok=True)
-    lines = ["# Made by ../make_cases.py. Each mesh is loaded by a world file of the same stem (FILE | COMMAND | EXPECT)."]
+    lines = ["# Made by ../make_cases.py. Each mesh is loaded by a world file of the same stem "
+             "(FILE | COMMAND | EXPECT)."]
     for name, (data, expect) in MESH_CASES.items():
         (MESHES / name).write_bytes(data)
         world = name.rsplit(".", 1)[0] + ".world.yaml"

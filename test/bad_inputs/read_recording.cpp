@@ -29,7 +29,9 @@ int main(int argc, char** argv) {
             read_extrinsics(argv[2]);
             std::printf("extrinsics read\n");
         } else {
-            std::fprintf(stderr, "bvc3d: usage error: bvc3d_read_recording scan FILE | poses FORMAT FILE | list PATH | extrinsics FILE\n");
+            std::fprintf(stderr,
+                         "bvc3d: usage error: bvc3d_read_recording scan FILE | poses FORMAT FILE | list PATH | "
+                         "extrinsics FILE\n");
             return 2;
         }
     } catch (const bvc3d::InputError& e) {

@@ -86,7 +86,8 @@ def file_cases():
         for path in sorted(folder.iterdir()):
             if path.name == "cases.txt" or path.is_dir() and path.name not in listed:
                 continue
-            spec = listed.get(path.name) or (header(path) if path.suffix in (".yaml", ".obj", ".txt", ".csv", ".ply", ".pcd") else None)
+            spec = listed.get(path.name) or (header(path) if path.suffix in (".yaml", ".obj", ".txt", ".csv",
+                                                                             ".ply", ".pcd") else None)
             if spec is None:
                 continue  # a helper file other cases refer to
             cmd, expect, names = spec
@@ -225,7 +226,8 @@ def make_hdf5_cases(args, folder):
     """Builds the bad trial files of hdf5_cases.py from one good trial file made by the CLI."""
     import hdf5_cases
     good = folder / "good.h5"
-    proc = subprocess.run([args.cli, "run", "--hours", "0.02", "--seed", "1", "--out", str(good), "--checkpoint-minutes", "0"],
+    proc = subprocess.run([args.cli, "run", "--hours", "0.02", "--seed", "1", "--out", str(good),
+                           "--checkpoint-minutes", "0"],
                           capture_output=True, text=True, env=args.env, timeout=args.timeout * 4)
     if proc.returncode != 0:
         raise SystemExit(f"cannot make the good trial file: {proc.stderr}")

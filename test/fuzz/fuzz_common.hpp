@@ -30,8 +30,8 @@ int expect_input_errors(F&& read) {
 // The input as a file with the given extension (the readers take paths), one per process.
 inline std::string as_file(const std::uint8_t* data, std::size_t size, const std::string& extension) {
     static const std::string path = "/tmp/bvc3d-fuzz-" + std::to_string(::getpid()) + extension;
-    std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data),
-                                                                  static_cast<std::streamsize>(size));
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
     return path;
 }
 

@@ -25,7 +25,8 @@ def lzf_literal(data):
 
 def pcd(data_kind, points):
     head = (f"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
-            f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(points)}\nDATA {data_kind}\n").encode()
+            f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+            f"POINTS {len(points)}\nDATA {data_kind}\n").encode()
     if data_kind == "ascii":
         return head + "".join(f"{x} {y} {z} {i}\n" for x, y, z, i in points).encode()
     if data_kind == "binary":
@@ -41,21 +42,25 @@ PLY_CLOUD_ASCII = b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\np
 PLY_CLOUD_BINARY = b"ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\nproperty double y\n" \
                    b"property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" + \
                    struct.pack("<6d", 1, 2, 3, 4, 5, 6) + struct.pack("<B3i", 3, 0, 1, 1)
-CUBE_OBJ = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3/1 4/1\nvt 0 0\nvn 0 0 1\nf 1//1 2//1 5//1\nf -1 -2 -3\n"
+CUBE_OBJ = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3/1 4/1\nvt 0 0\nvn 0 0 1\n" \
+           b"f 1//1 2//1 5//1\nf -1 -2 -3\n"
 STL_BINARY = b"solid-looking binary header".ljust(80, b" ") + struct.pack("<I", 1) + \
              struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0)
 STL_ASCII = b"solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n" \
             b"  endloop\n endfacet\nendsolid t\n"
 PLY_MESH = b"ply\nformat ascii 1.0\ncomment a triangle\nelement vertex 3\nproperty float x\nproperty float y\n" \
-           b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+           b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" \
+           b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
 
 SEEDS = {
     "fuzz_world_yaml": {
         "cross.yaml": (SOURCE / "configs/worlds/cross-30.yaml").read_bytes(),
         "objects.yaml": b"name: w\nobjects:\n  - box: {center: [0, 0, 1], size: [1, 1, 2], yaw_deg: 30}\n"
                         b"  - quad: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]\n"
-                        b"  - tilted_wall: {center: [2, 0], length: 3, thickness: 0.2, height: 2, yaw_deg: 0, tilt_deg: 20}\n"
-                        b"walkable: {polygon: [[-5, -5], [5, -5], [5, 5], [-5, 5]]}\nstart: {points: [[-4, -4], [4, 4]]}\n",
+                        b"  - tilted_wall: {center: [2, 0], length: 3, thickness: 0.2, height: 2, yaw_deg: 0, "
+                        b"tilt_deg: 20}\n"
+                        b"walkable: {polygon: [[-5, -5], [5, -5], [5, 5], [-5, 5]]}\n"
+                        b"start: {points: [[-4, -4], [4, 4]]}\n",
         "arena-start.yaml": b"objects:\n  - cross_arena: {tilt_deg: 45, lean: -x+y, half_width: 6}\n"
                             b"  - box: {center: [3, 3, 0.5], size: [1, 1, 1], rotation_deg: [0, 10, 0]}\n"
                             b"start: {rect: [-5, -5, -3, -3]}\n",

@@ -61,7 +61,8 @@ def test_validation_script_reads_what_the_program_prints():
     the Python binding returns, to the 4 printed decimals."""
     import importlib.util
 
-    spec = importlib.util.spec_from_file_location("adaptive_validation", SOURCE_DIR / "scripts" / "adaptive_validation.py")
+    spec = importlib.util.spec_from_file_location("adaptive_validation",
+                                                  SOURCE_DIR / "scripts" / "adaptive_validation.py")
     av = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(av)
     sets = [(0.0, 0.2), (0.1,)]
@@ -226,7 +227,8 @@ def test_choice_on_a_recording_against_its_replay(cli, tmp_path):
         bvc3d.choose_elevations(recording=bvc3d.Recording.open(HALL, HALL / "poses.csv"), max_rnage=3.0)
 
     # A recording is its own walk: no world or agent beside it, and poses need scans.
-    for args, words in ((rec + ["--world", "cross"], "not both"), (["--poses", HALL / "poses.csv"], "--poses needs --scans")):
+    for args, words in ((rec + ["--world", "cross"], "not both"),
+                        (["--poses", HALL / "poses.csv"], "--poses needs --scans")):
         bad = tmp_path / "bad.yaml"
         r = cli("choose-elevations", *args, "--out", bad)
         assert r.returncode == 2 and words in r.stderr and not bad.exists()

@@ -238,7 +238,8 @@ def test_dbscan_random_points_match_sklearn(density):
         n = max(1, int(density * side * side * rng.uniform(0.5, 1.5)))
         pts = rng.uniform(-side / 2, side / 2, (n, 2))
         if trial % 3 == 0:  # clumps
-            pts = np.vstack([rng.normal(rng.uniform(-5, 5, 2), rng.uniform(0.2, 1.0), (n // 3 + 1, 2)) for _ in range(3)])
+            pts = np.vstack([rng.normal(rng.uniform(-5, 5, 2), rng.uniform(0.2, 1.0), (n // 3 + 1, 2))
+                             for _ in range(3)])
         eps = float(rng.choice([1.0, rng.uniform(0.2, 2.0)]))
         ms = int(rng.choice([20, 5, int(rng.integers(1, 40))]))
         assert A.dbscan_cluster_count(pts, eps, ms) == sklearn_count(pts, eps, ms), (density, trial, n, eps, ms)
@@ -315,7 +316,8 @@ def test_dbscan_small_sets_use_sklearns_brute_force_rule():
         a = float(rng.choice([1.0, 0.3, 0.7]))
         base = rng.uniform(-6, 6, 2)
         ij = rng.integers(-2, 3, (n, 2))
-        pts = np.column_stack([base[0] + a * (ij[:, 0] + 0.5 * (ij[:, 1] % 2)), base[1] + a * ij[:, 1] * math.sqrt(3) / 2])
+        pts = np.column_stack([base[0] + a * (ij[:, 0] + 0.5 * (ij[:, 1] % 2)),
+                               base[1] + a * ij[:, 1] * math.sqrt(3) / 2])
         sk = sklearn_neighborhoods(pts, a)
         assert our_neighborhoods(pts, a) == sk
         differs_from_plain += sk != plain_neighborhoods(pts, a)
@@ -447,12 +449,14 @@ def test_undecoded_samples_count_at_chance():
     _, _, n_ok, n_bad, med_all, mean_all = dense_decoder(x, y, rates)
     assert d["n_undecoded"] == n_bad == len(range(half, len(x), 3))
     assert d["frac_undecoded"] == pytest.approx(1 / 3, abs=0.01)
-    assert d["mean_all_m"] == pytest.approx(mean_all, abs=1e-9) and d["median_all_m"] == pytest.approx(med_all, abs=1e-9)
+    assert (d["mean_all_m"] == pytest.approx(mean_all, abs=1e-9)
+            and d["median_all_m"] == pytest.approx(med_all, abs=1e-9))
     assert d["mean_all_m"] > d["mean_m"] + 1.0  # chance in a 10 m arena is metres, decoding is decimetres
 
 
 def test_decoding_default_templates_are_the_spec_rate_maps():
-    """docs/model-reference.md#analysis: the templates are the thresholded, max-normalized rate maps of the first half."""
+    """docs/model-reference.md#analysis: the templates are the thresholded, max-normalized rate maps of the first
+    half."""
     x, y = walk(45, 1.0, 8)
     rates = place_population(x, y, 120, np.random.default_rng(8), sigma=0.7)  # peak rates 0.3-1: scaling matters
     d = A.decoding_error(x, y, rates)

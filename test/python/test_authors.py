@@ -217,7 +217,8 @@ def test_choices_one_at_a_time(tmp_path):
     out = tmp_path / "one"
     run_cli("paper", "--authors-choices", "reading,labels", "--hours", 0.02, "--tilts", "30", "--models", "2d,3d-0.1",
             "--no-report", "--jobs", 2, "--out", out, check=True)
-    assert sorted(p.name for p in out.glob("*.h5")) == ["cross-30_2d-8beam_seed0.h5", "cross-30_3d-0.1-authors_seed0.h5"]
+    assert sorted(p.name for p in out.glob("*.h5")) == ["cross-30_2d-8beam_seed0.h5",
+                                                        "cross-30_3d-0.1-authors_seed0.h5"]
     with h5py.File(out / "cross-30_3d-0.1-authors_seed0.h5") as f:
         assert f.attrs["protocol"] == "explore_then_sample" and "log_lag" not in f.attrs["config"]
     bad = run_cli("paper", "--authors-choices", "robot,colour", "--out", tmp_path / "bad")

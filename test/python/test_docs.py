@@ -126,7 +126,8 @@ def check_config(kind, data, tmp_path, where):
         problems += rounded_restatements(data, expanded("model", data.get("base", "3d-0.2")))
         if isinstance(data.get("sensor"), dict) and "preset" in data["sensor"]:
             problems += rounded_restatements({"sensor": data["sensor"]},
-                                             {f"sensor.{k}": v for k, v in expanded("sensor", data["sensor"]["preset"]).items()})
+                                             {f"sensor.{k}": v
+                                              for k, v in expanded("sensor", data["sensor"]["preset"]).items()})
     elif kind == "sensor" and "preset" in data:
         problems += rounded_restatements(data, expanded("sensor", data["preset"]))
     assert not problems, f"{where}: {problems}"
@@ -199,6 +200,7 @@ def test_documented_defaults_run_the_presets_bit_for_bit(tmp_path):
     (tmp_path / "model.yaml").write_text(model)
     run_cli("run", "--config", tmp_path / "trial.yaml", "--out", tmp_path / "from_docs.h5", check=True)
     run_cli("run", "--hours", "0.02", "--out", tmp_path / "builtin.h5", check=True)
-    run_cli("run", "--model", tmp_path / "model.yaml", "--hours", "0.02", "--out", tmp_path / "model_docs.h5", check=True)
+    run_cli("run", "--model", tmp_path / "model.yaml", "--hours", "0.02", "--out", tmp_path / "model_docs.h5",
+            check=True)
     for name in ("from_docs.h5", "model_docs.h5"):
         assert (tmp_path / name).read_bytes() == (tmp_path / "builtin.h5").read_bytes(), name

@@ -91,9 +91,11 @@ def test_figures_and_report(paper_dir):
 
 def test_report_module_works_on_its_own(paper_dir, tmp_path):
     env = dict(os.environ)
-    proc = subprocess.run(["/usr/bin/python3", "-m", "bvc3d.report", str(paper_dir)], capture_output=True, text=True, env=env)
+    proc = subprocess.run(["/usr/bin/python3", "-m", "bvc3d.report", str(paper_dir)], capture_output=True, text=True,
+                          env=env)
     assert proc.returncode == 0, proc.stderr
-    proc = subprocess.run(["/usr/bin/python3", "-m", "bvc3d.report", str(tmp_path)], capture_output=True, text=True, env=env)
+    proc = subprocess.run(["/usr/bin/python3", "-m", "bvc3d.report", str(tmp_path)], capture_output=True, text=True,
+                          env=env)
     assert proc.returncode != 0 and "no trials.csv" in proc.stderr
 
 

@@ -266,7 +266,8 @@ def test_flying_trial_reports_3d_metrics_and_errors_for_mismatches():
     assert {"frac_unimodal", "isotropy_median", "decode_vertical_median_m"} <= set(r["metrics"])
     assert len(r["z"]) == len(r["x"]) and np.ptp(r["z"]) > 0.5
     with pytest.raises(bvc3d.InputError, match="no flight volume"):
-        bvc3d.run_trial(model="fly-5l", world=str(SOURCE_DIR / "configs" / "worlds" / "two-rooms.yaml"), agent="flight", explore_hours=0.01, sample_hours=0.01)
+        bvc3d.run_trial(model="fly-5l", world=str(SOURCE_DIR / "configs" / "worlds" / "two-rooms.yaml"), agent="flight",
+                        explore_hours=0.01, sample_hours=0.01)
     with pytest.raises(bvc3d.InputError, match="preset for the ground robot"):
         bvc3d.run_trial(model="3d-0.2", world="flight-room", agent="flight", explore_hours=0.01, sample_hours=0.01)
     with pytest.raises(bvc3d.InputError, match="flight-only world"):

@@ -9,7 +9,8 @@ from conftest import run_cli
 
 
 def reference_raw(returns, elevations, n_dir, n_per_axis, max_dist, sr, st, sp):
-    """docs/model-reference.md#boundary-vector-cells written with numpy broadcasting over every return and every cell."""
+    """docs/model-reference.md#boundary-vector-cells written with numpy broadcasting over every return and every
+    cell."""
     g = lambda x, s: np.exp(-x ** 2 / (2 * s * s)) / math.sqrt(2 * math.pi * s * s)
     r, th, ph = returns[:, 0], returns[:, 1], returns[:, 2]
     theta = np.arange(n_dir) * 2 * math.pi / n_dir
@@ -24,7 +25,8 @@ def reference_raw(returns, elevations, n_dir, n_per_axis, max_dist, sr, st, sp):
 @pytest.mark.parametrize("elevations, n_per_axis", [([0.0, 0.2], 60), ([0.0, 0.1, 0.2], 40), ([], 120)])
 def test_layer_matches_numpy_reference(elevations, n_per_axis):
     rng = np.random.default_rng(0)
-    returns = np.column_stack([rng.uniform(0, 15, 500), rng.uniform(-math.pi, math.pi, 500), rng.uniform(-0.1, 0.4, 500)])
+    returns = np.column_stack([rng.uniform(0, 15, 500), rng.uniform(-math.pi, math.pi, 500),
+                               rng.uniform(-0.1, 0.4, 500)])
     layer = bvc3d.BoundaryVectorLayer(elevations=elevations, n_per_axis=n_per_axis)
     raw = reference_raw(returns, elevations, 8, n_per_axis, 12.0, 0.75, 0.1, 0.01)
     assert layer.n_cells == raw.size
@@ -101,7 +103,8 @@ def test_place_cell_network_api():
 
 def test_cli_bvc_table(tmp_path):
     out = tmp_path / "cells.csv"
-    proc = run_cli("bvc", "--model", "3d-0.2", "--world", "cross", "--tilt", 45, "--pose", "1,2,0", "--csv", out, check=True)
+    proc = run_cli("bvc", "--model", "3d-0.2", "--world", "cross", "--tilt", 45, "--pose", "1,2,0", "--csv", out,
+                   check=True)
     lines = proc.stdout.splitlines()
     assert "960 BVCs" in lines[0]
     assert len(lines) == 2 + 16  # header, column titles, 2 layers x 8 directions

@@ -185,7 +185,8 @@ def test_map_of_an_exported_recording_lies_on_the_walls(tmp_path):
 
     # The map as a world: a scan in it sees the arena's walls where the arena has them.
     world = tmp_path / "map.yaml"
-    world.write_text(f"objects:\n  - point_cloud: {{file: {out.name}, radius: 0.06}}\nwalkable: {{rect: [-4, -4, 4, 4]}}\n")
+    world.write_text(f"objects:\n  - point_cloud: {{file: {out.name}, radius: 0.06}}\n"
+                     f"walkable: {{rect: [-4, -4, 4, 4]}}\n")
     w = bvc3d.World.from_yaml(world)
     pose = dict(x=-4.2, y=-4.1, heading=0.4)
     got = w.scan("spherical", **pose)

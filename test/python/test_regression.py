@@ -4,8 +4,8 @@ recorded in test/data/paper-0.5h-digests.json and its additions (only `format_ve
 
 The digests of test/data/paper-0.5h-digests.json were taken again after issue 16's speed work, which
 moves the BVC sums by up to 4e-10 of a step's largest rate (docs/performance.md#results); before that,
-from the files of the code before the architecture refactor. A change that adds datasets or attributes without moving any (a new metric, a
-new analysis parameter recorded with the metrics) records the new ones in a file of their own,
+from the files of the code before the architecture refactor. A change that adds datasets or attributes without moving
+any (a new metric, a new analysis parameter recorded with the metrics) records the new ones in a file of their own,
 test/data/paper-0.5h-digests.<what>.json, so that the earlier digests stay as they were and still
 must match:
     PYTHONPATH=build/python /usr/bin/python3 test/python/test_regression.py --add WHAT RESULTS_DIR

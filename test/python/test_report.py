@@ -69,7 +69,8 @@ def test_pick_example_cell():
     maps[:2, 1] = maps[:4, 2] = maps[:1, 3] = 1
     assert report.pick_example_cell([0, 2, 2, 1], maps, "multimodal") == (2, "multimodal")
     assert report.pick_example_cell([0, 2, 2, 1], maps, "unimodal") == (3, "unimodal")
-    assert report.pick_example_cell([0, 1, 1, 0], maps, "multimodal") == (2, "no multimodal cell; showing a unimodal one")
+    assert (report.pick_example_cell([0, 1, 1, 0], maps, "multimodal")
+            == (2, "no multimodal cell; showing a unimodal one"))
     assert report.pick_example_cell([0, 0], maps[:, :2], "unimodal")[0] is None
 
 
@@ -100,7 +101,8 @@ def test_failed_report_hint_works_as_printed(tmp_path):
     assert done.returncode == 0, done.stderr
     assert (out / "report.md").exists() and (out / "figures" / "msai.png").exists()
     # The interpreter the program is told to use is the one it names.
-    env = dict(os.environ, BVC3D_PYTHON="/usr/bin/python3.11" if os.path.exists("/usr/bin/python3.11") else "/usr/bin/python3")
+    env = dict(os.environ,
+               BVC3D_PYTHON="/usr/bin/python3.11" if os.path.exists("/usr/bin/python3.11") else "/usr/bin/python3")
     (out / "report.md").unlink()
     (out / "figures" / "msai.png").unlink()
     (out / "figures").rename(out / "figures.old")
@@ -112,7 +114,8 @@ def test_failed_report_hint_works_as_printed(tmp_path):
 
 # ---- figures and report.md of a whole experiment folder ----
 
-ANALYSIS = {"gridsize": 50, "quantile": 0.1, "eps": 1.0, "min_samples": 20, "d_th": 2.0, "decoding_templates": "rate_maps"}
+ANALYSIS = {"gridsize": 50, "quantile": 0.1, "eps": 1.0, "min_samples": 20, "d_th": 2.0,
+            "decoding_templates": "rate_maps"}
 
 
 def metric_values(model, tilt, seed, n_seeds):
@@ -131,7 +134,8 @@ def metric_values(model, tilt, seed, n_seeds):
     }
 
 
-def make_experiment(path, models=("A", "B", "C"), tilts=(0, 30, 45, 60), seeds=(0, 1, 2), sample_hours=lambda t, s: 4.0):
+def make_experiment(path, models=("A", "B", "C"), tilts=(0, 30, 45, 60), seeds=(0, 1, 2),
+                    sample_hours=lambda t, s: 4.0):
     """An experiment folder as `bvc3d paper` writes it: trial files with the attributes and /metrics the
     report reads, trials.csv, summary.csv (mean and sd with numpy) and summary.md."""
     names = [m["name"] for m in bvc3d.metric_table if m["dims"] == 0]
@@ -162,7 +166,8 @@ def make_experiment(path, models=("A", "B", "C"), tilts=(0, 30, 45, 60), seeds=(
             w.writerow([name, f"{world}_{m}", m, world, tilt, seed, *[v[n] for n in names]])
     with open(path / "summary.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["condition", "model", "world", "tilt_deg", "n_seeds", *[f"{n}_{s}" for n in names for s in ("mean", "sd")]])
+        w.writerow(["condition", "model", "world", "tilt_deg", "n_seeds",
+                    *[f"{n}_{s}" for n in names for s in ("mean", "sd")]])
         for tilt in tilts:
             for m in models:
                 rows = [t[5] for t in trials if t[1] == m and t[3] == tilt]
@@ -365,7 +370,8 @@ def test_every_figure_names_what_it_shows_with_axis_units(three_seeds):
     assert "cross-0, seed 0" in fig.axes[0].get_title() and fig.axes[0].get_xlabel() == "x (m)"
     plt.close(fig)
     fig = report.environments_figure(folder)
-    assert [a.get_title().split("\n")[0] for a in fig.axes] == [f"cross-{t}: central walls tilted {t}°" for t in (0, 30, 45, 60)]
+    assert [a.get_title().split("\n")[0] for a in fig.axes] == [f"cross-{t}: central walls tilted {t}°"
+                                                                for t in (0, 30, 45, 60)]
     assert all(a.get_title().endswith("arena 10 × 10 × 2.5 m (x × y × z)") for a in fig.axes)
     plt.close(fig)
 

@@ -69,7 +69,8 @@ def test_world_from_yaml_and_errors(tmp_path, source_dir):
 
 def test_cli_scan_matches_python(cli, tmp_path):
     out = tmp_path / "scan.csv"
-    cli("scan", "--world", "cross", "--tilt", 45, "--sensor", "spherical", "--pose", "1.5,-2,0.7", "--out", out, check=True)
+    cli("scan", "--world", "cross", "--tilt", 45, "--sensor", "spherical", "--pose", "1.5,-2,0.7", "--out", out,
+        check=True)
     rows = np.loadtxt(out, delimiter=",", skiprows=1)
     expected = bvc3d.World.cross(45).scan("spherical", 1.5, -2.0, 0.7)
     np.testing.assert_array_equal(rows, expected)  # shortest round-trip text: exact
@@ -101,9 +102,11 @@ def test_cli_help_is_complete(cli):
 
 BAD_WORLDS = {
     "malformed.yaml": ("objects: [ {box: {center: [0,0,0]} \n", "", "malformed YAML"),
-    "unknown_key.yaml": ("objects:\n  - box: {center: [0,0,0], size: [1,1,1], colour: red}\nwalkable: {rect: [-4,-4,4,4]}\n",
+    "unknown_key.yaml": ("objects:\n  - box: {center: [0,0,0], size: [1,1,1], colour: red}\n"
+                         "walkable: {rect: [-4,-4,4,4]}\n",
                          "objects[0].box.colour", "unknown key"),
-    "wrong_type.yaml": ("objects:\n  - cross_arena: {tilt_deg: steep}\n", "objects[0].cross_arena.tilt_deg", "expected a number"),
+    "wrong_type.yaml": ("objects:\n  - cross_arena: {tilt_deg: steep}\n", "objects[0].cross_arena.tilt_deg",
+                        "expected a number"),
     "missing_mesh.yaml": ("objects:\n  - mesh: {file: nowhere.obj}\nwalkable: {rect: [-4,-4,4,4]}\n",
                           "objects[0].mesh.file", "does not exist"),
     "broken_mesh.yaml": ("objects:\n  - mesh: {file: broken.obj}\nwalkable: {rect: [-4,-4,4,4]}\n",

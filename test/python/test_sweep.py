@@ -123,7 +123,8 @@ def test_robot_settings_get_their_own_walks(tmp_path):
     steps = {}
     for p in (tmp_path / "out").glob("*.h5"):
         with h5py.File(p) as h:
-            x, y, bumped = h["samples/x"][:], h["samples/y"][:], h["samples/bumped"][:] if "bumped" in h["samples"] else None
+            x, y, bumped = (h["samples/x"][:], h["samples/y"][:],
+                            h["samples/bumped"][:] if "bumped" in h["samples"] else None)
             d = np.hypot(np.diff(x), np.diff(y))
             steps[p.name.split("_seed")[0].split("=")[-1]] = np.median(d)
     assert steps["0.5"] == pytest.approx(0.144, abs=1e-6)

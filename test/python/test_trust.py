@@ -88,7 +88,8 @@ def small_disk(tmp_path):
 
 def test_full_disk_during_an_experiment_is_named_and_resumes(small_disk, tmp_path):
     out = small_disk / "paper"
-    args = ["paper", "--hours", "0.02", "--models", "2d", "--tilts", "0,30,45", "--jobs", "1", "--no-report", "--out", out]
+    args = ["paper", "--hours", "0.02", "--models", "2d", "--tilts", "0,30,45", "--jobs", "1", "--no-report",
+            "--out", out]
     proc = run_cli(*args)
     assert proc.returncode == 2, proc.stderr
     line = one_error_line(proc.stderr)
@@ -109,7 +110,8 @@ def test_figures_that_cannot_be_written_leave_no_half_figure(tmp_path):
     out = tmp_path / "paper"
     run_cli("paper", "--hours", "0.02", "--models", "2d", "--tilts", "0", "--no-report", "--out", out, check=True)
     # Tables fit under the limit, figures do not.
-    proc = subprocess.run([CLI, "summarize", str(out)], capture_output=True, text=True, preexec_fn=with_file_limit(20_000))
+    proc = subprocess.run([CLI, "summarize", str(out)], capture_output=True, text=True,
+                          preexec_fn=with_file_limit(20_000))
     assert proc.returncode == 2, proc.stderr
     line = one_error_line(proc.stderr)
     assert "cannot write '" in line and ".png': File too large" in line
@@ -125,7 +127,8 @@ def test_figures_that_cannot_be_written_leave_no_half_figure(tmp_path):
 
 def test_a_second_process_on_the_same_folder_stops_and_a_killed_one_leaves_no_stuck_lock(tmp_path):
     out = tmp_path / "paper"
-    first = subprocess.Popen([CLI, "paper", "--hours", "1", "--models", "2d", "--tilts", "0", "--no-report", "--out", str(out)],
+    first = subprocess.Popen([CLI, "paper", "--hours", "1", "--models", "2d", "--tilts", "0", "--no-report",
+                              "--out", str(out)],
                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     try:
         lock = out / ".bvc3d.lock"
@@ -193,7 +196,8 @@ def test_a_broken_checkpoint_is_named_before_the_trial_restarts(tmp_path, damage
     proc = run_cli(*args)
     assert proc.returncode == 0, proc.stderr
     warning = [l for l in proc.stderr.splitlines() if l.startswith("bvc3d: warning:")]
-    assert len(warning) == 1 and f"checkpoint '{ckpt}'" in warning[0] and "starts again from the beginning" in warning[0]
+    assert (len(warning) == 1 and f"checkpoint '{ckpt}'" in warning[0]
+            and "starts again from the beginning" in warning[0])
     if damage == "missing segment":
         assert f"{ckpt}.seg0' is missing" in warning[0]
     reference = tmp_path / "ref.h5"
@@ -302,7 +306,8 @@ def test_summarize_refuses_or_skips_unreadable_files_and_refuses_mixtures(tmp_pa
 
 def test_extent_is_one_flag_with_the_same_values_everywhere(tmp_path):
     bounds = [-4.0, 4.0, -3.0, 3.0]
-    run_cli("run", "--hours", "0.02", "--model", "2d", "--extent", ",".join(map(str, bounds)), "--out", tmp_path / "b.h5",
+    run_cli("run", "--hours", "0.02", "--model", "2d", "--extent", ",".join(map(str, bounds)),
+            "--out", tmp_path / "b.h5",
             check=True)
     with h5py.File(tmp_path / "b.h5") as f:
         assert list(f["metrics/extent"][:]) == bounds and "extent: [-4, 4, -3, 3]" in f.attrs["config"]

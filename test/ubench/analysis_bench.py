@@ -4,8 +4,8 @@ numpy / scikit-learn computation of the same metric, and check that they agree.
     PYTHONPATH=build/python /usr/bin/python3 test/ubench/analysis_bench.py [--samples 50000]
         [--cells 250] [--repeats 3] [--seed 1] [--dense]
 
-Input: a random walk in the 45° cross arena (docs/model-reference.md#robot-and-random-walk) cut to --samples steps, and --cells sparse
-place-field-like rates (1-3 Gaussian fields per cell, sigma 0.6 m, values below 0.05 set to 0,
+Input: a random walk in the 45° cross arena (docs/model-reference.md#robot-and-random-walk) cut to --samples steps,
+and --cells sparse place-field-like rates (1-3 Gaussian fields per cell, sigma 0.6 m, values below 0.05 set to 0,
 10 % silent cells), float32 as a trial records them. Times are the median of --repeats runs
 (references slower than 5 s run once). --dense replaces the rates by uniform random ones, all
 non-zero: the worst case for the sparse code paths (every cell active in every bin).

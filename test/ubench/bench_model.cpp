@@ -3,9 +3,9 @@
 #include <benchmark/benchmark.h>
 
 #include "../support/bvc_reference.hpp"
-#include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/config/model_spec.hpp"
 
 using namespace bvc3d;
 
@@ -22,8 +22,7 @@ Inputs inputs(const std::string& preset) {
     const World world = World::cross({.tilt_deg = 45});
     const Lidar lidar(in.model.sensor);
     const auto walk = random_walk(world, 0.05, 1);
-    for (std::size_t i = 0; i < walk.size(); i += walk.size() / 16)
-        in.scans.push_back(lidar.scan(world, walk[i].pose));
+    for (std::size_t i = 0; i < walk.size(); i += walk.size() / 16) in.scans.push_back(lidar.scan(world, walk[i].pose));
     return in;
 }
 
@@ -161,7 +160,8 @@ void BM_FlyingFullScanOnly(benchmark::State& state) {
         lidar.scan(world, walk[i++ % walk.size()].pose, scan);
         benchmark::DoNotOptimize(scan.data());
     }
-    state.counters["rays/s"] = benchmark::Counter(16200.0 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["rays/s"] =
+        benchmark::Counter(16200.0 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 }  // namespace

@@ -77,7 +77,8 @@ PointCloud synthetic_scan(unsigned seed) {
 }
 
 Eigen::Matrix3d synthetic_tilt() {
-    return (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX())).toRotationMatrix();
+    return (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
+        .toRotationMatrix();
 }
 
 // One real scan (hall-lidar 0030) with its rotation, or a synthetic one.
@@ -113,7 +114,8 @@ void BM_BvcRealScan(benchmark::State& state, std::string preset) {
     const OneScan scan = one_scan();
     const ModelSpec model = config::resolve_model(preset);
     Scan returns;
-    returns_from_points(scan.cloud.xyz, scan.rotation, {}, selection_for(model.sensor, model.bvc.elevations.empty()), returns);
+    returns_from_points(scan.cloud.xyz, scan.rotation, {}, selection_for(model.sensor, model.bvc.elevations.empty()),
+                        returns);
     const BoundaryVectorLayer layer(model.bvc);
     std::vector<double> rates(layer.n_cells());
     for (auto _ : state) {
@@ -129,7 +131,8 @@ void BM_BvcRealScanDense(benchmark::State& state, std::string preset) {
     const OneScan scan = one_scan();
     const ModelSpec model = config::resolve_model(preset);
     Scan returns;
-    returns_from_points(scan.cloud.xyz, scan.rotation, {}, selection_for(model.sensor, model.bvc.elevations.empty()), returns);
+    returns_from_points(scan.cloud.xyz, scan.rotation, {}, selection_for(model.sensor, model.bvc.elevations.empty()),
+                        returns);
     for (auto _ : state) {
         const auto rates = reference::bvc_rates(model.bvc, returns);
         benchmark::DoNotOptimize(rates.data());

@@ -149,7 +149,8 @@ void BM_RandomModelStep(benchmark::State& state) {
     Rng rng(1, Stream::walk);
     RandomWalk walk(body, RobotParams{}, rng, RandomWalk::draw_start(world.description(), *body, rng));
     for (auto _ : state) benchmark::DoNotOptimize(walk.next(1e12));
-    state.counters["steps/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["steps/s"] =
+        benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 }  // namespace

@@ -19,13 +19,13 @@
 #define CALLGRIND_STOP_INSTRUMENTATION
 #endif
 
-#include <ctime>
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <span>
-#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -71,7 +71,9 @@ struct Clock {
 double us(double d) { return d; }
 
 template <class Net>
-concept HasStepBlock = requires(Net& n, std::span<const double> r, std::span<const char> l) { n.step_block(r, l); };
+concept HasStepBlock = requires(Net& n, std::span<const double> r, std::span<const char> l) {
+    n.step_block(r, l);
+};
 
 // `steps` place-cell steps of `net` on rates (steps × n_bvc), learning: in one block where the tree has
 // step_block, else one call per step. Returns every step's rates.
@@ -150,7 +152,8 @@ int main(int argc, char** argv) {
     if (argc > 4) {
         std::FILE* f = std::fopen(argv[4], "wb");
         if (!f || std::fwrite(all_bvc.data(), sizeof(double), all_bvc.size(), f) != all_bvc.size() ||
-            std::fwrite(all_place.data(), sizeof(float), all_place.size(), f) != all_place.size() || std::fclose(f) != 0) {
+            std::fwrite(all_place.data(), sizeof(float), all_place.size(), f) != all_place.size() ||
+            std::fclose(f) != 0) {
             std::fprintf(stderr, "model_steps: cannot write %s\n", argv[4]);
             return 1;
         }
@@ -158,8 +161,9 @@ int main(int argc, char** argv) {
     const double n = static_cast<double>(steps);
     Digest digest = bvc_digest;
     digest.add(&place_digest.h, sizeof place_digest.h);
-    std::printf("%s: %ld steps, %.0f returns/step; per step: scan %.2f us, BVC %.2f us, place cells %.2f us, "
-                "total %.2f us; digest %016llx\n",
-                preset.c_str(), steps, static_cast<double>(returns) / n, t_scan / n, t_bvc / n, t_place / n,
-                (t_scan + t_bvc + t_place) / n, static_cast<unsigned long long>(digest.h));
+    std::printf(
+        "%s: %ld steps, %.0f returns/step; per step: scan %.2f us, BVC %.2f us, place cells %.2f us, "
+        "total %.2f us; digest %016llx\n",
+        preset.c_str(), steps, static_cast<double>(returns) / n, t_scan / n, t_bvc / n, t_place / n,
+        (t_scan + t_bvc + t_place) / n, static_cast<unsigned long long>(digest.h));
 }

@@ -58,14 +58,14 @@ TEST(AnalysisHexbin, BinRuleRoundingTiesAndEdges) {
     const HexGrid g = unit_grid(4, 2);  // lattice 1: 5 × 3 centers, lattice 2 starts at 15
     EXPECT_EQ(g.bin_of(0.0, 0.0), 0);
     EXPECT_EQ(g.bin_of(2.0, 1.0), 2 * 3 + 1);
-    EXPECT_EQ(g.bin_of(0.5, 0.5), 15);      // a lattice-2 center
-    EXPECT_EQ(g.bin_of(0.25, 0.25), 15);    // d1 == d2: lattice 2 wins
-    EXPECT_EQ(g.bin_of(0.2, 0.25), 0);      // d1 < d2
-    EXPECT_EQ(g.bin_of(0.5, 0.0), 0);       // numpy.round(0.5) = 0 (half to even)
-    EXPECT_EQ(g.bin_of(1.5, 0.0), 2 * 3);   // round(1.5) = 2
-    EXPECT_EQ(g.bin_of(2.5, 0.0), 2 * 3);   // round(2.5) = 2
-    EXPECT_EQ(g.bin_of(-0.6, 0.0), -1);     // outside lattice 1
-    EXPECT_EQ(g.bin_of(-0.4, 0.5), -1);     // nearest is lattice 2's column -1: dropped, not lattice 1
+    EXPECT_EQ(g.bin_of(0.5, 0.5), 15);     // a lattice-2 center
+    EXPECT_EQ(g.bin_of(0.25, 0.25), 15);   // d1 == d2: lattice 2 wins
+    EXPECT_EQ(g.bin_of(0.2, 0.25), 0);     // d1 < d2
+    EXPECT_EQ(g.bin_of(0.5, 0.0), 0);      // numpy.round(0.5) = 0 (half to even)
+    EXPECT_EQ(g.bin_of(1.5, 0.0), 2 * 3);  // round(1.5) = 2
+    EXPECT_EQ(g.bin_of(2.5, 0.0), 2 * 3);  // round(2.5) = 2
+    EXPECT_EQ(g.bin_of(-0.6, 0.0), -1);    // outside lattice 1
+    EXPECT_EQ(g.bin_of(-0.4, 0.5), -1);    // nearest is lattice 2's column -1: dropped, not lattice 1
     EXPECT_EQ(g.bin_of(3.5, 1.5), 15 + 3 * 2 + 1);
     EXPECT_EQ(g.bin_of(4.1, 1.9), 4 * 3 + 2);  // lattice-1 corner (4, 2)
     EXPECT_EQ(g.bin_of(4.4, 1.6), -1);         // nearest is lattice 2's column 4, which does not exist
@@ -193,7 +193,8 @@ TEST(AnalysisAliasing, MatchesDoubleLoop) {
         for (int j = 0; j < n; ++j) {
             const double dx = c(i, 0) - c(j, 0), dy = c(i, 1) - c(j, 1);
             const double ni = m.row(i).norm(), nj = m.row(j).norm();
-            if (j != i && std::sqrt(dx * dx + dy * dy) > 2.0 && ni > 0 && nj > 0) s += m.row(i).dot(m.row(j)) / (ni * nj);
+            if (j != i && std::sqrt(dx * dx + dy * dy) > 2.0 && ni > 0 && nj > 0)
+                s += m.row(i).dot(m.row(j)) / (ni * nj);
         }
         EXPECT_NEAR(res.sai(i), s / n, 1e-12);
         total += s / n;
@@ -217,7 +218,8 @@ TEST(AnalysisDecoding, GaussianPlaceFieldsDecodeWell) {
         x[static_cast<std::size_t>(i)] = u(rng), y[static_cast<std::size_t>(i)] = u(rng);
         for (int k = 0; k < cells; ++k) {
             const double cx = -4.5 + k % 10, cy = -4.5 + k / 10;
-            const double d2 = std::pow(x[static_cast<std::size_t>(i)] - cx, 2) + std::pow(y[static_cast<std::size_t>(i)] - cy, 2);
+            const double d2 =
+                std::pow(x[static_cast<std::size_t>(i)] - cx, 2) + std::pow(y[static_cast<std::size_t>(i)] - cy, 2);
             const double v = std::exp(-d2 / (2 * 0.8 * 0.8));
             rates(i, k) = v < 0.05 ? 0.f : static_cast<float>(v);
         }
@@ -286,7 +288,8 @@ TEST(AnalysisTrial, AllMetricsOfOneTrial) {
     for (int i = 0; i < n; ++i) {
         x[static_cast<std::size_t>(i)] = u(rng), y[static_cast<std::size_t>(i)] = u(rng);
         for (int k = 0; k < cells; ++k)
-            if (std::abs(x[static_cast<std::size_t>(i)] - (k % 5) * 2 + 4) < 0.8 && std::abs(y[static_cast<std::size_t>(i)] - (k / 5) * 2 + 3) < 0.8)
+            if (std::abs(x[static_cast<std::size_t>(i)] - (k % 5) * 2 + 4) < 0.8 &&
+                std::abs(y[static_cast<std::size_t>(i)] - (k / 5) * 2 + 3) < 0.8)
                 rates(i, k) = 1.f;
     }
     const TrialMetrics m = analyze_trial<float>(x, y, rates);
@@ -350,5 +353,6 @@ TEST(AnalysisInput, BadInputThrows) {
     EXPECT_THROW(decoding_error<double>(x, x, r, {50, 1.5, {}, DecodingTemplates::rate_maps}), InputError);
     EXPECT_THROW(parse_decoding_templates("maps"), InputError);
     EXPECT_EQ(parse_decoding_templates("means"), DecodingTemplates::means);
-    EXPECT_EQ(parse_decoding_templates(decoding_templates_name(DecodingTemplates::rate_maps)), DecodingTemplates::rate_maps);
+    EXPECT_EQ(parse_decoding_templates(decoding_templates_name(DecodingTemplates::rate_maps)),
+              DecodingTemplates::rate_maps);
 }

@@ -7,17 +7,18 @@
 #include <random>
 
 #include "../support/bvc_reference.hpp"
-#include "bvc3d/core/angles.hpp"
-#include "bvc3d/core/error.hpp"
-#include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/bvc/bvc_kernels.hpp"
+#include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/error.hpp"
 
 using namespace bvc3d;
 
 namespace {
 
-// |fast - reference| <= 1e-6 of the step's largest reference rate, for every cell (docs/model-reference.md#boundary-vector-cells).
+// |fast - reference| <= 1e-6 of the step's largest reference rate, for every cell
+// (docs/model-reference.md#boundary-vector-cells).
 void expect_matches_reference(const BvcParams& p, const Scan& returns, const std::string& what) {
     const BoundaryVectorLayer layer(p);
     std::vector<double> fast(layer.n_cells());
@@ -114,7 +115,8 @@ TEST(BvcKernels, ReturnReadingsAreTheScalarFormulasOnEveryInstructionSet) {
     Scan returns;
     for (int i = 0; i < 1000; ++i) returns.push_back({range(gen), az(gen), el(gen)});
     // Azimuths a turn out, many turns out, on the boundaries; ranges on window edges, far, absent.
-    for (double a : {M_PI, -M_PI, 2 * M_PI, -2 * M_PI, 3 * M_PI, -3 * M_PI, 2.9 * M_PI, -2.9 * M_PI, 1e6, -1e9, 0.0, -0.0})
+    for (double a :
+         {M_PI, -M_PI, 2 * M_PI, -2 * M_PI, 3 * M_PI, -3 * M_PI, 2.9 * M_PI, -2.9 * M_PI, 1e6, -1e9, 0.0, -0.0})
         returns.push_back({3.0, a, 0.1});
     for (int i = 0; i < 40; ++i) returns.push_back({range(gen), turns(gen), el(gen)});
     for (double r : {0.0, 0.75, 12.0, 12.0 + 4.5, 1e3, 1e300, static_cast<double>(NAN), static_cast<double>(INFINITY)})
@@ -135,7 +137,8 @@ TEST(BvcKernels, ReturnReadingsAreTheScalarFormulasOnEveryInstructionSet) {
                                                   std::to_string(cells) + ", return " + std::to_string(j + k);
                         ASSERT_EQ(in.absent[k] != 0, e.absent) << where;
                         if (e.absent) continue;
-                        EXPECT_EQ(std::bit_cast<std::uint64_t>(in.azimuth[k]), std::bit_cast<std::uint64_t>(e.azimuth)) << where;
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(in.azimuth[k]), std::bit_cast<std::uint64_t>(e.azimuth))
+                            << where;
                         EXPECT_EQ(in.slot[k], e.slot) << where;
                         EXPECT_EQ(in.width[k], e.width) << where;
                         if (e.width == 0) continue;
@@ -148,9 +151,9 @@ TEST(BvcKernels, ReturnReadingsAreTheScalarFormulasOnEveryInstructionSet) {
     }
     // The first invalid return of a batch is found, wherever it is and whatever comes before it.
     const kernels::ReturnRule rule{4.5, 0.2, 5.0, 61, true, 360 / (2 * M_PI), 360};
-    for (const LidarReturn bad : {LidarReturn{-1.0, 0.0, 0.0}, LidarReturn{-INFINITY, 0.0, 0.0},
-                                  LidarReturn{1.0, NAN, 0.0}, LidarReturn{1.0, INFINITY, 0.0},
-                                  LidarReturn{1.0, 0.0, NAN}, LidarReturn{1.0, 0.0, -INFINITY}}) {
+    for (const LidarReturn bad :
+         {LidarReturn{-1.0, 0.0, 0.0}, LidarReturn{-INFINITY, 0.0, 0.0}, LidarReturn{1.0, NAN, 0.0},
+          LidarReturn{1.0, INFINITY, 0.0}, LidarReturn{1.0, 0.0, NAN}, LidarReturn{1.0, 0.0, -INFINITY}}) {
         for (const std::size_t at : {0, 5, 8, 37, 63}) {
             Scan batch(returns.begin(), returns.begin() + 64);
             batch[at] = bad;
@@ -263,7 +266,8 @@ TEST(BoundaryVectorLayer, SharedSumsGiveEveryModelItsOwnBits) {
     const auto walk = random_walk(world, 0.02, 11);
     const ModelSpec base = model_preset("3d-3l");
     std::vector<BvcParams> models;
-    for (const std::vector<double>& e : std::vector<std::vector<double>>{{0.0, 0.1}, {0.0, 0.2}, {0.0, 0.1, 0.2}, {0.3}, {0.25, 0.0}}) {
+    for (const std::vector<double>& e :
+         std::vector<std::vector<double>>{{0.0, 0.1}, {0.0, 0.2}, {0.0, 0.1, 0.2}, {0.3}, {0.25, 0.0}}) {
         BvcParams p = base.bvc;
         p.elevations = e;
         models.push_back(p);
@@ -317,11 +321,13 @@ TEST(BoundaryVectorLayer, SharedSumsGiveEveryModelItsOwnBits) {
     EXPECT_FALSE(flat_reader.can_share_sums(all));
     BvcParams wider = models[0];
     wider.sigma_r = 0.5;
-    EXPECT_THROW(BoundaryVectorLayer(wider).rates_pruned_shared(scan, BoundaryVectorLayer(wider).plan(base.sensor), summed, v),
-                 InputError);
+    EXPECT_THROW(
+        BoundaryVectorLayer(wider).rates_pruned_shared(scan, BoundaryVectorLayer(wider).plan(base.sensor), summed, v),
+        InputError);
     BvcParams missing = models[0];
     missing.elevations = {0.15};
-    EXPECT_THROW(BoundaryVectorLayer(missing).rates_pruned_shared(scan, BoundaryVectorLayer(missing).plan(base.sensor), summed, v),
+    EXPECT_THROW(BoundaryVectorLayer(missing).rates_pruned_shared(scan, BoundaryVectorLayer(missing).plan(base.sensor),
+                                                                  summed, v),
                  InputError);
 }
 
@@ -357,8 +363,8 @@ TEST(BoundaryVectorLayer, CellOrderAndPreferredValues) {
     layer.rates(Scan{{6.1, 0.0, 0.2}}, v);
     const auto peak = std::max_element(v.begin(), v.end()) - v.begin();
     const int M = p.n_per_axis, K = p.n_dir;
-    EXPECT_EQ(peak / (K * M), 1);        // layer index of psi = 0.2
-    EXPECT_EQ((peak / M) % K, 0);        // direction east
+    EXPECT_EQ(peak / (K * M), 1);  // layer index of psi = 0.2
+    EXPECT_EQ((peak / M) % K, 0);  // direction east
     EXPECT_NEAR((peak % M) * p.spacing(), 6.1, p.spacing() / 2);
     // A return to the north-west lands in direction 3 (135°).
     layer.rates(Scan{{3.0, 3 * M_PI / 4, 0.0}}, v);

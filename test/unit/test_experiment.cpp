@@ -5,11 +5,11 @@
 #include <fstream>
 #include <iterator>
 
+#include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/experiment.hpp"
-#include "bvc3d/experiment/trial_runner.hpp"
-#include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
+#include "bvc3d/experiment/trial_runner.hpp"
 #include "bvc3d/recorder/trial_file.hpp"
 
 using namespace bvc3d;

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <set>
 #include <tuple>
 
@@ -73,7 +73,8 @@ TEST_P(FlightWorlds, EightHoursNeverOverlapNorLeaveTheVolume) {
         const Pose& q = steps[i].pose;
         check(q.position());
         // Along the straight path from the previous step (same direction, no turn in between).
-        if (i > 0 && !steps[i - 1].bumped && steps[i - 1].pose.heading == q.heading && steps[i - 1].pose.pitch == q.pitch) {
+        if (i > 0 && !steps[i - 1].bumped && steps[i - 1].pose.heading == q.heading &&
+            steps[i - 1].pose.pitch == q.pitch) {
             ++segments;
             const Vec3 a = steps[i - 1].pose.position();
             for (int k = 1; k < 12; ++k) check(a + (k / 12.0) * (q.position() - a));
@@ -98,7 +99,8 @@ TEST_P(FlightWorlds, ADefaultTrialsFlightVisitsEveryReachableHalfMetreVoxel) {
     const auto box = w.flight->bounds();
     std::set<std::tuple<int, int, int>> visited;
     auto voxel = [&](const Vec3& p, int d) { return static_cast<int>(std::floor((p[d] - box.min()[d]) / 0.5)); };
-    for (const auto& s : steps) visited.insert({voxel(s.pose.position(), 0), voxel(s.pose.position(), 1), voxel(s.pose.position(), 2)});
+    for (const auto& s : steps)
+        visited.insert({voxel(s.pose.position(), 0), voxel(s.pose.position(), 1), voxel(s.pose.position(), 2)});
     // A voxel is reachable if the body's center fits with 2 cm to spare at a quarter or more of a
     // 6 × 6 × 6 lattice of points in it (slivers beside a pillar or under a leaning wall are visited
     // only by grazing contacts), inside the volume and outside the pillars (solid boxes the oracle
@@ -109,7 +111,8 @@ TEST_P(FlightWorlds, ADefaultTrialsFlightVisitsEveryReachableHalfMetreVoxel) {
             if (std::abs(p.x() - c.x()) < 0.3 && std::abs(p.y() - c.y()) < 0.3) return true;
         return false;
     };
-    const int nx = static_cast<int>(std::ceil(box.sizes().x() / 0.5)), ny = static_cast<int>(std::ceil(box.sizes().y() / 0.5)),
+    const int nx = static_cast<int>(std::ceil(box.sizes().x() / 0.5)),
+              ny = static_cast<int>(std::ceil(box.sizes().y() / 0.5)),
               nz = static_cast<int>(std::ceil(box.sizes().z() / 0.5));
     int reachable = 0, missed = 0;
     for (int i = 0; i < nx; ++i)
@@ -225,7 +228,8 @@ TEST(FlyingWalk, TurnsFollowTheirDistributions) {
         if (!steps[i].bumped && steps[i + 1].pose.heading != steps[i].pose.heading)
             yaw_turns.push_back(wrap_pi(steps[i + 1].pose.heading - steps[i].pose.heading));
     ASSERT_GT(yaw_turns.size(), 5000u);
-    EXPECT_LT(ks_statistic(yaw_turns, [](double x) { return normal_cdf(x, pi / 6); }), ks_critical_1pct(yaw_turns.size()));
+    EXPECT_LT(ks_statistic(yaw_turns, [](double x) { return normal_cdf(x, pi / 6); }),
+              ks_critical_1pct(yaw_turns.size()));
     // Pitch turns as drawn (the realized ones are clipped to ±π/3): N(0, (π/12)²).
     for (const auto& e : log)
         if (e.kind == FlightTurn::Kind::gaussian) pitch_draws.push_back(e.pitch);
@@ -296,7 +300,7 @@ TEST(FlyingWalk, LevelHeadByDefaultAndStartsAnywhereInTheVolume) {
     EXPECT_LT(lo, 2.0);
     EXPECT_GT(hi, 3.5);
     const SphereCollider body(world.description(), R);
-    EXPECT_TRUE(body.is_free(Vec3(-1.5, 1.0, 1.0)));  // inside the pillar, far from its faces ...
+    EXPECT_TRUE(body.is_free(Vec3(-1.5, 1.0, 1.0)));        // inside the pillar, far from its faces ...
     EXPECT_FALSE(body.can_start_at(Vec3(-1.5, 1.0, 1.0)));  // ... but closed off
     EXPECT_TRUE(body.can_start_at(Vec3(0, 0, 1.0)));
 }
@@ -358,20 +362,21 @@ TEST(FlightErrors, BadFlightVolumesSayWhatIsWrong) {
     EXPECT_NE(outside.find("w.yaml"), std::string::npos) << outside;
     EXPECT_NE(outside.find("flight_volume"), std::string::npos) << outside;
     EXPECT_NE(outside.find("outside the world"), std::string::npos) << outside;
-    EXPECT_NE(world_yaml_error("{rect: [-1, -1, 1, 1], z_min: 0.5, z_max: 3}").find("outside the world"), std::string::npos);
+    EXPECT_NE(world_yaml_error("{rect: [-1, -1, 1, 1], z_min: 0.5, z_max: 3}").find("outside the world"),
+              std::string::npos);
     EXPECT_NE(world_yaml_error("{z_min: 0.5, z_max: 1.5}").find("'rect' or 'polygon'"), std::string::npos);
     WorldDescription small = config::world_from_yaml(config::YamlView::load_string(
         "name: w\nobjects:\n  - box: {center: [0, 0, 1], size: [4, 4, 2]}\nflight_volume: {rect: [-1, -1, 1, 1], "
-        "z_min: 0.5, z_max: 0.8}\n", "w.yaml"));
+        "z_min: 0.5, z_max: 0.8}\n",
+        "w.yaml"));
     const auto too_small = error_of([&] { flying_walk(World(small), 0.1, 0); });
     EXPECT_NE(too_small.find("smaller than the body"), std::string::npos) << too_small;
 }
 
 TEST(FlightErrors, AgentsAndPresetsOfTheOtherKind) {
     // A ground world with a flying agent, a flight-only world with the ground robot.
-    const auto ground = error_of([] {
-        flying_walk(World(config::load_world_file(BVC3D_SOURCE_DIR "/configs/worlds/two-rooms.yaml")), 0.1, 0);
-    });
+    const auto ground = error_of(
+        [] { flying_walk(World(config::load_world_file(BVC3D_SOURCE_DIR "/configs/worlds/two-rooms.yaml")), 0.1, 0); });
     EXPECT_NE(ground.find("no flight volume"), std::string::npos) << ground;
     const auto flight_only = error_of([] { random_walk(World(flight_room()), 0.1, 0); });
     EXPECT_NE(flight_only.find("flight-only world"), std::string::npos) << flight_only;
@@ -394,7 +399,8 @@ TEST(FlightWorldsYaml, PresetsEqualTheirFiles) {
         const WorldDescription file = config::load_world_file(BVC3D_SOURCE_DIR "/configs/worlds/" + name + ".yaml");
         ASSERT_EQ(preset.mesh.size(), file.mesh.size()) << name;
         for (std::size_t t = 0; t < preset.mesh.size(); ++t)
-            for (int k = 0; k < 3; ++k) ASSERT_EQ(preset.mesh.corners(t)[k], file.mesh.corners(t)[k]) << name << " " << t;
+            for (int k = 0; k < 3; ++k)
+                ASSERT_EQ(preset.mesh.corners(t)[k], file.mesh.corners(t)[k]) << name << " " << t;
         ASSERT_TRUE(preset.flight && file.flight);
         EXPECT_EQ(preset.flight->bounds().min(), file.flight->bounds().min());
         EXPECT_EQ(preset.flight->bounds().max(), file.flight->bounds().max());

@@ -1,4 +1,5 @@
-// Beam layout of the scanners (docs/model-reference.md#sensors) and the allocentric return convention (docs/model-reference.md#conventions).
+// Beam layout of the scanners (docs/model-reference.md#sensors) and the allocentric return convention
+// (docs/model-reference.md#conventions).
 #include <gtest/gtest.h>
 
 #include <cmath>

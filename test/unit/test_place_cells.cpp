@@ -140,7 +140,8 @@ TEST(PlaceCellNetwork, DriveIsTheFixedOrderSumBitForBit) {
             float lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
             for (int j = 0; j < n_bvc; ++j)
                 lane[j % 8] += w[static_cast<std::size_t>(i) * n_bvc + j] * static_cast<float>(vb[j]);
-            const float drive = ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
+            const float drive =
+                ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
             const float s = 0.0f + k * (-0.0f + drive - 0.0f);
             ASSERT_EQ(net.membrane()[i], s) << n_place << " cells, row " << i;
         }
@@ -231,17 +232,20 @@ TEST(PlaceCellNetwork, StepBlockIsStepAfterStep) {
             for (int t = 0; t < steps; ++t) {
                 const double center = u(gen) * n_bvc;  // a bump of BVC activity: some cells fire and learn
                 for (int j = 0; j < n_bvc; ++j)
-                    rates[static_cast<std::size_t>(t) * n_bvc + j] = 0.5 * std::exp(-0.5 * (j - center) * (j - center) / 400.0);
+                    rates[static_cast<std::size_t>(t) * n_bvc + j] =
+                        0.5 * std::exp(-0.5 * (j - center) * (j - center) / 400.0);
                 learn[static_cast<std::size_t>(t)] = u(gen) < 0.8;
                 learned_steps += learn[static_cast<std::size_t>(t)] != 0;
             }
             const auto block = blocked.step_block(rates, learn);
             ASSERT_EQ(block.size(), static_cast<std::size_t>(steps) * n_place);
             for (int t = 0; t < steps; ++t) {
-                const auto v = stepped.step(std::span<const double>(rates.data() + static_cast<std::size_t>(t) * n_bvc, n_bvc),
-                                            learn[static_cast<std::size_t>(t)] != 0);
+                const auto v =
+                    stepped.step(std::span<const double>(rates.data() + static_cast<std::size_t>(t) * n_bvc, n_bvc),
+                                 learn[static_cast<std::size_t>(t)] != 0);
                 for (int i = 0; i < n_place; ++i) {
-                    ASSERT_EQ(block[static_cast<std::size_t>(t) * n_place + i], v[i]) << n_place << " cells, step " << t;
+                    ASSERT_EQ(block[static_cast<std::size_t>(t) * n_place + i], v[i])
+                        << n_place << " cells, step " << t;
                     active += v[i] > 0;
                 }
             }

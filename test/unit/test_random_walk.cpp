@@ -1,4 +1,5 @@
-// The robot's random walk (docs/model-reference.md#robot-and-random-walk): stays in the arena, never overlaps a wall, turns as specified,
+// The robot's random walk (docs/model-reference.md#robot-and-random-walk): stays in the arena, never overlaps a wall,
+// turns as specified,
 // covers the floor, and is deterministic by seed.
 #include <gtest/gtest.h>
 
@@ -7,9 +8,9 @@
 #include <set>
 
 #include "../support/ks_test.hpp"
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/agent/random_walk.hpp"
 
 using namespace bvc3d;
 
@@ -56,8 +57,9 @@ TEST_P(PaperWorldWalk, TwentyFourHoursNeverLeaveNorOverlap) {
         if (i > 0 && steps[i - 1].pose.heading == s.pose.heading)
             for (int k = 1; k < 15; ++k) {
                 const double f = k / 15.0;
-                worst = std::min(worst, oracle_clearance(steps[i - 1].pose.x + f * (s.pose.x - steps[i - 1].pose.x),
-                                                         steps[i - 1].pose.y + f * (s.pose.y - steps[i - 1].pose.y), tilt));
+                worst =
+                    std::min(worst, oracle_clearance(steps[i - 1].pose.x + f * (s.pose.x - steps[i - 1].pose.x),
+                                                     steps[i - 1].pose.y + f * (s.pose.y - steps[i - 1].pose.y), tilt));
             }
     }
     EXPECT_GE(worst, -1e-3) << "the body overlapped a wall by " << -worst << " m";
@@ -73,7 +75,8 @@ TEST_P(PaperWorldWalk, FourHoursCoverEveryReachableHalfMetreCell) {
     EXPECT_GT(steps.size(), 30000u);
     EXPECT_LT(steps.size(), 50000u);
     std::set<std::pair<int, int>> visited;
-    for (const auto& s : steps) visited.insert({static_cast<int>(std::floor(s.pose.x / 0.5)), static_cast<int>(std::floor(s.pose.y / 0.5))});
+    for (const auto& s : steps)
+        visited.insert({static_cast<int>(std::floor(s.pose.x / 0.5)), static_cast<int>(std::floor(s.pose.y / 0.5))});
     // A cell is reachable if the body fits somewhere in it with 2 cm to spare (a sliver thinner than
     // that is visited only by grazing contacts, which a finite walk need not make).
     int reachable = 0;
@@ -395,7 +398,7 @@ TEST(RandomWalk, LogLagLogsWhereTheRobotIsLater) {
         still += shift == 0;
     }
     EXPECT_GT(exact, checked * 99 / 100);
-    EXPECT_GT(moved, checked / 2);  // most steps are followed by straight driving: 0.192 s × 0.5 m/s
+    EXPECT_GT(moved, checked / 2);   // most steps are followed by straight driving: 0.192 s × 0.5 m/s
     EXPECT_GT(still, checked / 50);  // turns longer than the lag
     EXPECT_FALSE(plain[0].logged_pose.has_value());
 }
@@ -424,7 +427,8 @@ TEST(BodyCollider, SpheresAreTheirDiscsInTheBodySlab) {
     cloud.name = "cloud";
     cloud.spheres.push_back({});
     cloud.spheres[0].radius = 0.08;
-    for (int i = 0; i < 60; ++i) cloud.spheres[0].centers.emplace_back(-2 + 4 * uniform(), -2 + 4 * uniform(), -0.1 + 0.35 * uniform());
+    for (int i = 0; i < 60; ++i)
+        cloud.spheres[0].centers.emplace_back(-2 + 4 * uniform(), -2 + 4 * uniform(), -0.1 + 0.35 * uniform());
     cloud.walkable = Polygon2::rectangle(-5, -5, 5, 5);
     const double H = 0.1;
     const BodyCollider cb(cloud, R, H);

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/temp_dir.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recording/extrinsics.hpp"
 #include "bvc3d/recording/kitti_bin.hpp"
@@ -32,7 +33,6 @@
 #include "bvc3d/recording/pose_file.hpp"
 #include "bvc3d/recording/scan_file.hpp"
 #include "bvc3d/recording/scan_list.hpp"
-#include "../support/temp_dir.hpp"
 
 using namespace bvc3d;
 using namespace bvc3d::recording;
@@ -230,7 +230,8 @@ TEST(RecordingWriters, FailedWriteLeavesNoFileAndNamesTheReason) {
     write_pcd(dir / "missing" / "a.pcd", cloud, PcdEncoding::binary, PcdPrecision::f8);
     EXPECT_EQ(read_pcd(dir / "missing" / "a.pcd").xyz, cloud.xyz);
     fs::create_directories(dir / "folder.pcd");
-    expect_input_error([&] { write_pcd(dir / "folder.pcd", cloud); }, (dir / "folder.pcd").string(), {"is a folder, not a file"});
+    expect_input_error([&] { write_pcd(dir / "folder.pcd", cloud); }, (dir / "folder.pcd").string(),
+                       {"is a folder, not a file"});
     write_kitti_bin(dir / "file.bin", cloud);
     expect_input_error([&] { write_ply(dir / "file.bin" / "a.ply", cloud); }, (dir / "file.bin").string(),
                        {"is not a folder"});

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <random>
 
+#include "../support/temp_dir.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/analysis/localization.hpp"
 #include "bvc3d/config/model_spec.hpp"
@@ -19,7 +20,6 @@
 #include "bvc3d/recording/recording.hpp"
 #include "bvc3d/recording/voxel_map.hpp"
 #include "bvc3d/sensor/recorded_returns.hpp"
-#include "../support/temp_dir.hpp"
 
 using namespace bvc3d;
 namespace fs = std::filesystem;
@@ -196,7 +196,8 @@ TEST(Replay, TiltedSensorsAreGravityAligned) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> angle(-0.6, 0.6);
     for (int i = 0; i < 6; ++i)
-        steps.push_back({static_cast<double>(i), Pose{-4.2 + 0.1 * i, -4.3, 0.4, angle(rng), angle(rng), angle(rng)}, false, std::nullopt});
+        steps.push_back({static_cast<double>(i), Pose{-4.2 + 0.1 * i, -4.3, 0.4, angle(rng), angle(rng), angle(rng)},
+                         false, std::nullopt});
     TempDir dir;
     const auto rec = export_walk(world, steps, sensor, dir / "tilted", recording::ScanWriteFormat::pcd_f8);
     RecordedReturnParams p;
@@ -205,7 +206,8 @@ TEST(Replay, TiltedSensorsAreGravityAligned) {
     int ceiling_hits = 0;
     for (std::size_t i = 0; i < steps.size(); ++i) {
         Scan replayed;
-        returns_from_points(rec->load(i).xyz, rec->poses[i].world_from_sensor.linear(), p, ReturnSelection::all, replayed);
+        returns_from_points(rec->load(i).xyz, rec->poses[i].world_from_sensor.linear(), p, ReturnSelection::all,
+                            replayed);
         const Scan simulated = lidar.scan(world, steps[i].pose);
         ASSERT_EQ(replayed.size(), simulated.size());
         const double sensor_z = rec->poses[i].world_from_sensor.translation().z();
@@ -333,7 +335,7 @@ TEST(VoxelMap, MeansPerVoxelInTheWorldFrame) {
     scan.xyz = {1.01, 0.02, 0.03,  // -> (9.98, 1.01, 0.03): voxel (99, 10, 0)
                 1.03, 0.04, 0.05,  // -> (9.96, 1.03, 0.05): same voxel
                 2.00, 0.05, 0.05,  // -> (9.95, 2.00, 0.05): voxel (99, 20, 0)
-                0.1, 0.1, 0.1};    // nearer than min_range: left out
+                0.1,  0.1,  0.1};  // nearer than min_range: left out
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = Eigen::AngleAxisd(pi / 2, Vec3::UnitZ()).toRotationMatrix();
     pose.translation() = Vec3(10, 0, 0);

@@ -44,8 +44,9 @@ TEST(Seams, PoseRotationRoundTripsAndFollowsItsConvention) {
     const Pose p{1, 2, 3, 0.7, -0.4, 0.25};
     const Eigen::Matrix3d R = p.rotation();
     // The forward axis is (cos p cos h, cos p sin h, sin p): pitch is nose up.
-    EXPECT_NEAR((R.col(0) - Vec3(std::cos(-0.4) * std::cos(0.7), std::cos(-0.4) * std::sin(0.7), std::sin(-0.4))).norm(),
-                0.0, 1e-15);
+    EXPECT_NEAR(
+        (R.col(0) - Vec3(std::cos(-0.4) * std::cos(0.7), std::cos(-0.4) * std::sin(0.7), std::sin(-0.4))).norm(), 0.0,
+        1e-15);
     EXPECT_NEAR(R.determinant(), 1.0, 1e-15);
     const Pose q = Pose::from_rotation(p.position(), R);
     EXPECT_NEAR(q.heading, p.heading, 1e-14);
@@ -123,7 +124,8 @@ TEST(Seams, TrajectoryFromArraysIsFollowedStepForStep) {
         EXPECT_EQ(r.y[i], y[first + i]);
         // The recorded BVC rates are the model's on a scan cast at the given pose (the definition, summed
         // in full by the reference, normalized to a maximum of 0.5).
-        const auto raw = reference::bvc_raw(trial.model.bvc, lidar.scan(world, Pose::on_floor(x[first + i], y[first + i], h[first + i])));
+        const auto raw = reference::bvc_raw(
+            trial.model.bvc, lidar.scan(world, Pose::on_floor(x[first + i], y[first + i], h[first + i])));
         const double top = *std::max_element(raw.begin(), raw.end());
         for (std::size_t c = 0; c < raw.size(); c += 7)
             EXPECT_NEAR(r.models[0].bvc[i * raw.size() + c], raw[c] / (2 * top), 1e-6 * 0.5 + 1e-7);
@@ -193,10 +195,12 @@ TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
     }
     EXPECT_THROW(read_trajectory_file(fs::temp_directory_path()), InputError);
     // A path in another frame (outside the world's geometry) is refused when the trial starts.
-    auto far = std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {100, 101}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
+    auto far =
+        std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {100, 101}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
     EXPECT_THROW(run_trial_group({trial_with(far, "2d", 0.0001)}), InputError);
     // In trial YAML, next to the random walk's robot.
-    const auto yaml = dir.write("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.001}\n");
+    const auto yaml =
+        dir.write("trial.yaml", "trajectory: " + header.string() + "\nprotocol: {kind: online, sample_hours: 0.001}\n");
     EXPECT_EQ(config::load_trial_file(yaml.string()).agent->kind(), "trajectory");
     const auto both = dir.write("both.yaml", "trajectory: " + header.string() + "\nrobot: {speed: 1}\n");
     EXPECT_THROW(config::load_trial_file(both.string()), ConfigError);
@@ -215,14 +219,14 @@ TEST(Seams, ReturnsFedFromArraysDriveTheModel) {
     trial.protocol.kind = Protocol::Kind::online;
     auto source = std::make_shared<ArrayReturnSource>(scans);
     const World world(trial.world.resolve());
-    const GroupResult res =
-        run_trial_group(world, {trial}, {}, [&](const ModelSpec&, const World*) { return source; });
+    const GroupResult res = run_trial_group(world, {trial}, {}, [&](const ModelSpec&, const World*) { return source; });
     ASSERT_GT(res.t.size(), 300u);
     const std::size_t nb = static_cast<std::size_t>(trial.model.bvc.n_cells());
     for (std::size_t i = 0; i < res.t.size(); i += 61) {
         const auto raw = reference::bvc_raw(trial.model.bvc, scans[i]);
         const double top = *std::max_element(raw.begin(), raw.end());
-        for (std::size_t c = 0; c < nb; c += 5) EXPECT_NEAR(res.models[0].bvc[i * nb + c], raw[c] / (2 * top), 1e-6 * 0.5 + 1e-7);
+        for (std::size_t c = 0; c < nb; c += 5)
+            EXPECT_NEAR(res.models[0].bvc[i * nb + c], raw[c] / (2 * top), 1e-6 * 0.5 + 1e-7);
     }
     EXPECT_EQ(res.stats.full_scan_fallbacks, 0);
     // More steps than returns were given for: a clear error.
@@ -378,8 +382,12 @@ void check_table_limits(const params::Table<S>& table, const std::string& yaml_s
 }  // namespace
 
 TEST(Seams, ParameterTablesCheckTheSameWayEverywhere) {
-    auto model = [](const std::string& text) { config::model_from_yaml(config::YamlView::load_string(text, "m.yaml")); };
-    auto trial = [](const std::string& text) { config::trial_from_yaml(config::YamlView::load_string(text, "t.yaml")); };
+    auto model = [](const std::string& text) {
+        config::model_from_yaml(config::YamlView::load_string(text, "m.yaml"));
+    };
+    auto trial = [](const std::string& text) {
+        config::trial_from_yaml(config::YamlView::load_string(text, "t.yaml"));
+    };
     check_table_limits(BvcParams::table(), "bvc", model);
     check_table_limits(PlaceParams::table(), "place", model);
     check_table_limits(LidarSpec::table(), "sensor", [](const std::string& text) {
@@ -391,13 +399,15 @@ TEST(Seams, ParameterTablesCheckTheSameWayEverywhere) {
     // Written and read back, every preset is itself (the text trial files store).
     for (const auto& name : model_preset_names()) {
         const ModelSpec m = model_preset(name);
-        const ModelSpec back = config::model_from_yaml(config::YamlView::load_string(config::model_to_yaml(m), "m.yaml"));
+        const ModelSpec back =
+            config::model_from_yaml(config::YamlView::load_string(config::model_to_yaml(m), "m.yaml"));
         EXPECT_EQ(config::model_to_yaml(back), config::model_to_yaml(m)) << name;
         EXPECT_EQ(back.bvc.elevations, m.bvc.elevations);
         EXPECT_EQ(back.place.alpha_pb, m.place.alpha_pb);
     }
     // Angles in degrees where a key takes radians.
-    const ModelSpec deg = config::model_from_yaml(config::YamlView::load_string("bvc: {elevations_deg: [0, 10]}\n", "m.yaml"));
+    const ModelSpec deg =
+        config::model_from_yaml(config::YamlView::load_string("bvc: {elevations_deg: [0, 10]}\n", "m.yaml"));
     EXPECT_EQ(deg.bvc.elevations[1], deg_to_rad(10.0));
 }
 
@@ -420,7 +430,8 @@ TEST(Seams, CommentedYamlReadsBackToTheSameConfiguration) {
     odd.azimuth_offset = pi / 7;
     odd.range_noise_sd = 1e-300;
     for (const LidarSpec& s : {LidarSpec::horizontal(), LidarSpec::spherical(), odd}) {
-        const LidarSpec back = config::sensor_from_yaml(YamlView::load_string(config::sensor_to_commented_yaml(s), "s.yaml"));
+        const LidarSpec back =
+            config::sensor_from_yaml(YamlView::load_string(config::sensor_to_commented_yaml(s), "s.yaml"));
         EXPECT_EQ(params::yaml_lines(LidarSpec::table(), back, ""), params::yaml_lines(LidarSpec::table(), s, ""));
         EXPECT_EQ(back.elevations, s.elevations);
         EXPECT_EQ(back.name, s.name);
@@ -467,15 +478,16 @@ TEST(Seams, CommentedYamlReadsBackToTheSameConfiguration) {
     EXPECT_NE(config::trial_to_commented_yaml(files).find("trajectory: " + track.string()), std::string::npos);
     // A path given as arrays has no file to name.
     TrialConfig arrays;
-    arrays.agent = std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {0, 0}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
+    arrays.agent =
+        std::make_shared<TrajectorySpec>(trajectory_steps({0, 1}, {0, 0}, {0, 0}, {}, {0, 0}, "arrays"), "arrays");
     EXPECT_THROW(config::trial_to_commented_yaml(arrays), InputError);
     fs::remove(track);
 }
 
 // Text that needs quoting in YAML is quoted, and reads back as itself.
 TEST(Seams, CommentedYamlQuotesTextThatNeedsIt) {
-    for (const std::string text : {"plain", "+x+y", "-x-y", "a: b", "#x", "x #y", "", "null", "~", "- x", "[a]",
-                                   "{a}", "it's \"q\"", "back\\slash", "colon:", "*star", "tab\there", " lead"}) {
+    for (const std::string text : {"plain", "+x+y", "-x-y", "a: b", "#x", "x #y", "", "null", "~", "- x", "[a]", "{a}",
+                                   "it's \"q\"", "back\\slash", "colon:", "*star", "tab\there", " lead"}) {
         params::CommentedYaml out;
         out.line("", "name", params::CommentedYaml::scalar(text), "a label");
         const auto v = config::YamlView::load_string(out.str(), "q.yaml");

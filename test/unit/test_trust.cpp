@@ -188,8 +188,8 @@ TEST(Cancellation, PollThrowsOnlyInsideAScopeWithItsFlagSet) {
 
 TEST(Seeds, EveryValueOfSixtyFourBitsAndNothingElse) {
     const auto seed_of = [](const std::string& text) {
-        return config::trial_from_yaml(config::YamlView::load_string("seed: " + text + "\nprotocol: {sample_hours: 0.01}\n",
-                                                                     "t.yaml"))
+        return config::trial_from_yaml(
+                   config::YamlView::load_string("seed: " + text + "\nprotocol: {sample_hours: 0.01}\n", "t.yaml"))
             .seed;
     };
     EXPECT_EQ(seed_of("0"), 0u);
@@ -215,8 +215,9 @@ TEST(MeshChecks, ValidFilesPassAndTheHeaderMustMatchTheData) {
         const std::string bytes((std::istreambuf_iterator<char>(in)), {});
         EXPECT_NO_THROW(check_mesh_file(name, bytes)) << name;
     }
-    const std::string header = "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\n"
-                               "property float z\nelement face 50\nproperty list uchar int vertex_indices\nend_header\n";
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 50\nproperty list uchar int vertex_indices\nend_header\n";
     EXPECT_THROW(check_mesh_file("a.ply", header + "0 0 0\n1 0 1\n0 1 1\n"), InputError);
     EXPECT_THROW(check_mesh_file("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"), InputError);
     EXPECT_NO_THROW(check_mesh_file("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n"));

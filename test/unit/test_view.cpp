@@ -76,9 +76,10 @@ TEST(ViewPaths, OnlyInsideTheServedFolder) {
     const auto canonical = fs::canonical(dir);
     EXPECT_EQ(view::path_inside(dir, "a/t.h5"), canonical / "a" / "t.h5");
     EXPECT_EQ(view::path_inside(dir, "a/./t.h5"), canonical / "a" / "t.h5");
-    EXPECT_EQ(view::path_inside(dir, "in"), canonical / "a" / "b");  // a link that stays inside
+    EXPECT_EQ(view::path_inside(dir, "in"), canonical / "a" / "b");             // a link that stays inside
     EXPECT_EQ(view::path_inside(dir, "not-yet.h5"), canonical / "not-yet.h5");  // missing is the caller's 404
-    for (const char* bad : {"", "/etc/passwd", "../x", "a/../../x", "a/..", "..", "a/out/passwd", "a\\..\\..\\x", "//etc"})
+    for (const char* bad :
+         {"", "/etc/passwd", "../x", "a/../../x", "a/..", "..", "a/out/passwd", "a\\..\\..\\x", "//etc"})
         EXPECT_FALSE(view::path_inside(dir, bad)) << bad;
     EXPECT_FALSE(view::path_inside(dir, std::string_view("a/t.h5\0/../../x", 15)));
     EXPECT_EQ(view::relative_name(dir, dir / "a" / "t.h5"), "a/t.h5");
@@ -89,9 +90,9 @@ TEST(ViewBlobs, HeaderThenAlignedLittleEndianArrays) {
     const std::vector<float> f{1.5f, -2.0f, 3.25f};
     const std::vector<std::uint8_t> u{7, 8, 9, 10, 11};
     const std::vector<double> d{0.1, 0.2};
-    const std::string blob = view::encode_blob({{"kind", "test"}}, {view::f32_array("f", std::span<const float>(f)),
-                                                                    view::u8_array("u", u),
-                                                                    view::f64_array("d", std::span<const double>(d), {1, 2})});
+    const std::string blob =
+        view::encode_blob({{"kind", "test"}}, {view::f32_array("f", std::span<const float>(f)), view::u8_array("u", u),
+                                               view::f64_array("d", std::span<const double>(d), {1, 2})});
     ASSERT_EQ(blob.substr(0, 4), "BVC3");
     std::uint32_t length = 0;
     std::memcpy(&length, blob.data() + 4, 4);

@@ -86,8 +86,12 @@ TEST_P(CrossArenaRays, DesignedRaysHitTheIntendedFace) {
     };
     // Plane solves: outer x = 5 -> (5 - ox)/dx; ceiling -> (2.5 - oz)/dz;
     // wall A faces y - z·ta = ±h -> (±h - oy + oz·ta)/(dy - dz·ta); wall B likewise with x.
-    auto wall_a = [&](const Vec3& o, const Vec3& d, double side) { return (side * h - o.y() + o.z() * ta) / (d.y() - d.z() * ta); };
-    auto wall_b = [&](const Vec3& o, const Vec3& d, double side) { return (side * h - o.x() + o.z() * ta) / (d.x() - d.z() * ta); };
+    auto wall_a = [&](const Vec3& o, const Vec3& d, double side) {
+        return (side * h - o.y() + o.z() * ta) / (d.y() - d.z() * ta);
+    };
+    auto wall_b = [&](const Vec3& o, const Vec3& d, double side) {
+        return (side * h - o.x() + o.z() * ta) / (d.x() - d.z() * ta);
+    };
     std::vector<Case> cases;
     auto add = [&](Vec3 o, double az, double el, Surface s, double t) { cases.push_back({o, az, el, s, t}); };
     {
@@ -122,7 +126,8 @@ TEST_P(CrossArenaRays, EveryBeamOfBothScannersMatchesTheAnalyticArena) {
     const World world = World::cross({.tilt_deg = tilt});
     const Lidar spherical(LidarSpec::spherical(false)), horizontal(LidarSpec::horizontal());
     int walls_seen = 0;
-    for (const Pose pose : {Pose::on_floor(4, 4, 0.3), Pose::on_floor(-1.2, 0.7, 2.0), Pose::on_floor(1.0, -2.5, -1.0), Pose::on_floor(0.6, 4.6, 3.0)}) {
+    for (const Pose pose : {Pose::on_floor(4, 4, 0.3), Pose::on_floor(-1.2, 0.7, 2.0), Pose::on_floor(1.0, -2.5, -1.0),
+                            Pose::on_floor(0.6, 4.6, 3.0)}) {
         for (const Lidar* lidar : {&spherical, &horizontal}) {
             const Scan scan = lidar->scan(world, pose);
             ASSERT_EQ(scan.size(), lidar->spec().beam_count()) << "a closed arena returns every beam";
@@ -200,8 +205,10 @@ TEST(RayCaster, SpheresAreHitExactlyInDouble) {
         state = state * 6364136223846793005ull + 1442695040888963407ull;
         return static_cast<double>(state >> 11) / 9007199254740992.0;
     };
-    for (int i = 0; i < 400; ++i) sets[0].centers.emplace_back(3 + 4 * uniform(), -3 + 6 * uniform(), -1 + 2 * uniform());
-    for (int i = 0; i < 30; ++i) sets[1].centers.emplace_back(3 + 4 * uniform(), -3 + 6 * uniform(), -1 + 2 * uniform());
+    for (int i = 0; i < 400; ++i)
+        sets[0].centers.emplace_back(3 + 4 * uniform(), -3 + 6 * uniform(), -1 + 2 * uniform());
+    for (int i = 0; i < 30; ++i)
+        sets[1].centers.emplace_back(3 + 4 * uniform(), -3 + 6 * uniform(), -1 + 2 * uniform());
     TriangleMesh wall;
     wall.add_quad(Vec3(9, -20, -20), Vec3(9, 20, -20), Vec3(9, 20, 20), Vec3(9, -20, 20));
     const RayCaster rc(wall, sets);
@@ -236,7 +243,8 @@ TEST(World, PointCloudWorldScansAndBounds) {
     w.name = "ring";
     SphereSet ring;
     ring.radius = 0.1;
-    for (int k = 0; k < 3600; ++k) ring.centers.emplace_back(4 * std::cos(k * two_pi / 3600), 4 * std::sin(k * two_pi / 3600), 0.08);
+    for (int k = 0; k < 3600; ++k)
+        ring.centers.emplace_back(4 * std::cos(k * two_pi / 3600), 4 * std::sin(k * two_pi / 3600), 0.08);
     w.spheres.push_back(ring);
     w.walkable = Polygon2::rectangle(-3, -3, 3, 3);
     EXPECT_TRUE(w.has_geometry());

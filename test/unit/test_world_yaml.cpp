@@ -5,11 +5,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../support/temp_dir.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/recording/ply.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 #include "bvc3d/world/ray_caster.hpp"
-#include "../support/temp_dir.hpp"
 
 using namespace bvc3d;
 namespace fs = std::filesystem;
@@ -139,7 +139,8 @@ TEST(WorldYamlErrors, NameFileKeyAndReason) {
                         "objects[0].box.size", "must be > 0");
     expect_config_error("objects:\n  - quad: [[0,0,0],[1,1,1],[2,2,2],[3,3,3]]\n" + std::string(walls),
                         "objects[0].quad", "degenerate");
-    expect_config_error("objects:\n  - sphere: {radius: 1}\n" + std::string(walls), "objects[0]", "unknown object kind 'sphere'");
+    expect_config_error("objects:\n  - sphere: {radius: 1}\n" + std::string(walls), "objects[0]",
+                        "unknown object kind 'sphere'");
     expect_config_error("objects: []\n" + std::string(walls), "objects", "no objects");
     expect_config_error("objects:\n  - quad: [[4,-4,0],[4,4,0],[4,4,3],[4,-4,3]]\n", "walkable", "is required");
     expect_config_error("objects:\n  - mesh: {file: missing.obj}\n" + std::string(walls), "objects[0].mesh.file",
@@ -171,7 +172,8 @@ TEST(WorldYamlErrors, BrokenAndDegenerateMeshFiles) {
             const std::string msg = e.what();
             EXPECT_NE(msg.find("objects[0].mesh.file"), std::string::npos) << msg;
             EXPECT_NE(msg.find(name), std::string::npos) << msg;
-            EXPECT_TRUE(msg.find(reason) != std::string::npos || msg.find("cannot be read") != std::string::npos) << msg;
+            EXPECT_TRUE(msg.find(reason) != std::string::npos || msg.find("cannot be read") != std::string::npos)
+                << msg;
         }
     }
     EXPECT_THROW(load_mesh_file(dir.path().string()), InputError);  // a directory
@@ -179,7 +181,8 @@ TEST(WorldYamlErrors, BrokenAndDegenerateMeshFiles) {
 
 TEST(SensorYaml, CustomBeamTableAndErrors) {
     TempDir dir;
-    const auto ok = dir.write("s.yaml", "elevations_deg: [15, 5, -5]\nazimuth_count: 360\nheight: 0.3\nrange_noise_sd: 0.02\n");
+    const auto ok =
+        dir.write("s.yaml", "elevations_deg: [15, 5, -5]\nazimuth_count: 360\nheight: 0.3\nrange_noise_sd: 0.02\n");
     const LidarSpec s = config::resolve_sensor(ok.string());
     EXPECT_EQ(s.beam_count(), 3u * 360u);
     EXPECT_NEAR(s.elevations[0], 15 * M_PI / 180, 1e-15);

@@ -182,9 +182,8 @@ double BodyCollider::free_distance(const Vec2& p, const Vec2& u, double max_dist
     box.min().array() -= radius_;
     box.max().array() += radius_;
     double t = max_dist;
-    for_segments_near(box, [&](int i) {
-        t = std::min(t, contact_time(p, u, radius_ + segments_[i].radius, segments_[i], t));
-    });
+    for_segments_near(
+        box, [&](int i) { t = std::min(t, contact_time(p, u, radius_ + segments_[i].radius, segments_[i], t)); });
     return t;
 }
 

@@ -74,8 +74,8 @@ private:
         Eigen::AlignedBox2d box;
         double step = 0;
         int nx = 0, ny = 0;
-        std::vector<int> label;      // per cell: component, or -1 where the body does not fit
-        std::vector<double> area;    // per component, m²
+        std::vector<int> label;    // per cell: component, or -1 where the body does not fit
+        std::vector<double> area;  // per component, m²
         double largest = 0;
     };
     const FreeSpace& free_space() const;

@@ -165,8 +165,9 @@ void FlyingWalk::restore_state(const std::string& text) {
 
 void FlightSpec::check_world(const WorldDescription& world) const {
     if (!world.flight) {
-        const std::string reason = "the world has no flight volume, so a flying agent cannot use it (a ground world: "
-                                   "use the random walk's robot, or declare flight_volume in the world's YAML)";
+        const std::string reason =
+            "the world has no flight volume, so a flying agent cannot use it (a ground world: "
+            "use the random walk's robot, or declare flight_volume in the world's YAML)";
         if (world.file.empty()) throw InputError("world '" + world.name + "': " + reason);
         throw ConfigError(world.file, "flight_volume", reason);
     }

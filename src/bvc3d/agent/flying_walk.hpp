@@ -21,15 +21,15 @@ namespace bvc3d {
 enum class FlightHead { level, body };
 
 struct FlightParams {
-    double radius = 0.2;              // m, the body is a sphere
-    double speed = 1.0;               // m/s along the direction of flight
-    double turn_rate = 2.1;           // rad/s, for yaw and for pitch
-    double model_dt = 0.288;          // s of motion per model step (0.288 m)
-    int n_walk = 10;                  // model steps between Gaussian turns
-    double yaw_sd = pi / 6;           // rad, sd of the Gaussian yaw turn
-    double pitch_sd = pi / 12;        // rad, sd of the Gaussian pitch turn
-    double max_pitch = pi / 3;        // rad, |pitch| never exceeds it
-    double min_update_move = 1e-3;    // m: a step cut short by a bump updates if it moved more
+    double radius = 0.2;            // m, the body is a sphere
+    double speed = 1.0;             // m/s along the direction of flight
+    double turn_rate = 2.1;         // rad/s, for yaw and for pitch
+    double model_dt = 0.288;        // s of motion per model step (0.288 m)
+    int n_walk = 10;                // model steps between Gaussian turns
+    double yaw_sd = pi / 6;         // rad, sd of the Gaussian yaw turn
+    double pitch_sd = pi / 12;      // rad, sd of the Gaussian pitch turn
+    double max_pitch = pi / 3;      // rad, |pitch| never exceeds it
+    double min_update_move = 1e-3;  // m: a step cut short by a bump updates if it moved more
     FlightHead head = FlightHead::level;
 
     static const params::Table<FlightParams>& table();
@@ -55,7 +55,8 @@ struct FlightState {
 
 class FlyingWalk : public Agent {
 public:
-    FlyingWalk(std::shared_ptr<const SphereCollider> body, const FlightParams& params, Rng rng, const FlightState& start);
+    FlyingWalk(std::shared_ptr<const SphereCollider> body, const FlightParams& params, Rng rng,
+               const FlightState& start);
 
     // A uniformly random start: a uniform point of the flight volume where the body fits (outside
     // solid obstacles and closed-off pockets), a direction uniform on the sphere within the pitch limits.
@@ -102,6 +103,7 @@ private:
 };
 
 // A whole flight of `hours` simulated hours from a seeded random start.
-std::vector<ModelStep> flying_walk(const World& world, double hours, std::uint64_t seed, const FlightParams& params = {});
+std::vector<ModelStep> flying_walk(const World& world, double hours, std::uint64_t seed,
+                                   const FlightParams& params = {});
 
 }  // namespace bvc3d

@@ -51,8 +51,7 @@ RobotParams RobotParams::authors() {
     return p;
 }
 
-RandomWalk::RandomWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& params, Rng rng,
-                       const Pose& start)
+RandomWalk::RandomWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& params, Rng rng, const Pose& start)
     : body_(std::move(body)), p_(params), rng_(std::move(rng)) {
     p_.validate();
     state_.pose = start;
@@ -66,15 +65,15 @@ Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& b
         const auto i = std::min(n - 1, static_cast<std::size_t>(rng.uniform() * static_cast<double>(n)));
         pose.x = world.start.points[i].x();
         pose.y = world.start.points[i].y();
-        const std::string where = "world '" + world.name + "': start point (" + format_number(pose.x) + ", " +
-                                  format_number(pose.y) + ")";
+        const std::string where =
+            "world '" + world.name + "': start point (" + format_number(pose.x) + ", " + format_number(pose.y) + ")";
         if (!body.is_free(world.start.points[i]))
             throw InputError(where + " is blocked or outside the walkable region");
         if (!body.can_start_at(world.start.points[i])) {
             const auto [area, largest] = body.free_area(world.start.points[i]);
-            throw InputError(where + " lies in a closed-off free area of " + format_number(std::round(area * 100) / 100) +
-                             " m² (the largest is " + format_number(std::round(largest * 100) / 100) +
-                             " m²): inside an obstacle?");
+            throw InputError(where + " lies in a closed-off free area of " +
+                             format_number(std::round(area * 100) / 100) + " m² (the largest is " +
+                             format_number(std::round(largest * 100) / 100) + " m²): inside an obstacle?");
         }
     } else {
         const auto& region = world.start.region;
@@ -91,7 +90,8 @@ Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& b
             }
         }
         if (!found)
-            throw InputError("world '" + world.name + "': the start region has no place where the robot fits, "
+            throw InputError("world '" + world.name +
+                             "': the start region has no place where the robot fits, "
                              "outside obstacles and closed-off pockets");
     }
     pose.heading = rng.uniform(-pi, pi);
@@ -136,17 +136,20 @@ void RandomWalk::check_start(const WorldDescription& world, const BodyCollider& 
         for (std::size_t i = 0; i < points.size(); ++i) {
             const std::string key = "start.points[" + std::to_string(i) + "]";
             const Vec2& p = points[i];
-            if (!world.walkable.contains(p)) world_key_error(world, key, point_text(p) + " lies outside the walkable region");
+            if (!world.walkable.contains(p))
+                world_key_error(world, key, point_text(p) + " lies outside the walkable region");
             if (!body.is_free(p))
-                world_key_error(world, key, point_text(p) + " is blocked: a robot of radius " + format_number(r) +
-                                                " m would overlap geometry there (room: " +
-                                                format_number(std::round(body.room(p) * 1000) / 1000) + " m)");
+                world_key_error(world, key,
+                                point_text(p) + " is blocked: a robot of radius " + format_number(r) +
+                                    " m would overlap geometry there (room: " +
+                                    format_number(std::round(body.room(p) * 1000) / 1000) + " m)");
             if (!body.can_start_at(p)) {
                 const auto [area, largest] = body.free_area(p);
-                world_key_error(world, key, point_text(p) + " lies in a closed-off free area of " +
-                                                format_number(std::round(area * 100) / 100) + " m² (the largest is " +
-                                                format_number(std::round(largest * 100) / 100) +
-                                                " m²): inside an obstacle, or a pocket the robot cannot leave");
+                world_key_error(world, key,
+                                point_text(p) + " lies in a closed-off free area of " +
+                                    format_number(std::round(area * 100) / 100) + " m² (the largest is " +
+                                    format_number(std::round(largest * 100) / 100) +
+                                    " m²): inside an obstacle, or a pocket the robot cannot leave");
             }
         }
         return;
@@ -269,8 +272,9 @@ void RandomWalk::restore(const WalkState& s) {
 std::string RandomWalk::save_state() const {
     const WalkState w = state();
     std::ostringstream os;
-    os << "random_walk " << format_number(w.pose.x) << ' ' << format_number(w.pose.y) << ' ' << format_number(w.pose.heading)
-       << ' ' << format_number(w.t) << ' ' << w.steps_since_turn << ' ' << (w.bump_pending ? 1 : 0) << '\n'
+    os << "random_walk " << format_number(w.pose.x) << ' ' << format_number(w.pose.y) << ' '
+       << format_number(w.pose.heading) << ' ' << format_number(w.t) << ' ' << w.steps_since_turn << ' '
+       << (w.bump_pending ? 1 : 0) << '\n'
        << w.rng_state;
     return os.str();
 }
@@ -296,7 +300,8 @@ void RandomWalk::restore_state(const std::string& text) {
 
 void RandomWalkSpec::check_world(const WorldDescription& world) const {
     if (world.walkable.points.empty() && world.flight)
-        throw InputError("world '" + world.name + "' is a flight-only world (no walkable region): the random walk's "
+        throw InputError("world '" + world.name +
+                         "' is a flight-only world (no walkable region): the random walk's "
                          "robot cannot use it; use the flying agent (trial key flight:, --agent flight)");
     validate();
     RandomWalk::check_start(world, BodyCollider(world, robot_.radius, robot_.height));

@@ -16,28 +16,28 @@
 namespace bvc3d {
 
 struct RobotParams {
-    double radius = 0.25;                  // m (the paper's 0.5 m diameter)
-    double height = 0.10;                  // m
-    double speed = 0.5;                    // m/s forward
-    double turn_rate = 2.1;                // rad/s, in place
-    double model_dt = 0.288;               // s of forward motion per model step (0.144 m)
-    int n_walk = 10;                       // model steps between Gaussian turns (the paper's τ_w)
-    double turn_sd = pi / 6;               // rad, sd of the Gaussian turn
-    double min_update_move = 1e-3;         // m: a step cut short by a bump updates if it moved more
+    double radius = 0.25;           // m (the paper's 0.5 m diameter)
+    double height = 0.10;           // m
+    double speed = 0.5;             // m/s forward
+    double turn_rate = 2.1;         // rad/s, in place
+    double model_dt = 0.288;        // s of forward motion per model step (0.144 m)
+    int n_walk = 10;                // model steps between Gaussian turns (the paper's τ_w)
+    double turn_sd = pi / 6;        // rad, sd of the Gaussian turn
+    double min_update_move = 1e-3;  // m: a step cut short by a bump updates if it moved more
     // Options for robots that differ from the paper's (docs/reproduction.md#the-authors-configuration);
     // at their defaults the walk is the paper's.
-    double turn_control_step = 0.0;   // s: > 0 turns in whole steps of this length until the target is
-                                      // reached or passed (overshooting by less than one step)
-    bool bump_gaussian_turn = false;  // after a bump's uniform heading, also make the Gaussian turn
-    bool fixed_start_heading = false; // start at start_heading instead of a uniform heading
-    double start_heading = 0.0;       // rad, with fixed_start_heading
-    double log_lag = 0.0;             // s: each sample is logged where the robot is this long after its scan
+    double turn_control_step = 0.0;    // s: > 0 turns in whole steps of this length until the target is
+                                       // reached or passed (overshooting by less than one step)
+    bool bump_gaussian_turn = false;   // after a bump's uniform heading, also make the Gaussian turn
+    bool fixed_start_heading = false;  // start at start_heading instead of a uniform heading
+    double start_heading = 0.0;        // rad, with fixed_start_heading
+    double log_lag = 0.0;              // s: each sample is logged where the robot is this long after its scan
 
     // The robot of the authors' Webots code: radius 0.17 m, turns at 1.83 rad/s in 96 ms control
     // steps, the Gaussian turn after a bump too, a fixed start heading (east). Its logging lag is
     // a separate choice (authors_log_lag).
     static RobotParams authors();
-    static constexpr double authors_control_step = 0.096;          // s
+    static constexpr double authors_control_step = 0.096;                // s
     static constexpr double authors_log_lag = 2 * authors_control_step;  // s: two control steps, ≈0.1 m
 
     static const params::Table<RobotParams>& table();
@@ -114,6 +114,7 @@ private:
 };
 
 // A whole walk of `hours` simulated hours from a seeded random start.
-std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed, const RobotParams& params = {});
+std::vector<ModelStep> random_walk(const World& world, double hours, std::uint64_t seed,
+                                   const RobotParams& params = {});
 
 }  // namespace bvc3d

@@ -72,12 +72,14 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 SphereCollider::SphereCollider(const WorldDescription& world, double radius) : radius_(radius) {
     if (!(radius > 0) || !std::isfinite(radius)) throw InputError("the flying body's radius must be a positive number");
     if (!world.flight)
-        throw InputError("world '" + world.name + "' declares no flight volume: a flying agent needs one "
+        throw InputError("world '" + world.name +
+                         "' declares no flight volume: a flying agent needs one "
                          "(flight_volume in the world's YAML; docs/flying.md#worlds)");
     volume_ = *world.flight;
     const auto& region = volume_.region;
     if (region.points.size() < 3 || region.area() <= 0)
-        throw InputError("world '" + world.name + "': the flight volume's region needs at least 3 points and a positive area");
+        throw InputError("world '" + world.name +
+                         "': the flight volume's region needs at least 3 points and a positive area");
     const double R = radius_;
     const auto box = volume_.bounds();
     const double height = volume_.z_max - volume_.z_min;
@@ -241,16 +243,14 @@ const SphereCollider::FreeSpace& SphereCollider::free_space() const {
     std::call_once(free_once_, [this] {
         FreeSpace& f = free_;
         f.step = free_space_step();
-        for (int d = 0; d < 3; ++d)
-            f.n[d] = std::max(1, static_cast<int>(std::ceil(center_box_.sizes()[d] / f.step)));
+        for (int d = 0; d < 3; ++d) f.n[d] = std::max(1, static_cast<int>(std::ceil(center_box_.sizes()[d] / f.step)));
         while (static_cast<double>(f.n[0]) * f.n[1] * f.n[2] > 8e6) {  // bounded memory for huge volumes
             f.step *= 2;
             for (int d = 0; d < 3; ++d)
                 f.n[d] = std::max(1, static_cast<int>(std::ceil(center_box_.sizes()[d] / f.step)));
         }
         // Cells centered in the center box (which may be thinner than a step).
-        for (int d = 0; d < 3; ++d)
-            f.origin[d] = center_box_.center()[d] - 0.5 * f.n[d] * f.step;
+        for (int d = 0; d < 3; ++d) f.origin[d] = center_box_.center()[d] - 0.5 * f.n[d] * f.step;
         const auto center = [&](int i, int j, int k) {
             return Vec3(f.origin.x() + (i + 0.5) * f.step, f.origin.y() + (j + 0.5) * f.step,
                         f.origin.z() + (k + 0.5) * f.step);

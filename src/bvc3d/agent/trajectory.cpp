@@ -52,7 +52,8 @@ std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std:
         if (i > 0 && !(t[i] > t[i - 1]))
             throw InputError(where() + "times must increase (" + format_number(t[i]) + " after " +
                              format_number(t[i - 1]) + ")");
-        steps[i] = ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), pi_, wrap_pi(ri)}, false, std::nullopt};
+        steps[i] =
+            ModelStep{t[i] - t[0], Pose{x[i], y[i], zi, wrap_pi(heading[i]), pi_, wrap_pi(ri)}, false, std::nullopt};
     }
     return steps;
 }
@@ -104,14 +105,18 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             for (const auto& c : {"t", "x", "y"})
                 if (std::find(columns.begin(), columns.end(), c) == columns.end())
                     throw InputError(at + "the header lacks the column '" + c + "'");
-            const auto has = [&](const char* c) { return std::find(columns.begin(), columns.end(), c) != columns.end(); };
+            const auto has = [&](const char* c) {
+                return std::find(columns.begin(), columns.end(), c) != columns.end();
+            };
             degrees = has("heading_deg");
-            if (has("heading") == degrees) throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
+            if (has("heading") == degrees)
+                throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
             for (const auto& c : columns)
-                if (c != "t" && c != "x" && c != "y" && c != "z" && c != "heading" && c != "heading_deg" && c != "pitch" &&
-                    c != "roll" && c != "pitch_deg" && c != "roll_deg")
-                    throw InputError(at + "unknown column '" + c +
-                                     "' (known: t, x, y, z, heading or heading_deg, pitch or pitch_deg, roll or roll_deg)");
+                if (c != "t" && c != "x" && c != "y" && c != "z" && c != "heading" && c != "heading_deg" &&
+                    c != "pitch" && c != "roll" && c != "pitch_deg" && c != "roll_deg")
+                    throw InputError(
+                        at + "unknown column '" + c +
+                        "' (known: t, x, y, z, heading or heading_deg, pitch or pitch_deg, roll or roll_deg)");
             if ((has("pitch") && has("pitch_deg")) || (has("roll") && has("roll_deg")))
                 throw InputError(at + "give each angle in radians or in degrees, not both");
             continue;
@@ -167,9 +172,12 @@ std::uint64_t hash_steps(const std::vector<ModelStep>& steps) {
 }  // namespace
 
 TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source, int dims)
-    : steps_(std::make_shared<const std::vector<ModelStep>>(std::move(steps))), source_(std::move(source)),
-      hash_(hash_steps(*steps_)), dims_(dims) {
-    if (dims != 2 && dims != 3) throw InputError("a trajectory's positions are analyzed in 2 or 3 dimensions, not " + std::to_string(dims));
+    : steps_(std::make_shared<const std::vector<ModelStep>>(std::move(steps))),
+      source_(std::move(source)),
+      hash_(hash_steps(*steps_)),
+      dims_(dims) {
+    if (dims != 2 && dims != 3)
+        throw InputError("a trajectory's positions are analyzed in 2 or 3 dimensions, not " + std::to_string(dims));
 }
 
 TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
@@ -180,7 +188,8 @@ TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
 
 void TrajectorySpec::write_yaml(params::CommentedYaml& out) const {
     if (file_.empty())
-        throw InputError("trajectory '" + source_ + "' was given as arrays: write it to a file to describe the trial in YAML");
+        throw InputError("trajectory '" + source_ +
+                         "' was given as arrays: write it to a file to describe the trial in YAML");
     out.line("", "trajectory", params::CommentedYaml::scalar(file_.string()),
              "a given path instead of the random walk: a file of t, x, y, [z], heading rows");
 }
@@ -203,8 +212,8 @@ void TrajectorySpec::check_world(const WorldDescription& world) const {
 
 std::string TrajectorySpec::key() const {
     std::ostringstream os;
-    os << "trajectory:\n  source: " << std::filesystem::path(source_).filename().string() << "\n  rows: " << steps_->size()
-       << "\n  hash: " << std::hex << hash_ << "\n";
+    os << "trajectory:\n  source: " << std::filesystem::path(source_).filename().string()
+       << "\n  rows: " << steps_->size() << "\n  hash: " << std::hex << hash_ << "\n";
     if (dims_ == 3) os << "  dims: 3\n";  // 2-D keys stay as they were
     return os.str();
 }

@@ -67,7 +67,7 @@ public:
 private:
     std::shared_ptr<const std::vector<ModelStep>> steps_;
     std::string source_;
-    std::uint64_t hash_ = 0;  // of the rows, for the key
+    std::uint64_t hash_ = 0;      // of the rows, for the key
     std::filesystem::path file_;  // the file it was read from (absolute), empty for arrays
     int dims_ = 2;
 };

@@ -62,9 +62,11 @@ Bins bin_positions(const Grid& grid, const Eigen::Ref<const Points>& positions) 
             out.counts.push_back(count[static_cast<std::size_t>(b)]);
         }
     out.centers.resize(static_cast<Eigen::Index>(out.ids.size()), grid.dims());
-    for (std::size_t r = 0; r < out.ids.size(); ++r) grid.center(out.ids[r], out.centers.row(static_cast<Eigen::Index>(r)).data());
+    for (std::size_t r = 0; r < out.ids.size(); ++r)
+        grid.center(out.ids[r], out.centers.row(static_cast<Eigen::Index>(r)).data());
     out.sample_bin.resize(n);
-    for (std::size_t i = 0; i < n; ++i) out.sample_bin[i] = flat[i] < 0 ? -1 : row_of[static_cast<std::size_t>(flat[i])];
+    for (std::size_t i = 0; i < n; ++i)
+        out.sample_bin[i] = flat[i] < 0 ? -1 : row_of[static_cast<std::size_t>(flat[i])];
     return out;
 }
 

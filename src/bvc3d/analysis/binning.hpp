@@ -25,10 +25,10 @@ public:
 
 // Samples assigned to the visited bins of a grid.
 struct Bins {
-    std::vector<int> ids;               // grid index of each visited bin, ascending
-    Points centers;                     // center of each visited bin (rows of D coordinates)
-    std::vector<std::int64_t> counts;   // samples in each visited bin
-    std::vector<int> sample_bin;        // per sample: row in `ids`, or -1 outside the grid
+    std::vector<int> ids;              // grid index of each visited bin, ascending
+    Points centers;                    // center of each visited bin (rows of D coordinates)
+    std::vector<std::int64_t> counts;  // samples in each visited bin
+    std::vector<int> sample_bin;       // per sample: row in `ids`, or -1 outside the grid
     int size() const { return static_cast<int>(ids.size()); }
 };
 

@@ -19,7 +19,8 @@ CellStats cell_stats(const RateMaps& maps) {
     double binned = 0;
     for (const auto c : maps.bins.counts) binned += static_cast<double>(c);
     Eigen::VectorXd occupancy(n_bins);
-    for (Eigen::Index b = 0; b < n_bins; ++b) occupancy(b) = static_cast<double>(maps.bins.counts[static_cast<std::size_t>(b)]) / binned;
+    for (Eigen::Index b = 0; b < n_bins; ++b)
+        occupancy(b) = static_cast<double>(maps.bins.counts[static_cast<std::size_t>(b)]) / binned;
     const double area = maps.grid->bin_measure();
     for (Eigen::Index c = 0; c < n_cells; ++c) {
         const auto k = static_cast<std::size_t>(c);

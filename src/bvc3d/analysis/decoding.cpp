@@ -129,7 +129,9 @@ double vertical_chance(const Bins& first, const Eigen::Ref<const Points>& positi
 
 }  // namespace
 
-std::string decoding_templates_name(DecodingTemplates t) { return t == DecodingTemplates::means ? "means" : "rate_maps"; }
+std::string decoding_templates_name(DecodingTemplates t) {
+    return t == DecodingTemplates::means ? "means" : "rate_maps";
+}
 
 DecodingTemplates parse_decoding_templates(std::string_view name) {
     if (name == "rate_maps") return DecodingTemplates::rate_maps;
@@ -193,7 +195,8 @@ DecodingResult decoding_error(const Grid& grid, const Eigen::Ref<const Points>& 
         errors.push_back(distance(s, best[i]));
         all.push_back(errors.back());
         if (split) {
-            const double dx = positions(s, 0) - first.centers(best[i], 0), dy = positions(s, 1) - first.centers(best[i], 1);
+            const double dx = positions(s, 0) - first.centers(best[i], 0),
+                         dy = positions(s, 1) - first.centers(best[i], 1);
             horizontal.push_back(std::sqrt(dx * dx + dy * dy));
             vertical.push_back(std::abs(positions(s, 2) - first.centers(best[i], 2)));
         }

@@ -17,11 +17,12 @@ namespace bvc3d::analysis {
 
 // What a bin's template is.
 enum class DecodingTemplates {
-    rate_maps,  // docs/model-reference.md#analysis (default): the first half's rate maps, thresholded at each cell's quantile
-                // and normalized to a maximum of 1 per cell
-    means,      // option: the first half's raw mean rates per bin (hexbin means), no threshold or scaling
+    // docs/model-reference.md#analysis (default): the first half's rate maps, thresholded at each cell's quantile and
+    // normalized to a maximum of 1 per cell
+    rate_maps,
+    means,  // option: the first half's raw mean rates per bin (hexbin means), no threshold or scaling
 };
-std::string decoding_templates_name(DecodingTemplates t);  // "rate_maps" | "means"
+std::string decoding_templates_name(DecodingTemplates t);           // "rate_maps" | "means"
 DecodingTemplates parse_decoding_templates(std::string_view name);  // throws InputError otherwise
 
 struct DecodingParams {

@@ -111,7 +111,8 @@ HexBins bin_samples(const HexGrid& grid, std::span<const double> x, std::span<co
     return out;
 }
 
-HexBins hexbin(std::span<const double> x, std::span<const double> y, int gridsize, const std::optional<Extent>& extent) {
+HexBins hexbin(std::span<const double> x, std::span<const double> y, int gridsize,
+               const std::optional<Extent>& extent) {
     return bin_samples(HexGrid::fit(x, y, gridsize, extent), x, y);
 }
 

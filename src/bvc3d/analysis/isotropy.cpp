@@ -9,7 +9,8 @@
 namespace bvc3d::analysis {
 
 double isotropy_of(const Eigen::Ref<const Centers>& points, const Eigen::Ref<const Eigen::VectorXd>& weights) {
-    if (points.cols() != 3) throw InputError("isotropy needs 3-D points, got " + std::to_string(points.cols()) + " columns");
+    if (points.cols() != 3)
+        throw InputError("isotropy needs 3-D points, got " + std::to_string(points.cols()) + " columns");
     if (weights.size() != points.rows()) throw InputError("isotropy: one weight per point");
     const double total = weights.sum();
     if (!(total > 0)) return std::numeric_limits<double>::quiet_NaN();
@@ -25,7 +26,8 @@ double isotropy_of(const Eigen::Ref<const Centers>& points, const Eigen::Ref<con
 
 std::vector<double> field_isotropy(const Eigen::Ref<const Centers>& centers, const Eigen::Ref<const RowMatrixXd>& maps,
                                    const std::vector<int>& modality, const DbscanParams& params) {
-    if (centers.cols() != 3) throw InputError("isotropy needs 3-D bin centers, got " + std::to_string(centers.cols()) + " columns");
+    if (centers.cols() != 3)
+        throw InputError("isotropy needs 3-D bin centers, got " + std::to_string(centers.cols()) + " columns");
     if (maps.rows() != centers.rows() || static_cast<std::size_t>(maps.cols()) != modality.size())
         throw InputError("isotropy: maps must be bins × cells with one modality index per cell");
     std::vector<double> out(modality.size(), std::numeric_limits<double>::quiet_NaN());

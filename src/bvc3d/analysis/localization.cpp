@@ -48,14 +48,16 @@ ErrorSummary summarize(const std::vector<double>& errors) {
     return s;
 }
 
-double horizontal(const Eigen::Ref<const Points>& a, Eigen::Index i, const Eigen::Ref<const Points>& b, Eigen::Index j) {
+double horizontal(const Eigen::Ref<const Points>& a, Eigen::Index i, const Eigen::Ref<const Points>& b,
+                  Eigen::Index j) {
     return std::hypot(a(i, 0) - b(j, 0), a(i, 1) - b(j, 1));
 }
 
 }  // namespace
 
-LocalizationResult localize(const Eigen::Ref<const RowMatrixXf>& templates, const Eigen::Ref<const Points>& template_xyz,
-                            const Eigen::Ref<const RowMatrixXf>& queries, const Eigen::Ref<const Points>& query_xyz) {
+LocalizationResult localize(const Eigen::Ref<const RowMatrixXf>& templates,
+                            const Eigen::Ref<const Points>& template_xyz, const Eigen::Ref<const RowMatrixXf>& queries,
+                            const Eigen::Ref<const Points>& query_xyz) {
     const Eigen::Index T = templates.rows(), Q = queries.rows();
     if (T == 0) throw InputError("localization needs at least one template");
     if (templates.cols() != queries.cols())

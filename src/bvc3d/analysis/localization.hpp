@@ -15,8 +15,8 @@
 namespace bvc3d::analysis {
 
 struct ErrorSummary {
-    double median = std::numeric_limits<double>::quiet_NaN();  // m
-    double mean = std::numeric_limits<double>::quiet_NaN();    // m
+    double median = std::numeric_limits<double>::quiet_NaN();     // m
+    double mean = std::numeric_limits<double>::quiet_NaN();       // m
     double within_1m = std::numeric_limits<double>::quiet_NaN();  // fraction
     double within_2m = std::numeric_limits<double>::quiet_NaN();
 };
@@ -37,7 +37,8 @@ struct LocalizationResult {
 // whose best similarity is not positive (all zero, or sharing no active cell with any template)
 // is undecoded and left out of every summary (as in the trial decoder). Positions are rows of
 // x, y, z. Rates are accumulated in double. InputError for mismatched shapes or no templates.
-LocalizationResult localize(const Eigen::Ref<const RowMatrixXf>& templates, const Eigen::Ref<const Points>& template_xyz,
-                            const Eigen::Ref<const RowMatrixXf>& queries, const Eigen::Ref<const Points>& query_xyz);
+LocalizationResult localize(const Eigen::Ref<const RowMatrixXf>& templates,
+                            const Eigen::Ref<const Points>& template_xyz, const Eigen::Ref<const RowMatrixXf>& queries,
+                            const Eigen::Ref<const Points>& query_xyz);
 
 }  // namespace bvc3d::analysis

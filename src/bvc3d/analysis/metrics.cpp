@@ -20,26 +20,30 @@ double median_not_nan(const std::vector<double>& values) {
 
 double fraction_unimodal(const TrialMetrics& m) {
     if (m.modality.empty()) return NAN;
-    return static_cast<double>(std::count(m.modality.begin(), m.modality.end(), 1)) / static_cast<double>(m.modality.size());
+    return static_cast<double>(std::count(m.modality.begin(), m.modality.end(), 1)) /
+           static_cast<double>(m.modality.size());
 }
 
 }  // namespace
 
 const std::vector<Metric>& metric_table() {
     static const std::vector<Metric> table{
-        {"frac_active", "MI>0 fraction", "fraction of cells with MI > 0", "Fraction of place cells with a field (MI > 0)",
-         3, [](const TrialMetrics& m) { return m.modality_summary.frac_active; }},
+        {"frac_active", "MI>0 fraction", "fraction of cells with MI > 0",
+         "Fraction of place cells with a field (MI > 0)", 3,
+         [](const TrialMetrics& m) { return m.modality_summary.frac_active; }},
         {"mean_mi_active", "mean MI (MI>0)", "mean MI of cells with MI > 0", "Mean modality index of active cells", 2,
          [](const TrialMetrics& m) { return m.modality_summary.mean_mi_active; }},
         {"frac_multimodal", "MI>1 fraction", "fraction of cells with MI > 1",
          "Fraction of multimodal place cells (MI > 1)", 3,
          [](const TrialMetrics& m) { return m.modality_summary.frac_multimodal; }},
-        {"msai", "MSAI", "MSAI", "Mean spatial aliasing index", 4, [](const TrialMetrics& m) { return m.aliasing.msai; }},
+        {"msai", "MSAI", "MSAI", "Mean spatial aliasing index", 4,
+         [](const TrialMetrics& m) { return m.aliasing.msai; }},
         {"decode_median_m", "decoding median (m)", "median decoding error (m)", "Localization error (median)", 2,
          [](const TrialMetrics& m) { return m.decoding.median_m; }},
         {"decode_mean_m", "decoding mean (m)", "mean decoding error (m)", "", 2,
          [](const TrialMetrics& m) { return m.decoding.mean_m; }},
-        {"n_bins", "bins", "visited bins", "", -1, [](const TrialMetrics& m) { return static_cast<double>(m.maps.bins.size()); }},
+        {"n_bins", "bins", "visited bins", "", -1,
+         [](const TrialMetrics& m) { return static_cast<double>(m.maps.bins.size()); }},
         {"n_decoded", "decoded samples", "decoded samples", "", -1,
          [](const TrialMetrics& m) { return static_cast<double>(m.decoding.n_decoded); }},
         {"n_undecoded", "undecoded samples", "undecoded samples", "", -1,
@@ -51,10 +55,11 @@ const std::vector<Metric>& metric_table() {
          "Isotropy of single 3-D fields (median over MI = 1 cells; bats: about 1)", 2,
          [](const TrialMetrics& m) { return median_not_nan(m.isotropy); }, 3},
         {"decode_horizontal_median_m", "decoding horizontal (m)", "median horizontal decoding error (m)",
-         "Horizontal localization error (median)", 2, [](const TrialMetrics& m) { return m.decoding.median_horizontal_m; },
-         3},
+         "Horizontal localization error (median)", 2,
+         [](const TrialMetrics& m) { return m.decoding.median_horizontal_m; }, 3},
         {"decode_vertical_median_m", "decoding vertical (m)", "median vertical decoding error (m)",
-         "Vertical localization error (median)", 2, [](const TrialMetrics& m) { return m.decoding.median_vertical_m; }, 3},
+         "Vertical localization error (median)", 2, [](const TrialMetrics& m) { return m.decoding.median_vertical_m; },
+         3},
         {"decode_vertical_chance_m", "vertical chance (m)", "median vertical error of a random guess (m)", "", 2,
          [](const TrialMetrics& m) { return m.decoding.median_vertical_chance_m; }, 3},
         // Decoding's coverage: how many samples it left out, and errors that count them at chance.

@@ -17,7 +17,7 @@ struct Metric {
     const char* title;    // figure title; "" for metrics without a figure of their own
     int digits;           // decimals in summary.md; -1 for metrics summary.md leaves out
     double (*value)(const TrialMetrics&);
-    int dims = 0;         // 0: every trial; 3: trials of 3-D positions only (flying agents)
+    int dims = 0;  // 0: every trial; 3: trials of 3-D positions only (flying agents)
     bool applies(int trial_dims) const { return dims == 0 || dims == trial_dims; }
 };
 

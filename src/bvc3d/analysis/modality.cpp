@@ -231,7 +231,8 @@ PointSet to_points(const Eigen::Ref<const Points>& points) {
 }  // namespace
 
 void DbscanParams::validate() const {
-    if (!(eps > 0) || !std::isfinite(eps)) throw InputError("eps must be a positive number, got " + std::to_string(eps));
+    if (!(eps > 0) || !std::isfinite(eps))
+        throw InputError("eps must be a positive number, got " + std::to_string(eps));
     if (min_samples < 1) throw InputError("min_samples must be >= 1, got " + std::to_string(min_samples));
 }
 
@@ -267,7 +268,8 @@ std::vector<int> modality(const Eigen::Ref<const Centers>& centers, const Eigen:
         poll_cancel();
         pts.coords.clear();
         for (Eigen::Index b = 0; b < maps.rows(); ++b) {
-            if (std::isnan(maps(b, c))) throw InputError("maps must not contain NaN (column " + std::to_string(c) + ")");
+            if (std::isnan(maps(b, c)))
+                throw InputError("maps must not contain NaN (column " + std::to_string(c) + ")");
             if (maps(b, c) > 0)
                 for (Eigen::Index d = 0; d < centers.cols(); ++d) pts.coords.push_back(centers(b, d));
         }

@@ -21,11 +21,11 @@ void check_quantile(double q) {
 double percentile_linear(std::span<double> v, double percent) {
     if (v.empty()) throw InputError("percentile of an empty array");
     const auto n = static_cast<std::ptrdiff_t>(v.size());
-    const double q = percent / 100;                        // np.true_divide(q, 100)
+    const double q = percent / 100;  // np.true_divide(q, 100)
     const double virtual_index = static_cast<double>(n - 1) * q;
     std::ptrdiff_t prev = static_cast<std::ptrdiff_t>(std::floor(virtual_index)), next = prev + 1;
     double prev_for_gamma = static_cast<double>(prev);
-    if (virtual_index >= static_cast<double>(n - 1)) {     // numpy takes index -1 for both
+    if (virtual_index >= static_cast<double>(n - 1)) {  // numpy takes index -1 for both
         prev = next = n - 1;
         prev_for_gamma = -1.0;
     } else if (virtual_index < 0) {
@@ -56,10 +56,8 @@ void threshold_and_normalize(RowMatrixXd& maps, double quantile) {
             if (col(b) < threshold) col(b) = 0.0;
             top = std::max(top, col(b));
         }
-        if (top > 0)
-            col /= top;
-        else
-            col.setZero();  // a silent cell: no field rather than 0/0
+        if (top > 0) col /= top;
+        else col.setZero();  // a silent cell: no field rather than 0/0
     }
 }
 
@@ -85,16 +83,16 @@ template <class T>
 RateMaps rate_maps(std::span<const double> x, std::span<const double> y, const Eigen::Ref<const RowMatrixX<T>>& rates,
                    const RateMapParams& params) {
     params.validate();
-    return rate_maps<T>(std::make_shared<HexGrid>(HexGrid::fit(x, y, params.gridsize, params.extent)), positions_2d(x, y),
-                        rates, params.quantile);
+    return rate_maps<T>(std::make_shared<HexGrid>(HexGrid::fit(x, y, params.gridsize, params.extent)),
+                        positions_2d(x, y), rates, params.quantile);
 }
 
 template RateMaps rate_maps<float>(std::shared_ptr<const Grid>, const Eigen::Ref<const Points>&,
                                    const Eigen::Ref<const RowMatrixXf>&, double);
 template RateMaps rate_maps<double>(std::shared_ptr<const Grid>, const Eigen::Ref<const Points>&,
                                     const Eigen::Ref<const RowMatrixXd>&, double);
-template RateMaps rate_maps<float>(std::span<const double>, std::span<const double>, const Eigen::Ref<const RowMatrixXf>&,
-                                   const RateMapParams&);
+template RateMaps rate_maps<float>(std::span<const double>, std::span<const double>,
+                                   const Eigen::Ref<const RowMatrixXf>&, const RateMapParams&);
 template RateMaps rate_maps<double>(std::span<const double>, std::span<const double>,
                                     const Eigen::Ref<const RowMatrixXd>&, const RateMapParams&);
 

@@ -15,13 +15,28 @@ const params::Table<AnalysisParams>& AnalysisParams::table() {
         "analysis",
         {integer("gridsize", &A::gridsize, closed(2, 2000), "hexagons across x (matplotlib's gridsize)"),
          real("quantile", &A::quantile, closed(0, 1), "rate-map threshold: values below this quantile become 0"),
-         Field<A>{"eps", "m, DBSCAN neighborhood radius", Kind::real, open_closed(0, 1e6), {}, false, 0, 0,
+         Field<A>{"eps",
+                  "m, DBSCAN neighborhood radius",
+                  Kind::real,
+                  open_closed(0, 1e6),
+                  {},
+                  false,
+                  0,
+                  0,
                   [](const A& a) { return Value(a.dbscan.eps); },
-                  [](A& a, const Value& v) { a.dbscan.eps = std::get<double>(v); }, false},
-         Field<A>{"min_samples", "DBSCAN neighbors (the point included) of a core point", Kind::integer,
-                  closed(1, 1e9), {}, false, 0, 0,
+                  [](A& a, const Value& v) { a.dbscan.eps = std::get<double>(v); },
+                  false},
+         Field<A>{"min_samples",
+                  "DBSCAN neighbors (the point included) of a core point",
+                  Kind::integer,
+                  closed(1, 1e9),
+                  {},
+                  false,
+                  0,
+                  0,
                   [](const A& a) { return Value(static_cast<long long>(a.dbscan.min_samples)); },
-                  [](A& a, const Value& v) { a.dbscan.min_samples = static_cast<int>(std::get<long long>(v)); }, false},
+                  [](A& a, const Value& v) { a.dbscan.min_samples = static_cast<int>(std::get<long long>(v)); },
+                  false},
          real("d_th", &A::d_th, closed(0, 1e6), "m, bins nearer than this do not count as aliased"),
          choice("decoding_templates", &A::decoding_templates,
                 {{DecodingTemplates::rate_maps, "rate_maps"}, {DecodingTemplates::means, "means"}},
@@ -46,7 +61,8 @@ AnalysisParams AnalysisParams::defaults(int dims) {
 void AnalysisParams::validate() const {
     table().check(*this);
     if (!(mi_quantile == -1 || (mi_quantile >= 0 && mi_quantile <= 1)))
-        table().fail("mi_quantile", "must be -1 (the same as quantile) or in [0, 1], got " + params::to_text(mi_quantile));
+        table().fail("mi_quantile",
+                     "must be -1 (the same as quantile) or in [0, 1], got " + params::to_text(mi_quantile));
     if (extent) extent->validate();
     if (!(voxel > 0) || !std::isfinite(voxel)) throw InputError("analysis: voxel must be a positive length");
     if (volume) volume->validate();
@@ -61,7 +77,8 @@ AnalysisParams AnalysisParams::authors() {
 }
 
 std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, const AnalysisParams& params) {
-    if (positions.cols() == 3) return std::make_shared<VoxelGrid>(VoxelGrid::fit(positions, params.voxel, params.volume));
+    if (positions.cols() == 3)
+        return std::make_shared<VoxelGrid>(VoxelGrid::fit(positions, params.voxel, params.volume));
     if (positions.cols() != 2)
         throw InputError("positions with " + std::to_string(positions.cols()) +
                          " coordinates: binning needs 2 (hexagons) or 3 (voxels)");
@@ -92,7 +109,8 @@ TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eige
         m.modality = modality(m.maps.bins.centers, maps, params.dbscan);
     }
     m.modality_summary = summarize_modality(m.modality);
-    m.aliasing = spatial_aliasing(m.maps.bins.centers, m.maps.map, params.d_th, static_cast<std::size_t>(params.msai_bins));
+    m.aliasing =
+        spatial_aliasing(m.maps.bins.centers, m.maps.map, params.d_th, static_cast<std::size_t>(params.msai_bins));
     const auto n = static_cast<std::size_t>(positions.rows());
     if (n >= 2) {
         m.decoding = decoding_error<T>(*m.maps.grid, positions, rates, params.decoding_templates, params.quantile);

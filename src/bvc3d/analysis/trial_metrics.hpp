@@ -31,7 +31,7 @@ struct AnalysisParams {
     // 3-D positions (docs/flying.md#analysis): cubic voxels of this side, over `volume` (a trial's
     // flight volume) or else over the positions' own bounds. Not keys of the table: 2-D trials'
     // configurations stay as they were.
-    double voxel = 0.5;            // m
+    double voxel = 0.5;  // m
     std::optional<Box3> volume;
     // Conventions of the authors' analysis code (docs/reproduction.md); at their defaults the paper's.
     double mi_quantile = -1;  // the modality's rate-map threshold; -1: the same as `quantile`
@@ -58,7 +58,7 @@ struct TrialMetrics {
     std::vector<int> modality;  // per cell
     ModalitySummary modality_summary;
     AliasingResult aliasing;
-    DecodingResult decoding;    // on the same grid as the maps, with the same quantile
+    DecodingResult decoding;  // on the same grid as the maps, with the same quantile
     CellStats cells;
     std::vector<double> isotropy;  // per cell, 3-D positions only (isotropy.hpp); empty in 2-D
 };

@@ -16,7 +16,8 @@ void Box3::validate() const {
 }
 
 VoxelGrid VoxelGrid::fit(const Eigen::Ref<const Points>& positions, double side, const std::optional<Box3>& box) {
-    if (!(side > 0) || !std::isfinite(side)) throw InputError("voxel side must be a positive length, got " + std::to_string(side));
+    if (!(side > 0) || !std::isfinite(side))
+        throw InputError("voxel side must be a positive length, got " + std::to_string(side));
     check_positions(positions, 3);
     VoxelGrid g;
     g.side = side;
@@ -35,8 +36,10 @@ VoxelGrid VoxelGrid::fit(const Eigen::Ref<const Points>& positions, double side,
         // A box is covered by whole voxels; data bounds put the maximum inside the last voxel.
         const double count = box ? std::max(1.0, std::ceil(cells)) : std::floor(cells) + 1;
         total *= count;
-        if (total > 5e7) throw InputError("a voxel grid of side " + std::to_string(side) + " m over these positions would "
-                                          "have more than 5e7 voxels");
+        if (total > 5e7)
+            throw InputError("a voxel grid of side " + std::to_string(side) +
+                             " m over these positions would "
+                             "have more than 5e7 voxels");
         n[d] = static_cast<int>(count);
     }
     g.x0 = lo[0], g.y0 = lo[1], g.z0 = lo[2];

@@ -67,7 +67,8 @@ void BvcParams::validate() const {
                                        " directions × " + std::to_string(n_per_axis) + " distances = " +
                                        format_number(cells) + " cells; the limit is " + format_number(max_cells));
     if (reading == BvcReading::nearest_beam && !elevations.empty())
-        table().fail("reading", "cannot be nearest_beam with elevation layers (the nearest_beam reading is a 2-D model)");
+        table().fail("reading",
+                     "cannot be nearest_beam with elevation layers (the nearest_beam reading is a 2-D model)");
 }
 
 BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params) : p_(std::move(params)) {
@@ -214,7 +215,8 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
     // the same addresses, which the CPU forwards (a load straddling two earlier stores waits for
     // both to reach the cache); the cells this adds get their true terms. Cells evaluated one by one
     // (no recurrence) keep the window as it is: each costs an exp.
-    const kernels::ReturnRule rule{cut_r_, dd, inv_dd, M, recurrence, slot_scale_, static_cast<std::int32_t>(memo_slots_)};
+    const kernels::ReturnRule rule{
+        cut_r_, dd, inv_dd, M, recurrence, slot_scale_, static_cast<std::int32_t>(memo_slots_)};
     static_assert(sizeof(LidarReturn) == 3 * sizeof(double));
     kernels::ReturnReadings in;
 
@@ -262,7 +264,8 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
         if (use_memo && memo_weight_[at] == azimuth) {
             slot_batch_[slot] = batch_;
         } else if (use_memo && !(recurrence && slot_batch_[slot] == batch_)) {  // a miss: the slot takes it
-            memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
+            memo_dir_[at] =
+                static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
             memo_weight_[at] = azimuth;
             slot_batch_[slot] = batch_;
         } else {  // no memo, or a job waiting for the kernel reads the slot's record: a record of its own
@@ -271,7 +274,8 @@ std::size_t BoundaryVectorLayer::pruned_pass(std::span<const LidarReturn> return
                 n_direct_ = 0;
             }
             at = (memo_slots_ + n_direct_++) * record;
-            memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
+            memo_dir_[at] =
+                static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
         }
         if constexpr (!planned) {
             for (int i = 0; i < n_any; ++i) layer_weight_[any_layers_[i]] += row_factor_[any_layers_[i]];
@@ -382,7 +386,8 @@ void BoundaryVectorLayer::copy_sums(const BoundaryVectorLayer& from_layer, std::
 }
 
 double BoundaryVectorLayer::term_bound(double kept, double dropped, double weight, double far) const {
-    return kept * c_r_ * tiny_r + dropped * c_r_ + weight * c_theta_ * c_r_ * tiny_theta + far * c_theta_ * c_r_ * tiny_r;
+    return kept * c_r_ * tiny_r + dropped * c_r_ + weight * c_theta_ * c_r_ * tiny_theta +
+           far * c_theta_ * c_r_ * tiny_r;
 }
 
 double BoundaryVectorLayer::elevation_tail(std::size_t returns) const {
@@ -400,7 +405,8 @@ double BoundaryVectorLayer::pruned_bound(std::size_t valid) const {
     for (int l = 0; l < L; ++l)
         for (int k = 0; k < K; ++k) {
             const std::size_t lk = static_cast<std::size_t>(l) * K + k;
-            bound = std::max(bound, term_bound(kept_weight_[lk], dropped_weight_[lk], layer_weight_[l], far_weight_[l]));
+            bound =
+                std::max(bound, term_bound(kept_weight_[lk], dropped_weight_[lk], layer_weight_[l], far_weight_[l]));
         }
     return bound + elevation_tail(valid);
 }
@@ -446,8 +452,10 @@ bool BoundaryVectorLayer::can_share_sums(const BvcParams& o) const {
 
 std::size_t BoundaryVectorLayer::first_axis(const BvcParams& reader, int l) const {
     if (reader.elevations.empty()) return 0;
-    const auto at = std::find(p_.elevations.begin(), p_.elevations.end(), reader.elevations[static_cast<std::size_t>(l)]);
-    if (at == p_.elevations.end()) throw InputError("BVC layer: shared sums lack the elevation of layer " + std::to_string(l));
+    const auto at =
+        std::find(p_.elevations.begin(), p_.elevations.end(), reader.elevations[static_cast<std::size_t>(l)]);
+    if (at == p_.elevations.end())
+        throw InputError("BVC layer: shared sums lack the elevation of layer " + std::to_string(l));
     return static_cast<std::size_t>(at - p_.elevations.begin()) * static_cast<std::size_t>(p_.n_dir);
 }
 
@@ -458,7 +466,8 @@ void BoundaryVectorLayer::sum_pruned(std::span<const LidarReturn> returns, const
 bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn>, const ScanPlan& plan,
                                               const BoundaryVectorLayer& summed, std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
-    if (!can_share_sums(summed.p_)) throw InputError("BVC layer: cannot read the sums of a layer with other parameters");
+    if (!can_share_sums(summed.p_))
+        throw InputError("BVC layer: cannot read the sums of a layer with other parameters");
     return planned_rates(plan, summed, out);
 }
 
@@ -501,7 +510,9 @@ int BoundaryVectorLayer::angular_weights(double azimuth, std::uint16_t* dir, dou
     for (int ki = k_first; ki <= k_last; ++ki) {
         const double x = all_dirs ? wrap_pi(azimuth - ki * dtheta) : azimuth - ki * dtheta;
         if (std::abs(x) > cut_theta_) continue;
-        dir[count] = static_cast<std::uint16_t>(ki < 0 ? ki + K : ki >= K ? ki - K : ki);  // |ki| < K: the window is under a turn
+        dir[count] = static_cast<std::uint16_t>(ki < 0    ? ki + K
+                                                : ki >= K ? ki - K
+                                                          : ki);  // |ki| < K: the window is under a turn
         weight[count] = c_theta_ * std::exp(-x * x * h_t);
         ++count;
     }

@@ -29,10 +29,10 @@ struct BvcParams {
     std::vector<double> elevations{0.0, 0.2};  // psi_l in radians; empty: the 2-D model (no elevation factor)
     int n_dir = 8;
     int n_per_axis = 60;
-    double max_dist = 12.0;     // m
-    double sigma_r = 0.75;      // m
-    double sigma_theta = 0.1;   // rad
-    double sigma_phi = 0.01;    // rad
+    double max_dist = 12.0;    // m
+    double sigma_r = 0.75;     // m
+    double sigma_theta = 0.1;  // rad
+    double sigma_phi = 0.01;   // rad
     BvcNormalization normalization = BvcNormalization::per_step_max;
     double norm_constant = 1.0;  // `fixed`: rate = raw / norm_constant
     BvcReading reading = BvcReading::gaussian;
@@ -69,10 +69,10 @@ public:
     // negligible for every layer, so the scanner need not cast it. What the skipped rows could have
     // added is bounded in advance from the beam table (its columns are evenly spaced in azimuth).
     struct ScanPlan {
-        std::vector<char> rows;              // one flag per row of the sensor
-        std::vector<double> skipped_rows;    // elevations of the rows not needed
-        std::vector<double> skipped_bound;   // per layer: bound on their contribution to any cell
-        std::size_t beams = 0;               // beams in the full table
+        std::vector<char> rows;             // one flag per row of the sensor
+        std::vector<double> skipped_rows;   // elevations of the rows not needed
+        std::vector<double> skipped_bound;  // per layer: bound on their contribution to any cell
+        std::size_t beams = 0;              // beams in the full table
         // Σ_columns c_θ·exp(-x²/2σ_θ²) over one row's columns, for any heading and direction, is at
         // most angular_sum (a unimodal function summed over a lattice); rows_per_label rows at most
         // carry the same elevation label.
@@ -142,9 +142,9 @@ private:
     static void check_return(const LidarReturn& r, std::size_t index);
 
     BvcParams p_;
-    double c_r_, c_theta_, c_phi_;      // Gaussian normalization constants 1/sqrt(2π σ²)
+    double c_r_, c_theta_, c_phi_;                  // Gaussian normalization constants 1/sqrt(2π σ²)
     double cut_r_, cut_theta_, cut_phi_, cut_row_;  // factor windows: exp(-x²/2σ²) >= tiny inside
-    std::vector<double> dist_decay_;    // exp(-n²Δ²/2σ_r²), n = 0..n_per_axis-1, zero-padded
+    std::vector<double> dist_decay_;                // exp(-n²Δ²/2σ_r²), n = 0..n_per_axis-1, zero-padded
     // The directions an azimuth reaches and their angular factors c_θ·exp(-x²/2σ_θ²): a pure
     // function of the azimuth, memoised in a direct-mapped table keyed by the azimuth's bits
     // (scanners repeat the same azimuths row after row, and step after step while the agent does not
@@ -198,7 +198,7 @@ private:
     // The first n_jobs jobs' a and b from their x0 and scale (two batched exps per return).
     void profile_factors(std::size_t n_jobs) const;
     mutable std::vector<double> kept_weight_, layer_weight_, far_weight_, dropped_weight_;  // truncation bound
-    int axis_stride_ = 0;  // n_per_axis rounded up to 8
+    int axis_stride_ = 0;                                       // n_per_axis rounded up to 8
     mutable std::vector<double, CacheAligned<double>> padded_;  // sums with padded axes, blocks of 8 cache-aligned
     // This layer's sums (its layers as `from_layer` holds them, padded) into result.
     void copy_sums(const BoundaryVectorLayer& from_layer, std::span<double> result) const;
@@ -207,9 +207,9 @@ private:
     std::vector<double> dir_angle_;                  // θ_k = k·2π/n_dir, NaN-padded to a multiple of 8
     mutable std::vector<std::int64_t> best_return_;  // nearest_beam reading: per direction
     mutable std::vector<double> best_gap_;
-    mutable std::vector<double> near_azimuth_;       // ... the valid returns' azimuths and indices
+    mutable std::vector<double> near_azimuth_;  // ... the valid returns' azimuths and indices
     mutable std::vector<std::size_t> near_index_;
-    mutable std::vector<std::size_t> cells_;        // ... its cells to evaluate and their exponents
+    mutable std::vector<std::size_t> cells_;  // ... its cells to evaluate and their exponents
     mutable std::vector<double> exponents_;
 };
 

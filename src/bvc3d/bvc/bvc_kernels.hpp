@@ -12,8 +12,8 @@ namespace bvc3d::kernels {
 // and each direction d of its record (count at dirs[record], directions at dirs[record + 1 ...],
 // factors A_d at factors[record + 1 ...]). Widths are multiples of 8 and decay holds the widest; base and stride are
 // multiples of 8 and the sums 64-byte aligned, so each block of 8 cells is one cache line.
-void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs,
-                           const double* factors, std::size_t stride, const double* decay, double* sums);
+void add_distance_profiles(const ProfileJob* jobs, std::size_t n_jobs, const std::uint16_t* dirs, const double* factors,
+                           std::size_t stride, const double* decay, double* sums);
 // For each direction k < n_dir (theta[k] in [0, 2π), padded with NaN to a multiple of 8 entries): the
 // first i < n with the smallest |wrap(azimuth[i] - theta[k])| (azimuth[i] in (-π, π]) into best[k]
 // (n if there is none) and that gap into gap[k]; best and gap have room for the padding.
@@ -24,12 +24,12 @@ void nearest_returns(const double* azimuth, std::size_t n, const double* theta, 
 // to ReturnReadings::size returns at a time: whether it is a return at all, its azimuth wrapped to
 // (-π, π] and the azimuth memo's slot for it, and its distance window over the cells m·Δ.
 struct ReturnRule {
-    double cut;             // m: cells within r ± cut are the window (a superset: an extra cell adds a true term)
-    double dd, inv_dd;      // the cells' spacing Δ and 1/Δ (both 0 for a single cell at distance 0)
-    int cells;              // n_per_axis: cells 0 .. cells − 1
-    bool aligned;           // windows widened to whole blocks of 8 cells (the kernel's recurrence)
-    double slot_scale;      // memo slots / 2π
-    std::int32_t slots;     // memo slots
+    double cut;          // m: cells within r ± cut are the window (a superset: an extra cell adds a true term)
+    double dd, inv_dd;   // the cells' spacing Δ and 1/Δ (both 0 for a single cell at distance 0)
+    int cells;           // n_per_axis: cells 0 .. cells − 1
+    bool aligned;        // windows widened to whole blocks of 8 cells (the kernel's recurrence)
+    double slot_scale;   // memo slots / 2π
+    std::int32_t slots;  // memo slots
 };
 struct ReturnReadings {
     static constexpr std::size_t size = 64;

@@ -11,8 +11,8 @@ namespace bvc3d::kernels {
 // record lists: sums[base + dir_d·stride + n]. The record (the BVC layer's memo) is a count and that
 // many directions in one array, a key and the factors A_d in another, both at `record`.
 struct ProfileJob {
-    double a, b;            // until the layer computes them: x0, and the scale s
-    std::uint32_t base;     // the cell m of direction 0, in the sums
+    double a, b;         // until the layer computes them: x0, and the scale s
+    std::uint32_t base;  // the cell m of direction 0, in the sums
     std::uint32_t record;
     std::int32_t width, unused;
 };

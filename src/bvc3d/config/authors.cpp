@@ -13,7 +13,8 @@ namespace {
 // The robot of a random-walk trial (InputError for a trial that follows a given path).
 RobotParams robot_of(const TrialConfig& t, const std::string& choice) {
     const auto* walk = dynamic_cast<const RandomWalkSpec*>(t.agent.get());
-    if (!walk) throw InputError("the authors' '" + choice + "' choice applies to the random walk, not to a given trajectory");
+    if (!walk)
+        throw InputError("the authors' '" + choice + "' choice applies to the random walk, not to a given trajectory");
     return walk->robot();
 }
 
@@ -37,8 +38,9 @@ const std::vector<AuthorsChoice>& authors_choices() {
          [](TrialConfig& t) {
              if (t.world.source == "cross") t.world.source = "cross-webots";
          }},
-        {"robot", "radius 0.17 m, turns at 1.83 rad/s in 96 ms control steps, the Gaussian turn after a bump too, "
-                  "start heading east",
+        {"robot",
+         "radius 0.17 m, turns at 1.83 rad/s in 96 ms control steps, the Gaussian turn after a bump too, "
+         "start heading east",
          [](TrialConfig& t) {
              RobotParams r = RobotParams::authors();
              r.log_lag = robot_of(t, "robot").log_lag;  // the lag is a choice of its own
@@ -46,7 +48,8 @@ const std::vector<AuthorsChoice>& authors_choices() {
          }},
         {"labels", "the spherical image's angle labels and whole-column heading roll (3d-X becomes 3d-X-authors)",
          [](TrialConfig& t) {
-             for (const char* m : {"3d-0.1", "3d-0.2", "3d-3l"}) replace_preset(t.model, m, std::string(m) + "-authors");
+             for (const char* m : {"3d-0.1", "3d-0.2", "3d-3l"})
+                 replace_preset(t.model, m, std::string(m) + "-authors");
          }},
         {"lag", "each sample's position logged two 96 ms control steps after its scan (≈0.1 m)",
          [](TrialConfig& t) {
@@ -89,14 +92,17 @@ void apply_authors_choices(TrialConfig& t, const std::vector<std::string>& names
 
 const std::vector<PaperPreset>& paper_presets() {
     static const std::vector<PaperPreset> presets{
-        {"spec", "the paper as specified: cross arena, explore then sample, the paper's robot, sensor and analysis", {}},
-        {"authors", "the authors' published code: every authors' choice (" +
-                        [] {
-                            std::string s;
-                            for (const auto& n : authors_choice_names()) s += (s.empty() ? "" : ", ") + n;
-                            return s;
-                        }() +
-                        ")",
+        {"spec",
+         "the paper as specified: cross arena, explore then sample, the paper's robot, sensor and analysis",
+         {}},
+        {"authors",
+         "the authors' published code: every authors' choice (" +
+             [] {
+                 std::string s;
+                 for (const auto& n : authors_choice_names()) s += (s.empty() ? "" : ", ") + n;
+                 return s;
+             }() +
+             ")",
          {"all"}},
     };
     return presets;

@@ -54,12 +54,19 @@ const std::vector<ModelPreset>& model_presets() {
     static const std::vector<ModelPreset> presets{
         {"2d", "the paper's 2-D model: horizontal scanner, 8 directions × 120 distances", [] { return planar("2d"); }},
         {"3d-0.1", "spherical scanner, layers 0 and 0.1 rad × 8 directions × 60 distances",
-         [] { return layered("3d-0.1", {0.0, 0.1}, 60); }},
+         [] {
+             return layered("3d-0.1", {0.0, 0.1}, 60);
+         }},
         {"3d-0.2", "spherical scanner, layers 0 and 0.2 rad × 8 directions × 60 distances",
-         [] { return layered("3d-0.2", {0.0, 0.2}, 60); }},
+         [] {
+             return layered("3d-0.2", {0.0, 0.2}, 60);
+         }},
         {"3d-3l", "spherical scanner, layers 0, 0.1 and 0.2 rad × 8 directions × 40 distances",
-         [] { return layered("3d-3l", {0.0, 0.1, 0.2}, 40); }},
-        {"2d-8beam", "the 2-D model as the authors' code computed it: the single nearest beam per direction, d_m = 0.1·m",
+         [] {
+             return layered("3d-3l", {0.0, 0.1, 0.2}, 40);
+         }},
+        {"2d-8beam",
+         "the 2-D model as the authors' code computed it: the single nearest beam per direction, d_m = 0.1·m",
          [] {
              ModelSpec m = planar("2d-8beam");
              m.bvc.reading = BvcReading::nearest_beam;
@@ -68,17 +75,32 @@ const std::vector<ModelPreset>& model_presets() {
          }},
         // The 3-D models reading the spherical image as the authors' code labels it.
         {"3d-0.1-authors", "3d-0.1 with the authors' image labels and whole-column heading roll",
-         [] { return as_authors(layered("3d-0.1-authors", {0.0, 0.1}, 60)); }},
+         [] {
+             return as_authors(layered("3d-0.1-authors", {0.0, 0.1}, 60));
+         }},
         {"3d-0.2-authors", "3d-0.2 with the authors' image labels and whole-column heading roll",
-         [] { return as_authors(layered("3d-0.2-authors", {0.0, 0.2}, 60)); }},
+         [] {
+             return as_authors(layered("3d-0.2-authors", {0.0, 0.2}, 60));
+         }},
         {"3d-3l-authors", "3d-3l with the authors' image labels and whole-column heading roll",
-         [] { return as_authors(layered("3d-3l-authors", {0.0, 0.1, 0.2}, 40)); }},
+         [] {
+             return as_authors(layered("3d-3l-authors", {0.0, 0.1, 0.2}, 40));
+         }},
         {"fly-up", "flying: full spherical scanner at the body's center, layers 0, 0.1, 0.2 rad (upward only) × 8 × 40",
-         [] { return flying("fly-up", {0.0, 0.1, 0.2}, 40); }, true},
+         [] {
+             return flying("fly-up", {0.0, 0.1, 0.2}, 40);
+         },
+         true},
         {"fly-5l", "flying: full spherical scanner, layers -0.4, -0.2, 0, 0.2, 0.4 rad × 8 directions × 24 distances",
-         [] { return flying("fly-5l", {-0.4, -0.2, 0.0, 0.2, 0.4}, 24); }, true},
+         [] {
+             return flying("fly-5l", {-0.4, -0.2, 0.0, 0.2, 0.4}, 24);
+         },
+         true},
         {"fly-9l", "flying: full spherical scanner, layers -0.8 to 0.8 rad in steps of 0.2 × 8 × 13 (936 cells)",
-         [] { return flying("fly-9l", {-0.8, -0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8}, 13); }, true},
+         [] {
+             return flying("fly-9l", {-0.8, -0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8}, 13);
+         },
+         true},
     };
     return presets;
 }

@@ -31,7 +31,7 @@ struct ModelPreset {
 // The one list of model presets, in the order help texts show them.
 const std::vector<ModelPreset>& model_presets();
 std::vector<std::string> model_preset_names();
-ModelSpec model_preset(const std::string& name);  // throws InputError for unknown names
+ModelSpec model_preset(const std::string& name);                // throws InputError for unknown names
 const ModelPreset* find_model_preset(const std::string& name);  // nullptr for unknown names
 
 }  // namespace bvc3d

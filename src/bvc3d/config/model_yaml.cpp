@@ -53,7 +53,8 @@ std::string model_to_yaml(const ModelSpec& m) {
 void write_model(params::CommentedYaml& out, const ModelSpec& m, const std::string& indent) {
     out.line(indent, "name", params::CommentedYaml::scalar(m.name), "a label: trial names and tables show it");
     if (const std::string builtin = builtin_sensor_name(m.sensor); !builtin.empty()) {
-        out.line(indent, "sensor", builtin, "horizontal, spherical, spherical-authors, or a sensor mapping (bvc3d config --sensor NAME)");
+        out.line(indent, "sensor", builtin,
+                 "horizontal, spherical, spherical-authors, or a sensor mapping (bvc3d config --sensor NAME)");
     } else {
         out.section(indent, "sensor", "the scanner the model reads (docs/worlds.md#sensors)");
         write_sensor(out, m.sensor, indent + "  ");

@@ -31,7 +31,8 @@ std::vector<std::pair<std::string, std::string>> RecordedReturnsSpec::attributes
     std::vector<std::pair<std::string, std::string>> a{{"recording", recording_->name},
                                                        {"recording_scans", recording_->scans_source.string()},
                                                        {"recording_poses", recording_->poses_source.string()}};
-    if (recording_->size() > 0 && recording_->time(0)) a.emplace_back("recording_t0", format_number(*recording_->time(0)));
+    if (recording_->size() > 0 && recording_->time(0))
+        a.emplace_back("recording_t0", format_number(*recording_->time(0)));
     return a;
 }
 

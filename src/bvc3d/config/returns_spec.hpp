@@ -24,9 +24,9 @@ using SourceFactory = std::function<std::shared_ptr<ReturnSource>(const ModelSpe
 class ReturnsSpec {
 public:
     virtual ~ReturnsSpec() = default;
-    virtual std::string label() const = 0;  // "hall-lidar": names the data in file names and tables
+    virtual std::string label() const = 0;         // "hall-lidar": names the data in file names and tables
     virtual std::string sensor_label() const = 0;  // what the trial file records as its sensor
-    virtual std::string key() const = 0;    // YAML text that fixes the returns (trial files, fingerprints)
+    virtual std::string key() const = 0;           // YAML text that fixes the returns (trial files, fingerprints)
     virtual bool needs_world() const = 0;
     // Text attributes a trial file records about the data (names, files).
     virtual std::vector<std::pair<std::string, std::string>> attributes() const { return {}; }

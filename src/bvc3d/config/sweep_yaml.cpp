@@ -49,8 +49,7 @@ std::string value_text(const YAML::Node& v) {
     std::string out;
     if (v.IsSequence())
         for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "-" : "") + value_text(v[i]);
-    else
-        out = "map";
+    else out = "map";
     return out;
 }
 
@@ -87,13 +86,14 @@ std::vector<Condition> grid_conditions(const YamlView& grid, std::vector<std::st
     double n = 1;
     for (const auto& a : axes) n *= static_cast<double>(a.second.size());
     if (n > max_trials)
-        grid.fail("makes " + format_number(n) + " conditions; the limit is " + std::to_string(static_cast<long long>(max_trials)) +
-                  " trials");
+        grid.fail("makes " + format_number(n) + " conditions; the limit is " +
+                  std::to_string(static_cast<long long>(max_trials)) + " trials");
     std::vector<Condition> conditions;
     std::vector<std::size_t> idx(axes.size(), 0);
     for (bool more = true; more;) {
         Condition c{{}, axes.back().second.at(idx.back())};
-        for (std::size_t a = 0; a < axes.size(); ++a) c.values.emplace_back(axes[a].first, axes[a].second.at(idx[a]).node());
+        for (std::size_t a = 0; a < axes.size(); ++a)
+            c.values.emplace_back(axes[a].first, axes[a].second.at(idx[a]).node());
         conditions.push_back(c);
         more = false;
         for (std::size_t a = axes.size(); a-- > 0;) {
@@ -134,15 +134,15 @@ std::vector<std::uint64_t> read_seeds(const YamlView& v) {
         const std::uint64_t n = s.as_uint64();
         if (n < 1) s.fail("must be >= 1 (a number of seeds) or a list of seeds");
         if (static_cast<double>(n) > max_trials)
-            s.fail("asks for " + std::to_string(n) + " seeds; the limit is " + std::to_string(static_cast<long long>(max_trials)) +
-                   " trials");
+            s.fail("asks for " + std::to_string(n) + " seeds; the limit is " +
+                   std::to_string(static_cast<long long>(max_trials)) + " trials");
         for (std::uint64_t i = 0; i < n; ++i) seeds.push_back(i);
         return seeds;
     }
     if (s.size() == 0) s.fail("lists no seeds");
     if (static_cast<double>(s.size()) > max_trials)
-        s.fail("lists " + std::to_string(s.size()) + " seeds; the limit is " + std::to_string(static_cast<long long>(max_trials)) +
-               " trials");
+        s.fail("lists " + std::to_string(s.size()) + " seeds; the limit is " +
+               std::to_string(static_cast<long long>(max_trials)) + " trials");
     for (std::size_t i = 0; i < s.size(); ++i) seeds.push_back(s.at(i).as_uint64());
     return seeds;
 }

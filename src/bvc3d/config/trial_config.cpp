@@ -19,7 +19,6 @@ namespace bvc3d {
 
 namespace {
 
-
 std::uint64_t text_hash(const std::string& s) {
     std::uint64_t h = 0x6276633364ull;
     for (unsigned char c : s) h = hash_u64(h, c, 0x9e37);
@@ -65,19 +64,21 @@ const params::Table<Protocol>& Protocol::table() {
     using namespace params;
     static const Table<Protocol> t(
         "protocol",
-        {choice("kind", &Protocol::kind,
-                {{Kind::explore_then_sample, "explore_then_sample"}, {Kind::online, "online"}},
+        {choice("kind", &Protocol::kind, {{Kind::explore_then_sample, "explore_then_sample"}, {Kind::online, "online"}},
                 "explore_then_sample (learn, then record frozen) or online (record while learning)"),
          real("explore_hours", &Protocol::explore_hours, closed(0, max_agent_hours),
               "h of exploration, learning on, not recorded"),
-         real("sample_hours", &Protocol::sample_hours, open_closed(0, max_agent_hours), "h recorded (online: the one phase)"),
+         real("sample_hours", &Protocol::sample_hours, open_closed(0, max_agent_hours),
+              "h recorded (online: the one phase)"),
          flag("record_bvc", &Protocol::record_bvc, "also record the BVC rates")});
     return t;
 }
 
 void Protocol::validate() const { table().check(*this); }
 
-double Protocol::seconds() const { return 3600.0 * (kind == Kind::online ? sample_hours : explore_hours + sample_hours); }
+double Protocol::seconds() const {
+    return 3600.0 * (kind == Kind::online ? sample_hours : explore_hours + sample_hours);
+}
 
 std::string protocol_name(Protocol::Kind k) { return k == Protocol::Kind::online ? "online" : "explore_then_sample"; }
 
@@ -90,7 +91,8 @@ Protocol::Kind parse_protocol(const std::string& name) {
 std::shared_ptr<const AgentSpec> agent_by_name(const std::string& name) {
     if (name == "random_walk" || name == "ground") return std::make_shared<RandomWalkSpec>();
     if (name == "flight" || name == "flying") return std::make_shared<FlightSpec>();
-    throw InputError("agent '" + name + "' is not one of random_walk (or ground: the paper's robot), flight (or flying)");
+    throw InputError("agent '" + name +
+                     "' is not one of random_walk (or ground: the paper's robot), flight (or flying)");
 }
 
 void TrialConfig::set_agent(std::shared_ptr<const AgentSpec> a) {
@@ -124,11 +126,13 @@ void TrialConfig::validate() const {
     if (const std::string preset = config::preset_name_of(model); !preset.empty()) {
         const bool flying_model = find_model_preset(preset)->flying;
         if (flying_model && agent->kind() == "random_walk")
-            throw InputError("model '" + preset + "' is a preset for flying agents (its scanner sits at the body's "
+            throw InputError("model '" + preset +
+                             "' is a preset for flying agents (its scanner sits at the body's "
                              "center and looks down too): the ground robot uses 2d, 3d-0.1, 3d-0.2, 3d-3l or 2d-8beam; "
                              "or fly with it (trial key flight:, --agent flight)");
         if (!flying_model && agent->kind() == "flight")
-            throw InputError("model '" + preset + "' is a preset for the ground robot (its scanner sits on the robot, "
+            throw InputError("model '" + preset +
+                             "' is a preset for the ground robot (its scanner sits on the robot, "
                              "above the floor): flying agents use fly-up, fly-5l or fly-9l (docs/flying.md#models)");
     }
     if (world.is_none() && (!returns || returns->needs_world()))
@@ -141,8 +145,8 @@ void TrialConfig::validate() const {
                          std::to_string(model.place.n_place) + " × " + std::to_string(model.bvc.n_cells()));
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
     if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
-        Protocol::table().fail("sample_hours", "= " + format_number(protocol.sample_hours) +
-                                                   " h records fewer than 2 model steps");
+        Protocol::table().fail("sample_hours",
+                               "= " + format_number(protocol.sample_hours) + " h records fewer than 2 model steps");
 }
 
 void TrialConfig::check_runnable() const {
@@ -165,9 +169,7 @@ void check_runnable(const std::vector<TrialConfig>& trials) {
     }
 }
 
-std::string TrialConfig::world_label() const {
-    return world.is_none() && returns ? returns->label() : world.label();
-}
+std::string TrialConfig::world_label() const { return world.is_none() && returns ? returns->label() : world.label(); }
 
 std::string TrialConfig::condition_label() const {
     return condition.empty() ? world_label() + "_" + model.name : condition;
@@ -186,8 +188,8 @@ std::string TrialConfig::canonical() const {
     std::string lines = params::yaml_lines(analysis::AnalysisParams::table(), analysis, "  ");
     std::string extent = arena_extent ? "arena" : "data";
     if (!arena_extent && analysis.extent)  // fixed bounds (rare): named in full, so they change the fingerprint
-        extent = params::to_text(std::vector<double>{analysis.extent->xmin, analysis.extent->xmax, analysis.extent->ymin,
-                                                     analysis.extent->ymax});
+        extent = params::to_text(std::vector<double>{analysis.extent->xmin, analysis.extent->xmax,
+                                                     analysis.extent->ymin, analysis.extent->ymax});
     lines.insert(lines.find("  decoding_templates:"), "  extent: " + extent + "\n");
     return walk_key() + config::model_to_yaml(model) + (weights ? weights->key() : "") + "analysis:\n" + lines;
 }
@@ -196,7 +198,8 @@ analysis::AnalysisParams TrialConfig::analysis_params(const WorldDescription& w)
     analysis::AnalysisParams params = analysis;
     if (agent->dims() == 3 && w.flight) {  // voxels over the flight volume (docs/flying.md#analysis)
         const auto box = w.flight->bounds();
-        params.volume = analysis::Box3{box.min().x(), box.max().x(), box.min().y(), box.max().y(), box.min().z(), box.max().z()};
+        params.volume =
+            analysis::Box3{box.min().x(), box.max().x(), box.min().y(), box.max().y(), box.min().z(), box.max().z()};
     }
     if (arena_extent && !w.walkable.points.empty()) {
         const auto box = w.walkable.bounds();

@@ -50,7 +50,7 @@ struct InitialWeights {
     std::string source;         // where they came from (a file name), for trial files
     std::vector<float> values;  // n_place × n_bvc, row-major
     int n_place = 0, n_bvc = 0;
-    std::string key() const;    // the source and a hash of the values
+    std::string key() const;  // the source and a hash of the values
 };
 
 struct TrialConfig {
@@ -58,10 +58,10 @@ struct TrialConfig {
     ModelSpec model = model_preset("3d-0.2");
     Protocol protocol;
     std::shared_ptr<const AgentSpec> agent = std::make_shared<RandomWalkSpec>();  // where the agent goes
-    std::shared_ptr<const ReturnsSpec> returns;          // null: each model's sensor ray-cast in the world
-    std::shared_ptr<const InitialWeights> weights;       // null: drawn from the seed
-    analysis::AnalysisParams analysis;  // defaults as the paper; its extent is set from arena_extent
-    bool arena_extent = false;          // bin over the walkable region's bounds, not the trajectory's
+    std::shared_ptr<const ReturnsSpec> returns;     // null: each model's sensor ray-cast in the world
+    std::shared_ptr<const InitialWeights> weights;  // null: drawn from the seed
+    analysis::AnalysisParams analysis;              // defaults as the paper; its extent is set from arena_extent
+    bool arena_extent = false;                      // bin over the walkable region's bounds, not the trajectory's
     std::uint64_t seed = 0;
 
     // The experimental condition this trial belongs to (its seeds are its replicates) and the

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -70,14 +70,16 @@ void analysis_from(const YamlView& v, TrialConfig& t) {
         return;
     }
     const std::string extent = e.as_string();
-    if (extent != "data" && extent != "arena") e.fail("must be data, arena or [xmin, xmax, ymin, ymax], got '" + extent + "'");
+    if (extent != "data" && extent != "arena")
+        e.fail("must be data, arena or [xmin, xmax, ymin, ymax], got '" + extent + "'");
     t.arena_extent = extent == "arena";
 }
 
 std::shared_ptr<const AgentSpec> agent_from(const YamlView& v) {
     if (v.has("robot") + v.has("trajectory") + v.has("flight") > 1)
-        v.fail("give one of 'robot' (the random walk's robot), 'trajectory' (a given path) or 'flight' (the flying "
-               "agent), not several");
+        v.fail(
+            "give one of 'robot' (the random walk's robot), 'trajectory' (a given path) or 'flight' (the flying "
+            "agent), not several");
     if (v.has("flight")) {
         FlightParams flight;
         read_table(v["flight"], flight, FlightParams::table());
@@ -161,7 +163,8 @@ std::string trial_to_commented_yaml(const TrialConfig& t) {
         out.line("  ", "lean", params::CommentedYaml::scalar(t.world.lean), "the corner they lean toward");
     if (const std::string preset = preset_name_of(t.model); !preset.empty()) {
         out.line("", "model", preset,
-                 "a preset (" + list(model_preset_names()) + "), a model YAML file or a mapping (bvc3d config --model NAME)");
+                 "a preset (" + list(model_preset_names()) +
+                     "), a model YAML file or a mapping (bvc3d config --model NAME)");
     } else {
         out.section("", "model", "a model mapping (docs/model.md#custom-models-yaml)");
         write_model(out, t.model, "  ");

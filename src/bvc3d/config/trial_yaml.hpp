@@ -3,8 +3,8 @@
 // (e.g. model.bvc.elevations) and parses it again, so every value meets the same checks.
 #include <string>
 
-#include "bvc3d/config/yaml_reader.hpp"
 #include "bvc3d/config/trial_config.hpp"
+#include "bvc3d/config/yaml_reader.hpp"
 
 namespace bvc3d::config {
 

@@ -4,8 +4,8 @@
 #include <filesystem>
 
 #include "bvc3d/core/angles.hpp"
-#include "bvc3d/recording/scan_file.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/recording/scan_file.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 
 namespace bvc3d::config {
@@ -17,7 +17,8 @@ std::vector<double> meters(const YamlView& v, std::size_t n) {
     const auto d = v.as_doubles(n);
     for (double x : d)
         if (std::abs(x) > max_coordinate)
-            v.fail("holds " + format_number(x) + ": coordinates and sizes must lie within ±" + format_number(max_coordinate) + " m");
+            v.fail("holds " + format_number(x) + ": coordinates and sizes must lie within ±" +
+                   format_number(max_coordinate) + " m");
     return d;
 }
 
@@ -54,7 +55,8 @@ void check_simple(const YamlView& v, const Polygon2& poly) {
         for (std::size_t j = i + 1; j < n; ++j) {
             if (j == i + 1 || (i == 0 && j == n - 1)) continue;  // neighbors share a corner
             if (segments_meet(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]))
-                v.fail("edges " + std::to_string(i) + " and " + std::to_string(j) + " cross: the polygon must not intersect itself");
+                v.fail("edges " + std::to_string(i) + " and " + std::to_string(j) +
+                       " cross: the polygon must not intersect itself");
         }
 }
 
@@ -83,10 +85,10 @@ Eigen::Isometry3d pose_from_yaml(const YamlView& v, const std::string& position_
     if (v.has(position_key)) pose.translation() = vec3(v[position_key]);
     if (v.has("rotation_deg")) {  // roll, pitch, yaw about x, y, z (applied in that order)
         const auto r = v["rotation_deg"].as_doubles(3);
-        pose.linear() = (Eigen::AngleAxisd(deg_to_rad(r[2]), Vec3::UnitZ()) *
-                         Eigen::AngleAxisd(deg_to_rad(r[1]), Vec3::UnitY()) *
-                         Eigen::AngleAxisd(deg_to_rad(r[0]), Vec3::UnitX()))
-                            .toRotationMatrix();
+        pose.linear() =
+            (Eigen::AngleAxisd(deg_to_rad(r[2]), Vec3::UnitZ()) * Eigen::AngleAxisd(deg_to_rad(r[1]), Vec3::UnitY()) *
+             Eigen::AngleAxisd(deg_to_rad(r[0]), Vec3::UnitX()))
+                .toRotationMatrix();
     } else if (v.has("yaw_deg")) {
         pose.linear() = Eigen::AngleAxisd(deg_to_rad(v["yaw_deg"].as_double()), Vec3::UnitZ()).toRotationMatrix();
     }
@@ -191,7 +193,10 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         TiltedWall t;
         double yaw = 0.0, tilt = 0.0;
         read_fields(v,
-                    {{"length", &t.length}, {"thickness", &t.thickness}, {"height", &t.height}, {"yaw_deg", &yaw},
+                    {{"length", &t.length},
+                     {"thickness", &t.thickness},
+                     {"height", &t.height},
+                     {"yaw_deg", &yaw},
                      {"tilt_deg", &tilt}},
                     {"center"});
         t.center = vec2(v["center"]);
@@ -222,7 +227,8 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         w.spheres.push_back(point_cloud_from_yaml(v));
         return;
     } else {
-        obj.fail("unknown object kind '" + kind + "' (expected cross_arena, box, quad, tilted_wall, mesh or point_cloud)");
+        obj.fail("unknown object kind '" + kind +
+                 "' (expected cross_arena, box, quad, tilted_wall, mesh or point_cloud)");
     }
     check_mesh(v, part);
     w.mesh.append(part);
@@ -241,7 +247,8 @@ FlightVolume flight_from_yaml(const YamlView& v, const WorldDescription& w) {
         f.region = region_from_yaml(v, {"z_min", "z_max"});
     } else {
         v.expect_map({"rect", "polygon", "z_min", "z_max"});
-        if (w.walkable.points.size() < 3) v.fail("needs a 'rect' or 'polygon' (the world has no walkable region to default to)");
+        if (w.walkable.points.size() < 3)
+            v.fail("needs a 'rect' or 'polygon' (the world has no walkable region to default to)");
         f.region = w.walkable;
     }
     if (!v.has("z_min")) v.fail_key("z_min", "is required (m, the volume's floor)");
@@ -268,7 +275,7 @@ FlightVolume flight_from_yaml(const YamlView& v, const WorldDescription& w) {
 // flying agents' worlds (no tilt).
 struct WorldPreset {
     std::string name;
-    std::optional<double> fixed_tilt;  // none: the preset takes a tilt (default 0)
+    std::optional<double> fixed_tilt;                       // none: the preset takes a tilt (default 0)
     CrossArenaParams (*params)(double tilt_deg) = nullptr;  // a cross arena ...
     WorldDescription (*fixed_world)() = nullptr;            // ... or a world of its own
 };
@@ -277,8 +284,11 @@ CrossArenaParams paper_cross(double tilt_deg) { return CrossArenaParams{.tilt_de
 
 const std::vector<WorldPreset>& world_presets() {
     static const std::vector<WorldPreset> presets{
-        {"cross", std::nullopt, paper_cross},   {"cross-0", 0.0, paper_cross},  {"cross-30", 30.0, paper_cross},
-        {"cross-45", 45.0, paper_cross},        {"cross-60", 60.0, paper_cross},
+        {"cross", std::nullopt, paper_cross},
+        {"cross-0", 0.0, paper_cross},
+        {"cross-30", 30.0, paper_cross},
+        {"cross-45", 45.0, paper_cross},
+        {"cross-60", 60.0, paper_cross},
         {"cross-webots", std::nullopt, CrossArenaParams::webots},
         {"flight-room", std::nullopt, nullptr, flight_room},
         {"atrium", std::nullopt, nullptr, atrium},
@@ -317,14 +327,16 @@ WorldDescription world_from_yaml(const YamlView& v) {
 
     if (arena) w.tilt_deg = arena->tilt_deg;
     if (static_cast<double>(w.mesh.size()) > max_mesh_triangles)
-        objects.fail("hold " + std::to_string(w.mesh.size()) + " triangles; the limit is " + format_number(max_mesh_triangles));
+        objects.fail("hold " + std::to_string(w.mesh.size()) + " triangles; the limit is " +
+                     format_number(max_mesh_triangles));
     if (v.has("walkable")) {
         w.walkable = region_from_yaml(v["walkable"]);
     } else if (arena) {
         w.walkable = arena->walkable;
     } else if (!v.has("flight_volume")) {
-        v.fail_key("walkable", "is required (the floor region the robot may use) unless the world has a cross_arena "
-                               "or a flight_volume");
+        v.fail_key("walkable",
+                   "is required (the floor region the robot may use) unless the world has a cross_arena "
+                   "or a flight_volume");
     }
     if (v.has("flight_volume")) {
         w.flight = flight_from_yaml(v["flight_volume"], w);
@@ -332,7 +344,8 @@ WorldDescription world_from_yaml(const YamlView& v) {
         w.flight = arena->flight;
     }
     if (w.walkable.points.empty()) {  // a flight-only world: no ground robot, no start region
-        if (v.has("start")) v.fail_key("start", "needs a walkable region (flying agents start anywhere in the flight volume)");
+        if (v.has("start"))
+            v.fail_key("start", "needs a walkable region (flying agents start anywhere in the flight volume)");
         return w;
     }
     // A floor with no geometry over it is a world the sensors cannot see.
@@ -341,7 +354,8 @@ WorldDescription world_from_yaml(const YamlView& v) {
     for (const auto& set : w.spheres)  // point clouds
         for (const auto& c : set.centers) geometry.extend(Vec2(c.x(), c.y()));
     if (!geometry.intersects(w.walkable.bounds()))
-        (v.has("walkable") ? v["walkable"] : objects).fail("the walkable region lies entirely outside the world's geometry");
+        (v.has("walkable") ? v["walkable"] : objects)
+            .fail("the walkable region lies entirely outside the world's geometry");
     if (v.has("start")) {
         const YamlView s = v["start"];
         if (s.has("points")) {
@@ -380,7 +394,8 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
 WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
     if (const WorldPreset* preset = find_world_preset(name)) {
         if (preset->fixed_world) {
-            if (tilt_deg) throw InputError("a tilt only applies to the cross and cross-webots worlds, not to '" + name + "'");
+            if (tilt_deg)
+                throw InputError("a tilt only applies to the cross and cross-webots worlds, not to '" + name + "'");
             return preset->fixed_world();
         }
         if (preset->fixed_tilt && tilt_deg)
@@ -466,7 +481,8 @@ void write_sensor(params::CommentedYaml& out, const LidarSpec& s, const std::str
 
 std::string sensor_to_commented_yaml(const LidarSpec& s) {
     params::CommentedYaml out;
-    out.comment("", "A sensor (docs/worlds.md#sensors): every key. Read by --sensor FILE, or as a model's sensor mapping.");
+    out.comment("",
+                "A sensor (docs/worlds.md#sensors): every key. Read by --sensor FILE, or as a model's sensor mapping.");
     write_sensor(out, s, "");
     return out.str();
 }
@@ -475,7 +491,9 @@ LidarSpec resolve_sensor(const std::string& name) {
     if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
     std::error_code ec;
     if (!std::filesystem::exists(name, ec))
-        throw InputError("sensor '" + name + "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors' nor an existing YAML file");
+        throw InputError(
+            "sensor '" + name +
+            "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors' nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }

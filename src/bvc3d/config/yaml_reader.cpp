@@ -21,7 +21,8 @@ YamlView YamlView::load_file(const std::string& file) {
         throw ConfigError(file, "", "is not a regular file");
     std::ifstream in(file);
     if (!in) {
-        throw ConfigError(file, "", std::filesystem::exists(file, ec) ? "cannot be opened for reading" : "file does not exist");
+        throw ConfigError(file, "",
+                          std::filesystem::exists(file, ec) ? "cannot be opened for reading" : "file does not exist");
     }
     std::stringstream text;
     text << in.rdbuf();
@@ -42,8 +43,11 @@ public:
     void OnAlias(const YAML::Mark&, YAML::anchor_t anchor) override {
         value(anchor < sizes_.size() ? sizes_[anchor] : 1, 0);
     }
-    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, const std::string&) override { value(1, anchor); }
-    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, const std::string&) override {
+        value(1, anchor);
+    }
+    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor,
+                         YAML::EmitterStyle::value) override {
         open_.push_back({1, anchor});
     }
     void OnSequenceEnd() override { close(); }
@@ -82,14 +86,16 @@ YamlView YamlView::load_string(const std::string& text, const std::string& name)
         ExpandedSize size;
         parser.HandleNextDocument(size);
         if (size.total() > ExpandedSize::limit)
-            throw ConfigError(name, "", "its anchors and aliases expand to more than " +
-                                            std::to_string(static_cast<long long>(ExpandedSize::limit)) + " values");
+            throw ConfigError(name, "",
+                              "its anchors and aliases expand to more than " +
+                                  std::to_string(static_cast<long long>(ExpandedSize::limit)) + " values");
         YAML::Node n = YAML::Load(text);
         if (!n.IsDefined() || n.IsNull()) throw ConfigError(name, "", "is empty");
         return YamlView(n, name);
     } catch (const YAML::Exception& e) {
-        throw ConfigError(name, "", "malformed YAML at line " + std::to_string(e.mark.line + 1) + ", column " +
-                                        std::to_string(e.mark.column + 1) + ": " + e.msg);
+        throw ConfigError(name, "",
+                          "malformed YAML at line " + std::to_string(e.mark.line + 1) + ", column " +
+                              std::to_string(e.mark.column + 1) + ": " + e.msg);
     }
 }
 
@@ -118,7 +124,8 @@ void YamlView::expect_map(const std::vector<std::string>& allowed) const {
     if (!node_.IsMap()) fail("expected a mapping of keys to values");
     std::vector<std::string> seen;
     for (const auto& kv : node_) {
-        if (!kv.first.IsScalar()) YamlView(kv.first, file_, path_).fail("a key must be a name, not a list or a mapping");
+        if (!kv.first.IsScalar())
+            YamlView(kv.first, file_, path_).fail("a key must be a name, not a list or a mapping");
         const std::string k = kv.first.Scalar();
         if (std::find(seen.begin(), seen.end(), k) != seen.end())
             YamlView(kv.first, file_, child_path(k)).fail("appears twice in the same mapping");
@@ -154,7 +161,8 @@ std::vector<std::string> YamlView::keys() const {
     if (!node_.IsMap()) fail("expected a mapping of keys to values");
     std::vector<std::string> out;
     for (const auto& kv : node_) {
-        if (!kv.first.IsScalar()) YamlView(kv.first, file_, path_).fail("a key must be a name, not a list or a mapping");
+        if (!kv.first.IsScalar())
+            YamlView(kv.first, file_, path_).fail("a key must be a name, not a list or a mapping");
         out.push_back(kv.first.Scalar());
     }
     return out;
@@ -206,7 +214,8 @@ std::string YamlView::as_string() const {
 }
 
 std::vector<double> YamlView::as_doubles(std::optional<std::size_t> n) const {
-    if (!node_.IsSequence()) fail(n ? "expected a list of " + std::to_string(*n) + " numbers" : "expected a list of numbers");
+    if (!node_.IsSequence())
+        fail(n ? "expected a list of " + std::to_string(*n) + " numbers" : "expected a list of numbers");
     if (n && node_.size() != *n)
         fail("expected a list of " + std::to_string(*n) + " numbers, got " + std::to_string(node_.size()));
     std::vector<double> out;
@@ -263,17 +272,22 @@ void require_positive(const YamlView& v, const std::string& key, double value) {
 
 void require_range(const YamlView& v, const std::string& key, double value, double lo, double hi) {
     if (!(value >= lo && value <= hi))
-        fail_at(v, key, "must be in [" + format_number(lo) + ", " + format_number(hi) + "], got " + format_number(value));
+        fail_at(v, key,
+                "must be in [" + format_number(lo) + ", " + format_number(hi) + "], got " + format_number(value));
 }
 
 params::Value read_value(const YamlView& v, params::Kind kind, bool degrees) {
     using params::Kind;
     switch (kind) {
-        case Kind::real: return degrees ? deg_to_rad(v.as_double()) : v.as_double();
-        case Kind::integer: return v.as_int();
-        case Kind::flag: return v.as_bool();
+        case Kind::real:
+            return degrees ? deg_to_rad(v.as_double()) : v.as_double();
+        case Kind::integer:
+            return v.as_int();
+        case Kind::flag:
+            return v.as_bool();
         case Kind::text:
-        case Kind::choice: return v.as_string();
+        case Kind::choice:
+            return v.as_string();
         case Kind::reals: {
             if (v.node().IsNull()) return std::vector<double>{};  // `key:` with nothing: an empty list
             std::vector<double> xs = v.as_doubles();

@@ -45,7 +45,7 @@ public:
 
     YamlView operator[](const std::string& key) const;  // fails if missing
     YamlView at(std::size_t i) const;
-    std::size_t size() const;  // of a sequence (fails if not one)
+    std::size_t size() const;               // of a sequence (fails if not one)
     std::vector<std::string> keys() const;  // of a map, in file order
 
     double as_double() const;  // finite number

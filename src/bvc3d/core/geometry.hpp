@@ -14,7 +14,7 @@ using Vec3 = Eigen::Vector3d;
 // axis R·x̂ is (cos p·cos h, cos p·sin h, sin p). A ground robot stands level on the floor:
 // Pose::on_floor(x, y, heading) has z = pitch = roll = 0.
 struct Pose {
-    double x = 0.0, y = 0.0, z = 0.0;  // m
+    double x = 0.0, y = 0.0, z = 0.0;               // m
     double heading = 0.0, pitch = 0.0, roll = 0.0;  // rad
 
     static Pose on_floor(double x, double y, double heading) { return Pose{x, y, 0.0, heading, 0.0, 0.0}; }

@@ -48,7 +48,8 @@ OutputLock::OutputLock(std::filesystem::path lock_file, const std::string& what)
                                  "'); wait for it to finish or stop it, or write elsewhere");
             throw InputError("cannot lock '" + path_.string() + "' for " + what + ": " + std::strerror(e));
         }
-        struct stat held {}, named {};
+        struct stat held {
+        }, named{};
         if (::fstat(fd_, &held) == 0 && ::stat(path_.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
             held.st_dev == named.st_dev)
             break;
@@ -60,8 +61,7 @@ OutputLock::OutputLock(std::filesystem::path lock_file, const std::string& what)
     holder << "bvc3d process " << ::getpid() << " on host " << host_name() << "\n";
     const std::string text = holder.str();
     // Best effort: the lock is the flock, the text only makes the message helpful.
-    if (::ftruncate(fd_, 0) == 0 && ::write(fd_, text.data(), text.size()) < 0) {
-    }
+    if (::ftruncate(fd_, 0) == 0 && ::write(fd_, text.data(), text.size()) < 0) {}
 }
 
 OutputLock::~OutputLock() {

@@ -53,7 +53,8 @@ std::string problem(Kind kind, const Limits& limits, const std::vector<std::stri
             return "must be one of " + list + ", got '" + s + "'";
         }
         case Kind::flag:
-        case Kind::text: return "";
+        case Kind::text:
+            return "";
     }
     return "";
 }
@@ -79,8 +80,8 @@ namespace bvc3d::params {
 
 namespace {
 
-constexpr std::size_t kWidth = 100;       // wrap lists beyond this many characters
-constexpr std::size_t kMaxAligned = 44;   // longer lines get their comment on the line above
+constexpr std::size_t kWidth = 100;      // wrap lists beyond this many characters
+constexpr std::size_t kMaxAligned = 44;  // longer lines get their comment on the line above
 
 }  // namespace
 
@@ -142,7 +143,9 @@ void CommentedYaml::line(const std::string& indent, const std::string& key, cons
 }
 
 std::string CommentedYaml::str() const {
-    const auto aligned = [](const Entry& e) { return e.text.find('\n') == std::string::npos && e.text.size() <= kMaxAligned; };
+    const auto aligned = [](const Entry& e) {
+        return e.text.find('\n') == std::string::npos && e.text.size() <= kMaxAligned;
+    };
     std::size_t column = 0;
     for (const auto& e : entries_)
         if (!e.doc.empty() && aligned(e)) column = std::max(column, e.text.size() + 2);

@@ -127,37 +127,87 @@ private:
 // Field builders from data members.
 template <class S>
 Field<S> real(const char* key, double S::*m, Limits limits, const char* doc) {
-    return {key, doc, Kind::real, limits, {}, false, 0, 0, [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<double>(v); }, false};
+    return {key,
+            doc,
+            Kind::real,
+            limits,
+            {},
+            false,
+            0,
+            0,
+            [m](const S& s) { return Value(s.*m); },
+            [m](S& s, const Value& v) { s.*m = std::get<double>(v); },
+            false};
 }
 template <class S>
 Field<S> integer(const char* key, int S::*m, Limits limits, const char* doc) {
-    return {key, doc, Kind::integer, limits, {}, false, 0, 0,
+    return {key,
+            doc,
+            Kind::integer,
+            limits,
+            {},
+            false,
+            0,
+            0,
             [m](const S& s) { return Value(static_cast<long long>(s.*m)); },
-            [m](S& s, const Value& v) { s.*m = static_cast<int>(std::get<long long>(v)); }, false};
+            [m](S& s, const Value& v) { s.*m = static_cast<int>(std::get<long long>(v)); },
+            false};
 }
 template <class S>
 Field<S> flag(const char* key, bool S::*m, const char* doc) {
-    return {key, doc, Kind::flag, {}, {}, false, 0, 0, [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<bool>(v); }, false};
+    return {key,
+            doc,
+            Kind::flag,
+            {},
+            {},
+            false,
+            0,
+            0,
+            [m](const S& s) { return Value(s.*m); },
+            [m](S& s, const Value& v) { s.*m = std::get<bool>(v); },
+            false};
 }
 template <class S>
 Field<S> text(const char* key, std::string S::*m, const char* doc) {
-    return {key, doc, Kind::text, {}, {}, false, 0, 0, [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<std::string>(v); }, false};
+    return {key,
+            doc,
+            Kind::text,
+            {},
+            {},
+            false,
+            0,
+            0,
+            [m](const S& s) { return Value(s.*m); },
+            [m](S& s, const Value& v) { s.*m = std::get<std::string>(v); },
+            false};
 }
 template <class S>
 Field<S> reals(const char* key, std::vector<double> S::*m, Limits each, const char* doc) {
-    return {key, doc, Kind::reals, each, {}, false, 0, std::numeric_limits<std::size_t>::max(),
+    return {key,
+            doc,
+            Kind::reals,
+            each,
+            {},
+            false,
+            0,
+            std::numeric_limits<std::size_t>::max(),
             [m](const S& s) { return Value(s.*m); },
-            [m](S& s, const Value& v) { s.*m = std::get<std::vector<double>>(v); }, false};
+            [m](S& s, const Value& v) { s.*m = std::get<std::vector<double>>(v); },
+            false};
 }
 // An enum member with its names, in the order the enum's values are listed.
 template <class S, class E>
 Field<S> choice(const char* key, E S::*m, std::vector<std::pair<E, std::string>> names, const char* doc) {
     std::vector<std::string> choices;
     for (const auto& n : names) choices.push_back(n.second);
-    return {key, doc, Kind::choice, {}, choices, false, 0, 0,
+    return {key,
+            doc,
+            Kind::choice,
+            {},
+            choices,
+            false,
+            0,
+            0,
             [m, names](const S& s) {
                 for (const auto& [e, n] : names)
                     if (e == s.*m) return Value(n);
@@ -166,7 +216,8 @@ Field<S> choice(const char* key, E S::*m, std::vector<std::pair<E, std::string>>
             [m, names](S& s, const Value& v) {
                 for (const auto& [e, n] : names)
                     if (n == std::get<std::string>(v)) s.*m = e;
-            }, false};
+            },
+            false};
 }
 
 }  // namespace bvc3d::params

@@ -1,5 +1,6 @@
 #pragma once
-// Seeded random streams (docs/model-reference.md#conventions: one generator per trial; same seed => bit-identical outputs).
+// Seeded random streams (docs/model-reference.md#conventions: one generator per trial; same seed => bit-identical
+// outputs).
 //
 // A trial's seed is split into independent named streams, so that e.g. drawing the initial
 // weights never changes the robot's trajectory. Distributions are written out here rather than

@@ -34,9 +34,13 @@ struct doubles {
 };
 
 template <class V, class T>
-inline void load(V& v, const T* p) { __builtin_memcpy(&v, p, sizeof v); }
+inline void load(V& v, const T* p) {
+    __builtin_memcpy(&v, p, sizeof v);
+}
 template <class V, class T>
-inline void store(T* p, const V& v) { __builtin_memcpy(p, &v, sizeof v); }
+inline void store(T* p, const V& v) {
+    __builtin_memcpy(p, &v, sizeof v);
+}
 
 // Whether every lane of v is 0 (a NaN lane is not), lane by lane: once per call, after a loop.
 template <class V>

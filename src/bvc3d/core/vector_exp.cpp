@@ -67,9 +67,12 @@ void exp_baseline(const double* x, double* y, std::size_t n) {
 void vector_exp(const double* x, double* y, std::size_t n) {
 #if BVC3D_HAVE_DISPATCH
     switch (simd::isa()) {
-        case simd::Isa::v4: return exp_v4(x, y, n);
-        case simd::Isa::v3: return exp_v3(x, y, n);
-        case simd::Isa::baseline: break;
+        case simd::Isa::v4:
+            return exp_v4(x, y, n);
+        case simd::Isa::v3:
+            return exp_v3(x, y, n);
+        case simd::Isa::baseline:
+            break;
     }
 #endif
     exp_baseline(x, y, n);

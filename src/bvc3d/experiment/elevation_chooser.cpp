@@ -40,7 +40,8 @@ private:
 // One factory per worker thread: each distinct inner source is wrapped once, so models that share
 // it still share one scan per step.
 SourceFactory replay_factory(const SourceFactory& inner, std::uint64_t walk_steps, std::uint64_t noise_seed) {
-    auto wrapped = std::make_shared<std::vector<std::pair<std::shared_ptr<ReturnSource>, std::shared_ptr<ReturnSource>>>>();
+    auto wrapped =
+        std::make_shared<std::vector<std::pair<std::shared_ptr<ReturnSource>, std::shared_ptr<ReturnSource>>>>();
     return [=](const ModelSpec& model, const World* world) -> std::shared_ptr<ReturnSource> {
         std::shared_ptr<ReturnSource> made = inner ? inner(model, world) : nullptr;
         for (const auto& [from, replay] : *wrapped) {
@@ -123,10 +124,13 @@ const params::Table<ChooserParams>& ChooserParams::table() {
         {integer("budget", &ChooserParams::budget, at_least(1), "BVCs shared by the layers"),
          integer("min_layers", &ChooserParams::min_layers, at_least(1), "fewest layers the search returns"),
          integer("max_layers", &ChooserParams::max_layers, at_least(1), "most layers the search returns"),
-         real("elevation_min", &ChooserParams::elevation_min, closed(-std::numbers::pi / 2, std::numbers::pi / 2), "rad, lowest candidate elevation"),
-         real("elevation_max", &ChooserParams::elevation_max, closed(-std::numbers::pi / 2, std::numbers::pi / 2), "rad, highest candidate elevation"),
+         real("elevation_min", &ChooserParams::elevation_min, closed(-std::numbers::pi / 2, std::numbers::pi / 2),
+              "rad, lowest candidate elevation"),
+         real("elevation_max", &ChooserParams::elevation_max, closed(-std::numbers::pi / 2, std::numbers::pi / 2),
+              "rad, highest candidate elevation"),
          real("elevation_step", &ChooserParams::elevation_step, above(0), "rad, spacing of the candidate elevations"),
-         real("explore_minutes", &ChooserParams::explore_minutes, above(0), "simulated minutes of the exploratory walk")});
+         real("explore_minutes", &ChooserParams::explore_minutes, above(0),
+              "simulated minutes of the exploratory walk")});
     return t;
 }
 
@@ -153,8 +157,8 @@ void ChooserParams::validate(int n_dir) const {
                          " > elevation_max " + format_number(elevation_max));
     const auto n = static_cast<int>(candidate_elevations().size());
     if (n < min_layers)
-        throw InputError("elevation chooser: the candidate range holds " + std::to_string(n) + " elevation(s), fewer than min_layers = " +
-                         std::to_string(min_layers));
+        throw InputError("elevation chooser: the candidate range holds " + std::to_string(n) +
+                         " elevation(s), fewer than min_layers = " + std::to_string(min_layers));
     const int layers = std::min(max_layers, n);
     if (budget / (n_dir * layers) < 2)
         throw InputError("elevation chooser: a budget of " + std::to_string(budget) + " BVCs is too small for " +
@@ -180,7 +184,8 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
     const int per_axis = budget / (base.bvc.n_dir * static_cast<int>(elevations.size()));
     if (per_axis < 2)
         throw InputError("a budget of " + std::to_string(budget) + " BVCs is too small for " +
-                         std::to_string(elevations.size()) + " layers of " + std::to_string(base.bvc.n_dir) + " directions");
+                         std::to_string(elevations.size()) + " layers of " + std::to_string(base.bvc.n_dir) +
+                         " directions");
     m.bvc.elevations = elevations;
     m.bvc.n_per_axis = per_axis;
     m.name = "adaptive[" + elevations_text(elevations) + "]";
@@ -217,11 +222,10 @@ ExplorationWalk exploration_walk(const World& world, const AgentSpec& agent, std
                      " m apart: explore longer");
 }
 
-std::vector<CandidateScore> score_elevation_sets(const World* world, const ModelSpec& base,
-                                                 const ExplorationWalk& walk,
+std::vector<CandidateScore> score_elevation_sets(const World* world, const ModelSpec& base, const ExplorationWalk& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
-                                                 std::uint64_t seed, const analysis::AnalysisParams& analysis,
-                                                 int jobs, const SourceFactory& sources, const std::atomic<bool>* stop) {
+                                                 std::uint64_t seed, const analysis::AnalysisParams& analysis, int jobs,
+                                                 const SourceFactory& sources, const std::atomic<bool>* stop) {
     if (jobs < 0) throw InputError("jobs must be >= 0");
     if (walk.steps.size() < 2) throw InputError("the exploratory walk needs at least 2 steps");
     std::vector<TrialConfig> trials;
@@ -238,7 +242,9 @@ std::vector<CandidateScore> score_elevation_sets(const World* world, const Model
         trials.push_back(std::move(t));
     }
     const std::uint64_t noise_seed = hash_u64(seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
-    const std::size_t threads = std::clamp<std::size_t>(static_cast<std::size_t>(jobs > 0 ? jobs : std::max(1u, std::thread::hardware_concurrency())), 1, std::max<std::size_t>(sets.size(), 1));
+    const std::size_t threads = std::clamp<std::size_t>(
+        static_cast<std::size_t>(jobs > 0 ? jobs : std::max(1u, std::thread::hardware_concurrency())), 1,
+        std::max<std::size_t>(sets.size(), 1));
     std::vector<CandidateScore> out(sets.size());
     std::vector<std::exception_ptr> errors(threads);
     // Thread k runs sets k, k + threads, ...: one group each, sharing its scans between its sets.
@@ -253,7 +259,8 @@ std::vector<CandidateScore> score_elevation_sets(const World* world, const Model
             if (mine.empty()) return;
             RunControl control;
             control.stop = stop;
-            const GroupResult r = run_trial_group(world, mine, control, replay_factory(sources, walk.steps.size(), noise_seed));
+            const GroupResult r =
+                run_trial_group(world, mine, control, replay_factory(sources, walk.steps.size(), noise_seed));
             for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(world, r, m, mine[m]);
         } catch (...) {
             errors[k] = std::current_exception();
@@ -290,8 +297,8 @@ ElevationChoice greedy_search(const World* world, const ModelSpec& base, const E
             set.insert(std::upper_bound(set.begin(), set.end(), e), e);
             sets.push_back(std::move(set));
         }
-        auto scores = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
-                                           params.stop);
+        auto scores = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs,
+                                           sources, params.stop);
         for (auto& s : scores) s.round = round;
         choice.candidates.insert(choice.candidates.end(), scores.begin(), scores.end());
         const CandidateScore& top = scores[best_of(scores)];
@@ -311,8 +318,8 @@ ElevationChoice best_of_sets(const World* world, const ModelSpec& base, const Ex
                              const analysis::AnalysisParams& analysis, const SourceFactory& sources) {
     ElevationChoice c;
     c.walk_steps = walk.steps.size();
-    c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs, sources,
-                                        params.stop);
+    c.candidates = score_elevation_sets(world, base, walk, sets, params.budget, params.seed, analysis, params.jobs,
+                                        sources, params.stop);
     for (auto& s : c.candidates) s.round = static_cast<int>(s.elevations.size());
     c.chosen = c.candidates[best_of(c.candidates)];
     if (std::isnan(c.chosen.msai)) throw InputError("the exploratory walk gave no bins to measure aliasing on");
@@ -371,7 +378,8 @@ ElevationChoice choose_elevations_on(const ReplaySource& source, const ModelSpec
                                      const analysis::AnalysisParams& analysis,
                                      const std::vector<std::vector<double>>& sets) {
     check_choice(base, sets, params, analysis);
-    if (!source.path || !source.returns) throw InputError("choosing elevations on recorded scans needs their poses and scans");
+    if (!source.path || !source.returns)
+        throw InputError("choosing elevations on recorded scans needs their poses and scans");
     const ExplorationWalk walk{source.path->steps(), source.path->dims()};
     if (walk.steps.size() < 2 || !spreads_beyond(walk, analysis.d_th))
         throw InputError("the recording's " + std::to_string(walk.steps.size()) + " poses never lie more than d_th = " +

@@ -21,15 +21,15 @@
 namespace bvc3d {
 
 struct ChooserParams {
-    int budget = 960;               // BVCs shared by the layers: n_per_axis = budget / (n_dir · layers)
-    int min_layers = 1;             // the greedy search adds layers up to at least this many...
-    int max_layers = 4;             // ...and stops here or when a layer no longer lowers the criterion
-    double elevation_min = 0.0;     // rad, candidate elevations: min, min + step, ... ≤ max
+    int budget = 960;            // BVCs shared by the layers: n_per_axis = budget / (n_dir · layers)
+    int min_layers = 1;          // the greedy search adds layers up to at least this many...
+    int max_layers = 4;          // ...and stops here or when a layer no longer lowers the criterion
+    double elevation_min = 0.0;  // rad, candidate elevations: min, min + step, ... ≤ max
     double elevation_max = 0.4;
     double elevation_step = 0.05;
-    double explore_minutes = 30;    // simulated minutes of the exploratory walk
-    std::uint64_t seed = 0;         // the walk's seed (and the candidates' initial weights)
-    int jobs = 0;                   // threads the candidates are split between; 0: every core
+    double explore_minutes = 30;              // simulated minutes of the exploratory walk
+    std::uint64_t seed = 0;                   // the walk's seed (and the candidates' initial weights)
+    int jobs = 0;                             // threads the candidates are split between; 0: every core
     const std::atomic<bool>* stop = nullptr;  // when set: Interrupted within a few steps
 
     static const params::Table<ChooserParams>& table();
@@ -51,17 +51,17 @@ ChooserDefaults chooser_defaults(const AgentSpec& agent);
 struct CandidateScore {
     std::vector<double> elevations;
     int n_per_axis = 0;
-    int round = 0;                  // the greedy round (= number of layers) that considered it
-    double msai = 0;                // the criterion: lower is better
-    double frac_multimodal = 0;     // shown beside it, not used to choose
-    double bvc_msai = 0;            // the same MSAI over the BVC population's rate maps on the same
-                                    // bins: the input's aliasing, shown, not used (docs/adaptive.md)
+    int round = 0;               // the greedy round (= number of layers) that considered it
+    double msai = 0;             // the criterion: lower is better
+    double frac_multimodal = 0;  // shown beside it, not used to choose
+    double bvc_msai = 0;         // the same MSAI over the BVC population's rate maps on the same
+                                 // bins: the input's aliasing, shown, not used (docs/adaptive.md)
 };
 
 struct ElevationChoice {
-    ModelSpec model;                        // the base model with the chosen layers
+    ModelSpec model;  // the base model with the chosen layers
     CandidateScore chosen;
-    std::vector<CandidateScore> candidates; // every set considered, in the order considered
+    std::vector<CandidateScore> candidates;  // every set considered, in the order considered
     std::size_t walk_steps = 0;
 };
 
@@ -84,8 +84,7 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
 // step (e.g. recorded scans; default: the model's sensor ray-cast in `world`; called from worker
 // threads); the second pass reads the same steps again. `jobs` threads share the sets (0: every core).
 // `stop`, when set, ends the runs with Interrupted.
-std::vector<CandidateScore> score_elevation_sets(const World* world, const ModelSpec& base,
-                                                 const ExplorationWalk& walk,
+std::vector<CandidateScore> score_elevation_sets(const World* world, const ModelSpec& base, const ExplorationWalk& walk,
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis,
                                                  int jobs = 0, const SourceFactory& sources = {},

@@ -97,21 +97,24 @@ private:
         std::fprintf(stderr, "\r  %d/%d trials  %.1f/%.1f simulated hours  %.0f model steps/s  %s%s s       %s",
                      trials_.load(), total_trials_, seconds_.load() / 3600, total_seconds_ / 3600,
                      w > 0 ? static_cast<double>(live_model_steps_.load()) / w : 0.0, final ? "took " : "~",
-                     final ? std::to_string(static_cast<long long>(w + 0.5)).c_str() : left().c_str(), final ? "\n" : "");
+                     final ? std::to_string(static_cast<long long>(w + 0.5)).c_str() : left().c_str(),
+                     final ? "\n" : "");
         std::fflush(stderr);
     }
     // "bvc3d: 3/16 trials done (cross-30_2d_seed0), 0.40/1.60 simulated hours (25%), ~95 s left"
     void line(const std::string& what) {
         std::lock_guard lock(mutex_);
         const double done = std::min(seconds_.load(), total_seconds_);
-        std::string text = "bvc3d: " + std::to_string(trials_.load()) + "/" + std::to_string(total_trials_) + " trials done";
+        std::string text =
+            "bvc3d: " + std::to_string(trials_.load()) + "/" + std::to_string(total_trials_) + " trials done";
         if (!what.empty() && what != "done") text += " (" + what + ")";
         char buf[160];
         if (what == "done") {
             std::snprintf(buf, sizeof buf, ", %.2f simulated hours in %.0f s", total_seconds_ / 3600, wall());
         } else {
             std::snprintf(buf, sizeof buf, ", %.2f/%.2f simulated hours (%.0f%%), ~%s s left", done / 3600,
-                          total_seconds_ / 3600, total_seconds_ > 0 ? 100 * done / total_seconds_ : 100.0, left().c_str());
+                          total_seconds_ / 3600, total_seconds_ > 0 ? 100 * done / total_seconds_ : 100.0,
+                          left().c_str());
         }
         std::fprintf(stderr, "%s%s\n", text.c_str(), buf);
         std::fflush(stderr);
@@ -138,7 +141,8 @@ double group_memory(const std::vector<const TrialConfig*>& group) {
         const double n_place = t->model.place.n_place, n_bvc = t->model.bvc.n_cells();
         const double gridsize = t->analysis.gridsize;
         const double bins = std::min(samples, 1.2 * gridsize * gridsize);  // hexagons visited, at most
-        const double recorded = samples * n_place * sizeof(float) + (t->protocol.record_bvc ? samples * n_bvc * sizeof(float) : 0);
+        const double recorded =
+            samples * n_place * sizeof(float) + (t->protocol.record_bvc ? samples * n_bvc * sizeof(float) : 0);
         const double weights = n_place * n_bvc * sizeof(float);
         const double analysis = 4 * bins * n_place * sizeof(double) + samples * n_place * sizeof(double) / 8;
         const double scan = static_cast<double>(t->model.sensor.beam_count()) * 3 * sizeof(double);
@@ -319,9 +323,9 @@ ExperimentOutcome ExperimentRun::run() {
             }
         });
         // More threads than groups would only wait.
-        const int jobs = static_cast<int>(std::min<std::size_t>(
-            options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency()),
-            std::max<std::size_t>(pending_.size(), 1)));
+        const int jobs = static_cast<int>(
+            std::min<std::size_t>(options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency()),
+                                  std::max<std::size_t>(pending_.size(), 1)));
         {
             std::vector<std::jthread> workers;
             for (int j = 0; j < jobs; ++j) workers.emplace_back([this] { work(); });

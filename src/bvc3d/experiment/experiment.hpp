@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <string>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "bvc3d/config/trial_config.hpp"
@@ -20,10 +20,10 @@ enum class ProgressStyle { none, terminal, lines };
 
 struct ExperimentOptions {
     std::filesystem::path out_dir = "results";
-    int jobs = 0;                              // threads; 0: every core
+    int jobs = 0;  // threads; 0: every core
     ProgressStyle progress = ProgressStyle::none;
-    double checkpoint_minutes = 0;             // periodic checkpoints (simulated minutes); 0: on interrupt only
-    const std::atomic<bool>* stop = nullptr;   // Ctrl-C: checkpoint and stop
+    double checkpoint_minutes = 0;            // periodic checkpoints (simulated minutes); 0: on interrupt only
+    const std::atomic<bool>* stop = nullptr;  // Ctrl-C: checkpoint and stop
     std::function<void(const std::string& name)> on_trial_done;  // called from worker threads
 };
 
@@ -44,8 +44,8 @@ public:
 struct ExperimentOutcome {
     std::vector<std::filesystem::path> files;  // every trial's file, in the order of the trials
     int ran = 0, skipped = 0;
-    std::int64_t steps = 0;                    // walk steps simulated in this run (one per group step)
-    std::int64_t model_steps = 0;              // model updates: walk steps × models sharing the walk
+    std::int64_t steps = 0;        // walk steps simulated in this run (one per group step)
+    std::int64_t model_steps = 0;  // model updates: walk steps × models sharing the walk
     double wall_seconds = 0;
 };
 

@@ -1,8 +1,8 @@
 #include "bvc3d/experiment/pipeline.hpp"
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
+#include <optional>
 
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/core/error.hpp"
@@ -34,7 +34,8 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
     AnalyzedTrial a;
     a.params = t.analysis_params(world);
     const auto& rec = r.models.at(model);
-    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()), rec.n_place);
+    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()),
+                                                        rec.n_place);
     a.metrics = analysis::analyze_trial<float>(sample_positions(r, t.agent->dims()), rates, a.params);
     return a;
 }
@@ -101,16 +102,21 @@ MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::An
     static const analysis::AnalysisParams defaults;
     for (const auto& f : analysis::AnalysisParams::table().fields())
         if (!f.quiet_default || f.get(p) != f.get(defaults)) r.parameters.emplace_back(f.key, f.get(p));
-    if (p.extent) r.arrays.push_back(array("extent", {4}, std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, false));
+    if (p.extent)
+        r.arrays.push_back(array(
+            "extent", {4}, std::vector<double>{p.extent->xmin, p.extent->xmax, p.extent->ymin, p.extent->ymax}, false));
     if (m.dims == 3 && p.volume) {
         const auto& v = *p.volume;
-        r.arrays.push_back(array("volume", {6}, std::vector<double>{v.xmin, v.xmax, v.ymin, v.ymax, v.zmin, v.zmax}, false));
+        r.arrays.push_back(
+            array("volume", {6}, std::vector<double>{v.xmin, v.xmax, v.ymin, v.ymax, v.zmin, v.zmax}, false));
     }
     const auto& bins = m.maps.bins;
     const std::size_t nb = static_cast<std::size_t>(bins.size()), nc = static_cast<std::size_t>(m.maps.map.cols());
     const std::size_t dims = static_cast<std::size_t>(bins.centers.cols());
-    r.arrays.push_back(array("modality", {m.modality.size()}, std::vector<std::int64_t>(m.modality.begin(), m.modality.end())));
-    r.arrays.push_back(array("bin_centers", {nb, dims}, std::vector<double>(bins.centers.data(), bins.centers.data() + nb * dims)));
+    r.arrays.push_back(
+        array("modality", {m.modality.size()}, std::vector<std::int64_t>(m.modality.begin(), m.modality.end())));
+    r.arrays.push_back(
+        array("bin_centers", {nb, dims}, std::vector<double>(bins.centers.data(), bins.centers.data() + nb * dims)));
     r.arrays.push_back(array("bin_counts", {nb}, std::vector<std::int64_t>(bins.counts.begin(), bins.counts.end())));
     r.arrays.push_back(array("sai", {nb}, std::vector<double>(m.aliasing.sai.data(), m.aliasing.sai.data() + nb)));
     std::vector<float> maps(nb * nc);
@@ -126,7 +132,9 @@ MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::An
 analysis::AnalysisParams stored_analysis_params(const TrialFileData& file, const std::filesystem::path& path) {
     analysis::AnalysisParams p = analysis::AnalysisParams::defaults(file.dims);
     const auto& table = analysis::AnalysisParams::table();
-    const auto where = [&](const std::string& name) { return "trial file '" + path.string() + "': attribute '/metrics/" + name + "'"; };
+    const auto where = [&](const std::string& name) {
+        return "trial file '" + path.string() + "': attribute '/metrics/" + name + "'";
+    };
     bool any = false;
     for (const auto& [name, value] : file.metric_attributes) {
         const auto* f = table.find(name);
@@ -184,7 +192,8 @@ bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t
     const auto stamp = read_trial_stamp(path);
     if (!stamp || stamp->fingerprint != t.fingerprint()) return false;
     for (const auto& name : analysis::metric_names(t.agent->dims()))
-        if (std::find(stamp->metric_attributes.begin(), stamp->metric_attributes.end(), name) == stamp->metric_attributes.end())
+        if (std::find(stamp->metric_attributes.begin(), stamp->metric_attributes.end(), name) ==
+            stamp->metric_attributes.end())
             return false;
     return true;
 }

@@ -31,7 +31,8 @@ GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std
 // The recorded positions as N × dims: x, y (and z for 3-D agents).
 analysis::Points sample_positions(const GroupResult& r, int dims);
 // Analyzes one model of a group's result with the trial's parameters.
-AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const GroupResult& result, std::size_t model);
+AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const GroupResult& result,
+                      std::size_t model);
 
 // What a trial file records of a trial: its identity and configuration, and its metrics.
 TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world);

@@ -4,7 +4,8 @@
 
 namespace bvc3d {
 
-ReplaySource recorded_source(std::shared_ptr<const recording::Recording> recording, const RecordedReturnParams& params) {
+ReplaySource recorded_source(std::shared_ptr<const recording::Recording> recording,
+                             const RecordedReturnParams& params) {
     if (recording->size() < 2)
         throw InputError("recording '" + recording->name + "' has " + std::to_string(recording->size()) +
                          " scan; a replay needs at least 2");
@@ -14,8 +15,8 @@ ReplaySource recorded_source(std::shared_ptr<const recording::Recording> recordi
     return s;
 }
 
-ReplaySource simulated_source(const WorldSpec& world, std::shared_ptr<const TrajectorySpec> path, const LidarSpec& sensor,
-                              const RecordedReturnParams& params) {
+ReplaySource simulated_source(const WorldSpec& world, std::shared_ptr<const TrajectorySpec> path,
+                              const LidarSpec& sensor, const RecordedReturnParams& params) {
     ReplaySource s;
     s.world = world;
     s.path = std::move(path);

@@ -24,8 +24,8 @@ struct ReplaySource {
 // A recording: no world, its own poses as the path.
 ReplaySource recorded_source(std::shared_ptr<const recording::Recording> recording, const RecordedReturnParams& params);
 // A simulated sensor along a path in a world, preprocessed like a recording.
-ReplaySource simulated_source(const WorldSpec& world, std::shared_ptr<const TrajectorySpec> path, const LidarSpec& sensor,
-                              const RecordedReturnParams& params);
+ReplaySource simulated_source(const WorldSpec& world, std::shared_ptr<const TrajectorySpec> path,
+                              const LidarSpec& sensor, const RecordedReturnParams& params);
 
 // The trial that replays `source` through `model`: one model step per scan, every step recorded
 // with its BVC rates; place cells learn when `learn` (the online protocol), else stay frozen

@@ -112,10 +112,12 @@ int GroupRun::use_source(const ModelSpec& model, const SourceFactory& factory) {
     }
     if (!made) {
         if (!world)
-            throw InputError("model '" + model.name + "' has no source of returns: without a world its sensor cannot be cast");
+            throw InputError("model '" + model.name +
+                             "' has no source of returns: without a world its sensor cannot be cast");
         // Sensor noise: the trial's own stream, the same draws for every sensor of the group (common
         // random numbers: conditions that differ in their noise level see the same underlying draws).
-        const std::uint64_t noise_seed = hash_u64(trials.front().seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
+        const std::uint64_t noise_seed =
+            hash_u64(trials.front().seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
         made = std::make_shared<RayCastSource>(*world, model.sensor, noise_seed);
     }
     const LidarSpec* table = made->beam_table();
@@ -139,7 +141,8 @@ void GroupRun::share_sums() {
                 if (std::find(all.elevations.begin(), all.elevations.end(), psi) == all.elevations.end())
                     all.elevations.push_back(psi);
         // Alone, or too many layers to sum at once: each sums its own.
-        if (g.models.size() < 2 || static_cast<double>(all.elevations.size()) * all.n_dir * all.n_per_axis > BvcParams::max_cells)
+        if (g.models.size() < 2 ||
+            static_cast<double>(all.elevations.size()) * all.n_dir * all.n_per_axis > BvcParams::max_cells)
             continue;
         g.layer = std::make_unique<BoundaryVectorLayer>(all);
         g.plan = g.layer->plan(*sources[g.source].source->beam_table());
@@ -232,9 +235,9 @@ GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) const {
     c.saved = ckpt_saved;
     c.partial.stats = result.stats;
     const auto from = static_cast<std::ptrdiff_t>(ckpt_saved);
-    for (auto [to, all] : {std::pair{&c.partial.t, &result.t}, std::pair{&c.partial.x, &result.x},
-                           std::pair{&c.partial.y, &result.y}, std::pair{&c.partial.z, &result.z},
-                           std::pair{&c.partial.heading, &result.heading}})
+    for (auto [to, all] :
+         {std::pair{&c.partial.t, &result.t}, std::pair{&c.partial.x, &result.x}, std::pair{&c.partial.y, &result.y},
+          std::pair{&c.partial.z, &result.z}, std::pair{&c.partial.heading, &result.heading}})
         to->assign(all->begin() + from, all->end());
     for (std::size_t i = 0; i < nets.size(); ++i) {
         const auto& rec = result.models[i];
@@ -255,7 +258,8 @@ void GroupRun::restore(const GroupCheckpoint& c) {
     // Everything is checked before anything changes: a checkpoint that does not fit leaves the run
     // as it was, to start from the beginning.
     const auto mismatch = [] { throw InputError("its arrays do not match the group's models"); };
-    if (c.partial.models.size() != nets.size() || c.membrane.size() != nets.size() || c.place_rates.size() != nets.size())
+    if (c.partial.models.size() != nets.size() || c.membrane.size() != nets.size() ||
+        c.place_rates.size() != nets.size())
         mismatch();
     for (std::size_t i = 0; i < nets.size(); ++i) {
         const auto& m = c.partial.models[i];
@@ -334,8 +338,9 @@ GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& 
         if (!s) {
             if (sampling) break;
             if (run.agent->finished())
-                throw InputError("the agent's path ends after " + format_number(run.agent->time() / 3600) +
-                                 " h, before the recorded phase begins (explore_hours = " + format_number(p.explore_hours) + ")");
+                throw InputError(
+                    "the agent's path ends after " + format_number(run.agent->time() / 3600) +
+                    " h, before the recorded phase begins (explore_hours = " + format_number(p.explore_hours) + ")");
             continue;  // exploration is over: go on sampling from here
         }
         run.step(*s, !sampling || online, sampling);

@@ -23,11 +23,11 @@
 namespace bvc3d {
 
 struct RunControl {
-    const std::atomic<bool>* stop = nullptr;            // checked every few steps
+    const std::atomic<bool>* stop = nullptr;                                     // checked every few steps
     std::function<void(double seconds_done, std::int64_t steps_done)> progress;  // every progress_every steps
-    std::int64_t progress_every = 512;                  // a replay's steps are few and slow: every step
-    std::filesystem::path checkpoint;                   // empty: no checkpoints
-    double checkpoint_minutes = 0;                      // > 0: also every this many simulated minutes
+    std::int64_t progress_every = 512;  // a replay's steps are few and slow: every step
+    std::filesystem::path checkpoint;   // empty: no checkpoints
+    double checkpoint_minutes = 0;      // > 0: also every this many simulated minutes
     // Warnings (a checkpoint that cannot be used, ...); default: a line on standard error.
     std::function<void(const std::string& message)> warn;
 };

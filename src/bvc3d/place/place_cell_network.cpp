@@ -65,8 +65,8 @@ void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, 
     // leaves it as it is (a sum of floats from +0 is never −0): summing the active ones is the sum.
     float previous = 0;
     for (int i : active_) previous += v_[i];
-    const float inhibition = static_cast<float>(p_.gamma_pb) * kernels::sum8(vb, stride_) +
-                             static_cast<float>(p_.gamma_pp) * previous;
+    const float inhibition =
+        static_cast<float>(p_.gamma_pb) * kernels::sum8(vb, stride_) + static_cast<float>(p_.gamma_pp) * previous;
     // tanh(g·[s]+); for a silent cell (the argument ±0, or NaN) the argument is its own tanh.
     bool finite = false;
     active_.resize(s_.size());
@@ -75,8 +75,10 @@ void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, 
     for (int i : active_) v_[i] = std::tanh(v_[i]);
     // Weights that ran away (a learning rate far too large) show up here first: stop early.
     if (!std::isfinite(inhibition) || !finite)
-        throw InputError("place cells diverged (non-finite membrane potentials): the weights ran away; is the "
-                         "learning rate eta = " + std::to_string(p_.eta) + " too large?");
+        throw InputError(
+            "place cells diverged (non-finite membrane potentials): the weights ran away; is the "
+            "learning rate eta = " +
+            std::to_string(p_.eta) + " too large?");
     if (!learn || !(p_.eta > 0)) return;
     // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
     const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
@@ -127,7 +129,8 @@ std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_
 std::vector<float> PlaceCellNetwork::weights() const {
     std::vector<float> out(static_cast<std::size_t>(p_.n_place) * n_bvc_);
     for (int i = 0; i < p_.n_place; ++i)
-        for (int j = 0; j < n_bvc_; ++j) out[static_cast<std::size_t>(i) * n_bvc_ + j] = row(i)[kernels::paired_column(j)];
+        for (int j = 0; j < n_bvc_; ++j)
+            out[static_cast<std::size_t>(i) * n_bvc_ + j] = row(i)[kernels::paired_column(j)];
     return out;
 }
 
@@ -137,7 +140,8 @@ void PlaceCellNetwork::set_weights(std::span<const float> w) {
     for (float x : w)
         if (!std::isfinite(x)) throw InputError("place cells: weights must be finite");
     for (int i = 0; i < p_.n_place; ++i)
-        for (int j = 0; j < n_bvc_; ++j) row(i)[kernels::paired_column(j)] = flush_tiny(w[static_cast<std::size_t>(i) * n_bvc_ + j]);
+        for (int j = 0; j < n_bvc_; ++j)
+            row(i)[kernels::paired_column(j)] = flush_tiny(w[static_cast<std::size_t>(i) * n_bvc_ + j]);
 }
 
 void PlaceCellNetwork::reset() {
@@ -147,7 +151,8 @@ void PlaceCellNetwork::reset() {
 }
 
 void PlaceCellNetwork::set_state(std::span<const float> membrane, std::span<const float> rates) {
-    if (membrane.size() != s_.size() || rates.size() != v_.size()) throw InputError("place cells: state has the wrong size");
+    if (membrane.size() != s_.size() || rates.size() != v_.size())
+        throw InputError("place cells: state has the wrong size");
     std::copy(membrane.begin(), membrane.end(), s_.begin());
     std::copy(rates.begin(), rates.end(), v_.begin());
     active_.clear();  // any cell may be active: every rate other than ±0

@@ -12,19 +12,19 @@
 #include <span>
 #include <vector>
 
-#include "bvc3d/core/params.hpp"
 #include "bvc3d/core/aligned.hpp"
+#include "bvc3d/core/params.hpp"
 
 namespace bvc3d {
 
 struct PlaceParams {
     int n_place = 250;
-    double p_connect = 0.25;    // initial weights are Bernoulli(p_connect)
-    double dt_over_tau = 0.5;   // Δt/τ_p
-    double gamma_pb = 0.3;      // feedforward inhibition
-    double gamma_pp = 0.5;      // recurrent inhibition
-    double gain = 1.0;          // g in v = tanh(g·[s]+)
-    double eta = 0.096;         // learning rate Δt/τ_W
+    double p_connect = 0.25;                // initial weights are Bernoulli(p_connect)
+    double dt_over_tau = 0.5;               // Δt/τ_p
+    double gamma_pb = 0.3;                  // feedforward inhibition
+    double gamma_pp = 0.5;                  // recurrent inhibition
+    double gain = 1.0;                      // g in v = tanh(g·[s]+)
+    double eta = 0.096;                     // learning rate Δt/τ_W
     double alpha_pb = 0.70710678118654752;  // √0.5
     static const params::Table<PlaceParams>& table();
     void validate() const { table().check(*this); }

@@ -9,7 +9,8 @@ using simd::f8;
 namespace {
 template <class V>
 inline float reduce8(const V& acc, int f) {
-    return ((acc[f] + acc[f + 1]) + (acc[f + 2] + acc[f + 3])) + ((acc[f + 4] + acc[f + 5]) + (acc[f + 6] + acc[f + 7]));
+    return ((acc[f] + acc[f + 1]) + (acc[f + 2] + acc[f + 3])) +
+           ((acc[f + 4] + acc[f + 5]) + (acc[f + 6] + acc[f + 7]));
 }
 
 template <int N>
@@ -66,8 +67,9 @@ template <int N, int P, int T>
 
 // One row of tiles: T steps of every pair, PB pairs at a time, then the pairs left one by one.
 template <int N, int PB, int T>
-[[gnu::always_inline]] inline void tile_row(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride,
-                                            std::size_t n, int pairs, float* out, std::size_t out_stride) {
+[[gnu::always_inline]] inline void tile_row(const float* W, std::size_t pair_stride, const float* v,
+                                            std::size_t v_stride, std::size_t n, int pairs, float* out,
+                                            std::size_t out_stride) {
     int p = 0;
     for (; p + PB <= pairs; p += PB)
         tile<N, PB, T>(W + p * pair_stride, pair_stride, v, v_stride, n, out + 2 * p, out_stride);
@@ -105,9 +107,12 @@ void paired_products(const float* W, std::size_t pair_stride, const float* v, st
                      int pairs, int steps, float* out, std::size_t out_stride) {
 #if BVC3D_HAVE_DISPATCH
     switch (simd::isa()) {
-        case simd::Isa::v4: return products_v4(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
-        case simd::Isa::v3: return products_v3(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
-        case simd::Isa::baseline: break;
+        case simd::Isa::v4:
+            return products_v4(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
+        case simd::Isa::v3:
+            return products_v3(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);
+        case simd::Isa::baseline:
+            break;
     }
 #endif
     products<8, 4, 1, 2>(W, pair_stride, v, v_stride, n, pairs, steps, out, out_stride);

@@ -29,8 +29,8 @@ float sum8(const float* v, std::size_t n);
 // v[i] = gain·max(s[i], 0) (the caller takes tanh of the cells with s[i] > 0). Lists those cells'
 // indices in `positive` (room for n), in order, and returns how many; *finite is false when some s[i]
 // is not finite. Each cell's operations are the scalar ones, in the same order.
-std::size_t membrane_step(float* s, const float* drive, std::size_t n, float k, float inhibition, float gain,
-                          float* v, int* positive, bool* finite);
+std::size_t membrane_step(float* s, const float* drive, std::size_t n, float k, float inhibition, float gain, float* v,
+                          int* positive, bool* finite);
 // Oja's update of one row in the paired layout (w: its first block; its blocks are 16 floats apart):
 // w[j] += a·(v[j] - c·w[j]), a result smaller than `tiny` in magnitude stored as 0; n a multiple of 8.
 void oja_row(float* w, const float* v, float a, float c, float tiny, std::size_t n);

@@ -51,7 +51,8 @@ void read_segment(const std::filesystem::path& path, GroupResult& r) {
     auto lock = h5::hdf5_lock();
     try {
         const auto f = h5::open_file(path.string());
-        if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint-segment") throw InputError("not a checkpoint segment");
+        if (h5::read_attr_string(f, "format") != "bvc3d-checkpoint-segment")
+            throw InputError("not a checkpoint segment");
         append(r.t, h5::read_doubles(f, "t"));
         append(r.x, h5::read_doubles(f, "x"));
         append(r.y, h5::read_doubles(f, "y"));
@@ -109,7 +110,9 @@ void write_checkpoint(const std::filesystem::path& path, GroupCheckpoint& c) {
 CheckpointRead read_checkpoint(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return {};
-    const auto broken = [&](const std::string& why) { return CheckpointRead{std::nullopt, "checkpoint '" + path.string() + "' " + why}; };
+    const auto broken = [&](const std::string& why) {
+        return CheckpointRead{std::nullopt, "checkpoint '" + path.string() + "' " + why};
+    };
     GroupCheckpoint c;
     try {
         auto lock = h5::hdf5_lock();
@@ -156,8 +159,7 @@ CheckpointRead read_checkpoint(const std::filesystem::path& path) {
 void remove_checkpoint(const std::filesystem::path& path) {
     std::error_code ec;
     std::filesystem::remove(path, ec);
-    for (std::size_t k = 0; std::filesystem::remove(segment_path(path, k), ec); ++k) {
-    }
+    for (std::size_t k = 0; std::filesystem::remove(segment_path(path, k), ec); ++k) {}
 }
 
 }  // namespace bvc3d

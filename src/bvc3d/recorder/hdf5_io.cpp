@@ -32,7 +32,8 @@ void write_any(hid_t loc, const std::string& name, const std::vector<T>& v, std:
     for (auto d : shape) n *= d;
     if (n != v.size()) throw std::logic_error("HDF5 write: shape does not match data for " + name);
     std::vector<hsize_t> hd(shape.begin(), shape.end());
-    Handle space(check(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), "dataspace " + name), H5Sclose);
+    Handle space(check(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), "dataspace " + name),
+                 H5Sclose);
     Handle dcpl(check(H5Pcreate(H5P_DATASET_CREATE), "plist"), H5Pclose);
     check(H5Pset_obj_track_times(dcpl, false), "track times");
     if (compress && n > 0) {
@@ -65,7 +66,8 @@ std::vector<T> read_any(hid_t loc, const std::string& name, hid_t mem_type) {
 
 Handle attr_for_write(hid_t obj, const std::string& name, hid_t type, hid_t space) {
     if (H5Aexists(obj, name.c_str()) > 0) check(H5Adelete(obj, name.c_str()), "delete attribute " + name);
-    return Handle(check(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), "attribute " + name), H5Aclose);
+    return Handle(check(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), "attribute " + name),
+                  H5Aclose);
 }
 
 }  // namespace
@@ -116,8 +118,9 @@ std::string file_image(hid_t file) {
 
 Handle open_file(const std::string& path) {
     auto lock = hdf5_lock();
-    return Handle(check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "cannot open '" + path + "' as an HDF5 file"),
-                  H5Fclose);
+    return Handle(
+        check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "cannot open '" + path + "' as an HDF5 file"),
+        H5Fclose);
 }
 
 Handle create_group(hid_t loc, const std::string& name) {
@@ -257,10 +260,14 @@ params::Value read_attr(hid_t obj, const std::string& name) {
     Handle a(check(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "no attribute '" + name + "'"), H5Aclose);
     Handle type(check(H5Aget_type(a), "type"), H5Tclose);
     switch (H5Tget_class(type)) {
-        case H5T_STRING: return read_attr_string(obj, name);
-        case H5T_INTEGER: return static_cast<long long>(read_attr_int(obj, name));
-        case H5T_FLOAT: return read_attr_double(obj, name);
-        default: fail("attribute '" + name + "' is neither a number nor text");
+        case H5T_STRING:
+            return read_attr_string(obj, name);
+        case H5T_INTEGER:
+            return static_cast<long long>(read_attr_int(obj, name));
+        case H5T_FLOAT:
+            return read_attr_double(obj, name);
+        default:
+            fail("attribute '" + name + "' is neither a number nor text");
     }
 }
 
@@ -307,15 +314,24 @@ Element element(hid_t loc, const std::string& name) {
     Handle ds(check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), "no dataset '" + name + "'"), H5Dclose);
     Handle type(check(H5Dget_type(ds), "type " + name), H5Tclose);
     switch (H5Tget_class(type)) {
-        case H5T_FLOAT: return H5Tget_size(type) <= 4 ? Element::f32 : Element::f64;
-        case H5T_INTEGER: return Element::integer;
-        default: return Element::other;
+        case H5T_FLOAT:
+            return H5Tget_size(type) <= 4 ? Element::f32 : Element::f64;
+        case H5T_INTEGER:
+            return Element::integer;
+        default:
+            return Element::other;
     }
 }
 
-std::vector<double> read_doubles(hid_t loc, const std::string& n) { return read_any<double>(loc, n, H5T_NATIVE_DOUBLE); }
+std::vector<double> read_doubles(hid_t loc, const std::string& n) {
+    return read_any<double>(loc, n, H5T_NATIVE_DOUBLE);
+}
 std::vector<float> read_floats(hid_t loc, const std::string& n) { return read_any<float>(loc, n, H5T_NATIVE_FLOAT); }
-std::vector<std::int64_t> read_ints(hid_t loc, const std::string& n) { return read_any<std::int64_t>(loc, n, H5T_NATIVE_INT64); }
-std::vector<std::uint8_t> read_bytes(hid_t loc, const std::string& n) { return read_any<std::uint8_t>(loc, n, H5T_NATIVE_UINT8); }
+std::vector<std::int64_t> read_ints(hid_t loc, const std::string& n) {
+    return read_any<std::int64_t>(loc, n, H5T_NATIVE_INT64);
+}
+std::vector<std::uint8_t> read_bytes(hid_t loc, const std::string& n) {
+    return read_any<std::uint8_t>(loc, n, H5T_NATIVE_UINT8);
+}
 
 }  // namespace bvc3d::h5

@@ -37,8 +37,8 @@ private:
 // writes file_image() itself, so a full disk is reported with its reason (AtomicFile) and never
 // leaves HDF5 holding a half-written file. `name` must be unique among open files.
 Handle create_memory_file(const std::string& name);
-std::string file_image(hid_t file);  // the bytes of the file as it stands (flushed first)
-Handle open_file(const std::string& path);    // read-only
+std::string file_image(hid_t file);         // the bytes of the file as it stands (flushed first)
+Handle open_file(const std::string& path);  // read-only
 Handle create_group(hid_t loc, const std::string& name);
 Handle open_group(hid_t loc, const std::string& name);
 bool exists(hid_t loc, const std::string& name);
@@ -65,10 +65,14 @@ std::vector<std::string> attribute_names(hid_t obj);
 
 // Row-major datasets of 1 or 2 dimensions; chunked and compressed when `compress` (for h5py users
 // this is transparent).
-void write(hid_t loc, const std::string& name, const std::vector<double>& v, std::vector<std::size_t> dims, bool compress = true);
-void write(hid_t loc, const std::string& name, const std::vector<float>& v, std::vector<std::size_t> dims, bool compress = true);
-void write(hid_t loc, const std::string& name, const std::vector<std::int64_t>& v, std::vector<std::size_t> dims, bool compress = true);
-void write(hid_t loc, const std::string& name, const std::vector<std::uint8_t>& v, std::vector<std::size_t> dims, bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<double>& v, std::vector<std::size_t> dims,
+           bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<float>& v, std::vector<std::size_t> dims,
+           bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<std::int64_t>& v, std::vector<std::size_t> dims,
+           bool compress = true);
+void write(hid_t loc, const std::string& name, const std::vector<std::uint8_t>& v, std::vector<std::size_t> dims,
+           bool compress = true);
 
 std::vector<std::size_t> dims(hid_t loc, const std::string& name);
 // What a dataset's elements are, for readers that take any stored type.

@@ -67,7 +67,8 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         h5::write(s, "heading", group.heading, {n});
         h5::write(s, "rates", rec.rates, {n, static_cast<std::size_t>(rec.n_place)});
         if (!rec.bvc.empty()) h5::write(s, "bvc_rates", rec.bvc, {n, static_cast<std::size_t>(rec.n_bvc)});
-        h5::write(f, "weights", rec.weights, {static_cast<std::size_t>(rec.n_place), static_cast<std::size_t>(rec.n_bvc)});
+        h5::write(f, "weights", rec.weights,
+                  {static_cast<std::size_t>(rec.n_place), static_cast<std::size_t>(rec.n_bvc)});
 
         const auto w = h5::create_group(f, "walk");
         h5::write_attr(w, "explore_steps", group.stats.explore_steps);
@@ -108,7 +109,8 @@ std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
         if (h5::read_attr_string(f, "format") != "bvc3d-trial") return std::nullopt;
         version = format_version(f);
         if (h5::exists(f, "metrics"))
-            stamp = TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
+            stamp =
+                TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
     } catch (const InputError&) {
         return std::nullopt;
     }
@@ -136,11 +138,13 @@ public:
             fail("is not a bvc3d trial file (its 'format' attribute is not 'bvc3d-trial')");
         // Files of the first version may lack the attribute.
         if (h5::exists_attr(file_, "format_version")) {
-            if (h5::attr_class(file_, "format_version") != H5T_INTEGER) fail("attribute 'format_version' is not an integer");
+            if (h5::attr_class(file_, "format_version") != H5T_INTEGER)
+                fail("attribute 'format_version' is not an integer");
             const auto version = h5::read_attr_int(file_, "format_version");
             if (version < 1 || version > trial_file_format_version)
-                fail("format_version " + std::to_string(version) + " is not supported (this bvc3d reads versions 1 to " +
-                     std::to_string(trial_file_format_version) + (version > trial_file_format_version ? "; a newer bvc3d wrote it)" : ")"));
+                fail("format_version " + std::to_string(version) +
+                     " is not supported (this bvc3d reads versions 1 to " + std::to_string(trial_file_format_version) +
+                     (version > trial_file_format_version ? "; a newer bvc3d wrote it)" : ")"));
         }
     }
 
@@ -182,13 +186,15 @@ public:
     }
 
     // A float dataset of `rank` dimensions, its shape checked by the caller.
-    std::vector<std::size_t> shape(hid_t loc, const std::string& where, const std::string& name, std::size_t rank) const {
+    std::vector<std::size_t> shape(hid_t loc, const std::string& where, const std::string& name,
+                                   std::size_t rank) const {
         if (!h5::exists(loc, name)) fail(": dataset '" + where + name + "' is missing");
         const auto c = guarded("dataset '" + where + name + "'", [&] { return h5::dataset_class(loc, name); });
         if (c != H5T_FLOAT) fail(": dataset '" + where + name + "' does not hold floating-point numbers");
         const auto d = guarded("dataset '" + where + name + "'", [&] { return h5::dims(loc, name); });
         if (d.size() != rank)
-            fail(": dataset '" + where + name + "' has " + std::to_string(d.size()) + " dimensions, not " + std::to_string(rank));
+            fail(": dataset '" + where + name + "' has " + std::to_string(d.size()) + " dimensions, not " +
+                 std::to_string(rank));
         return d;
     }
     template <class T>
@@ -239,7 +245,8 @@ TrialIdentity read_identity(const TrialReader& r) {
 std::optional<std::vector<double>> read_extent(const TrialReader& r, hid_t metrics) {
     if (!h5::exists(metrics, "extent")) return std::nullopt;
     const auto d = r.shape(metrics, "/metrics/", "extent", 1);
-    if (d[0] != 4) r.fail(": dataset '/metrics/extent' holds " + std::to_string(d[0]) + " values, not 4 (xmin, xmax, ymin, ymax)");
+    if (d[0] != 4)
+        r.fail(": dataset '/metrics/extent' holds " + std::to_string(d[0]) + " values, not 4 (xmin, xmax, ymin, ymax)");
     const auto e = r.finite<double>(metrics, "/metrics/", "extent");
     if (!(e[0] < e[1] && e[2] < e[3])) r.fail(": dataset '/metrics/extent' needs xmin < xmax and ymin < ymax");
     return e;
@@ -254,18 +261,20 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     static_cast<TrialIdentity&>(d) = read_identity(r);
     const auto g = r.group("metrics");
     for (const auto& name : r.guarded("group '/metrics'", [&] { return h5::attribute_names(g); }))
-        d.metric_attributes.emplace_back(name, r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
+        d.metric_attributes.emplace_back(
+            name, r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
     d.extent = read_extent(r, g);
     if (h5::exists(g, "volume")) d.volume = r.finite<double>(g, "/metrics/", "volume");
     const auto s = r.group("samples");
     const auto nx = r.shape(s, "/samples/", "x", 1)[0];
-    if (r.shape(s, "/samples/", "y", 1)[0] != nx)
-        r.fail(": datasets '/samples/x' and '/samples/y' differ in length");
+    if (r.shape(s, "/samples/", "y", 1)[0] != nx) r.fail(": datasets '/samples/x' and '/samples/y' differ in length");
     const bool has_z = h5::exists(s, "z");
-    if (has_z && r.shape(s, "/samples/", "z", 1)[0] != nx) r.fail(": dataset '/samples/z' differs in length from '/samples/x'");
+    if (has_z && r.shape(s, "/samples/", "z", 1)[0] != nx)
+        r.fail(": dataset '/samples/z' differs in length from '/samples/x'");
     const auto rates = r.shape(s, "/samples/", "rates", 2);
     if (rates[0] != nx)
-        r.fail(": dataset '/samples/rates' has " + std::to_string(rates[0]) + " rows for " + std::to_string(nx) + " samples");
+        r.fail(": dataset '/samples/rates' has " + std::to_string(rates[0]) + " rows for " + std::to_string(nx) +
+               " samples");
     if (rates[1] < 1) r.fail(": dataset '/samples/rates' has no cells");
     d.x = r.finite<double>(s, "/samples/", "x");
     d.y = r.finite<double>(s, "/samples/", "y");
@@ -291,7 +300,8 @@ TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc) {
             r.fail(": dataset '/samples/" + k + "' differs in length from '/samples/x'");
     const auto dims = r.shape(s, "/samples/", name, 2);
     if (dims[0] != n)
-        r.fail(": dataset '/samples/" + name + "' has " + std::to_string(dims[0]) + " rows for " + std::to_string(n) + " samples");
+        r.fail(": dataset '/samples/" + name + "' has " + std::to_string(dims[0]) + " rows for " + std::to_string(n) +
+               " samples");
     TrialRates out;
     out.t = r.finite<double>(s, "/samples/", "t");
     out.x = r.finite<double>(s, "/samples/", "x");
@@ -333,9 +343,15 @@ std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, co
     if (rest.empty() || !h5::exists(loc, rest)) return std::nullopt;
     NamedArray a{dataset, h5::dims(loc, rest), {}, true};
     switch (h5::element(loc, rest)) {
-        case h5::Element::f64: a.data = h5::read_doubles(loc, rest); break;
-        case h5::Element::f32: a.data = h5::read_floats(loc, rest); break;
-        case h5::Element::integer: a.data = h5::read_ints(loc, rest); break;
+        case h5::Element::f64:
+            a.data = h5::read_doubles(loc, rest);
+            break;
+        case h5::Element::f32:
+            a.data = h5::read_floats(loc, rest);
+            break;
+        case h5::Element::integer:
+            a.data = h5::read_ints(loc, rest);
+            break;
         case h5::Element::other:
             throw InputError("'" + path.string() + "': dataset '" + dataset + "' holds neither numbers nor integers");
     }
@@ -353,7 +369,8 @@ TrialSummaryRow read_trial_summary(const std::filesystem::path& path, const std:
     for (const auto& name : parameter_names) {
         std::string value = "(not recorded)";
         if (h5::exists_attr(g, name))
-            value = params::to_text(r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
+            value =
+                params::to_text(r.guarded("attribute '/metrics/" + name + "'", [&] { return h5::read_attr(g, name); }));
         row.parameters.emplace_back(name, value);
     }
     std::string extent = "data";

@@ -22,7 +22,9 @@ namespace bvc3d {
 inline constexpr int trial_file_format_version = 2;
 inline constexpr int trial_file_format_version_2d = 1;
 // The version a trial of positions with `dims` coordinates is written with.
-inline int trial_file_version_for(int dims) { return dims == 3 ? trial_file_format_version : trial_file_format_version_2d; }
+inline int trial_file_version_for(int dims) {
+    return dims == 3 ? trial_file_format_version : trial_file_format_version_2d;
+}
 
 // Which trial a file holds and how it was configured (the root attributes).
 struct TrialIdentity {
@@ -72,10 +74,10 @@ std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path);
 // a format_version this code does not read.
 struct TrialFileData : TrialIdentity {
     std::vector<std::pair<std::string, params::Value>> metric_attributes;  // everything under /metrics
-    std::optional<std::vector<double>> extent;                          // /metrics/extent, if fixed
-    std::optional<std::vector<double>> volume;                          // /metrics/volume (3-D trials)
-    std::vector<double> x, y, z;                                        // z empty for ground trials
-    std::vector<float> rates;                                           // samples × n_place
+    std::optional<std::vector<double>> extent;                             // /metrics/extent, if fixed
+    std::optional<std::vector<double>> volume;                             // /metrics/volume (3-D trials)
+    std::vector<double> x, y, z;                                           // z empty for ground trials
+    std::vector<float> rates;                                              // samples × n_place
     std::size_t n_place = 0;
 };
 TrialFileData read_trial_samples(const std::filesystem::path& path);  // throws InputError

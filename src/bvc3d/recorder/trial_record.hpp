@@ -32,7 +32,7 @@ struct GroupCheckpoint {
     std::string fingerprint;  // of the group's configuration
     std::string agent_state;  // Agent::save_state()
     std::int64_t step_index = 0;
-    GroupResult partial;  // samples (see below); per model the current weights
+    GroupResult partial;                                    // samples (see below); per model the current weights
     std::vector<std::vector<float>> membrane, place_rates;  // per model
     // On disk the samples sit in `segments` files holding the first `saved` of them. When writing,
     // `partial` holds only the samples after those; when read back, all of them.

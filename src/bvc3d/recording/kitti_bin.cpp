@@ -2,8 +2,8 @@
 
 #include <string>
 
-#include "bvc3d/recording/cloud_builder.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/recording/cloud_builder.hpp"
 #include "bvc3d/recording/file_io.hpp"
 #include "bvc3d/recording/parsing.hpp"
 

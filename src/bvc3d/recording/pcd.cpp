@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "bvc3d/recording/cloud_builder.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/recording/cloud_builder.hpp"
 #include "bvc3d/recording/file_io.hpp"
 #include "bvc3d/recording/parsing.hpp"
 
@@ -410,9 +410,15 @@ void append_compressed(const fs::path& file, std::string& out, const std::string
 template <class T>
 void append_points(const fs::path& file, std::string& out, const PointCloud& cloud, PcdEncoding encoding) {
     switch (encoding) {
-        case PcdEncoding::ascii: append_text_points<T>(out, cloud.xyz); break;
-        case PcdEncoding::binary: append_binary_points<T>(out, cloud.xyz, ByteOrder::little); break;
-        case PcdEncoding::binary_compressed: append_compressed(file, out, by_field<T>(cloud.xyz)); break;
+        case PcdEncoding::ascii:
+            append_text_points<T>(out, cloud.xyz);
+            break;
+        case PcdEncoding::binary:
+            append_binary_points<T>(out, cloud.xyz, ByteOrder::little);
+            break;
+        case PcdEncoding::binary_compressed:
+            append_compressed(file, out, by_field<T>(cloud.xyz));
+            break;
     }
 }
 
@@ -422,9 +428,12 @@ PointCloud read_pcd(const fs::path& file) {
     const std::string bytes = read_file(file);
     const PcdHeader header = parse_header(file, bytes);
     switch (header.data) {
-        case PcdData::ascii: return read_ascii(file, bytes, header);
-        case PcdData::binary: return read_binary(file, bytes, header);
-        case PcdData::binary_compressed: return read_compressed(file, bytes, header);
+        case PcdData::ascii:
+            return read_ascii(file, bytes, header);
+        case PcdData::binary:
+            return read_binary(file, bytes, header);
+        case PcdData::binary_compressed:
+            return read_compressed(file, bytes, header);
     }
     throw input_error(file, "unknown DATA encoding");
 }

@@ -8,8 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "bvc3d/recording/cloud_builder.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/recording/cloud_builder.hpp"
 #include "bvc3d/recording/file_io.hpp"
 #include "bvc3d/recording/parsing.hpp"
 
@@ -37,13 +37,17 @@ std::optional<Scalar> scalar_named(std::string_view name) {
 std::uint64_t size_of(Scalar type) {
     switch (type) {
         case Scalar::int8:
-        case Scalar::uint8: return 1;
+        case Scalar::uint8:
+            return 1;
         case Scalar::int16:
-        case Scalar::uint16: return 2;
+        case Scalar::uint16:
+            return 2;
         case Scalar::int32:
         case Scalar::uint32:
-        case Scalar::float32: return 4;
-        case Scalar::float64: return 8;
+        case Scalar::float32:
+            return 4;
+        case Scalar::float64:
+            return 8;
     }
     return 0;
 }
@@ -53,13 +57,20 @@ bool is_integer(Scalar type) { return type != Scalar::float32 && type != Scalar:
 // A list length as stored: any integer type, possibly signed (and then possibly negative).
 std::int64_t load_length(const char* bytes, Scalar type, ByteOrder order) {
     switch (type) {
-        case Scalar::int8: return load<std::int8_t>(bytes, order);
-        case Scalar::uint8: return load<std::uint8_t>(bytes, order);
-        case Scalar::int16: return load<std::int16_t>(bytes, order);
-        case Scalar::uint16: return load<std::uint16_t>(bytes, order);
-        case Scalar::int32: return load<std::int32_t>(bytes, order);
-        case Scalar::uint32: return load<std::uint32_t>(bytes, order);
-        default: return -1;  // the header allows only integer list lengths
+        case Scalar::int8:
+            return load<std::int8_t>(bytes, order);
+        case Scalar::uint8:
+            return load<std::uint8_t>(bytes, order);
+        case Scalar::int16:
+            return load<std::int16_t>(bytes, order);
+        case Scalar::uint16:
+            return load<std::uint16_t>(bytes, order);
+        case Scalar::int32:
+            return load<std::int32_t>(bytes, order);
+        case Scalar::uint32:
+            return load<std::uint32_t>(bytes, order);
+        default:
+            return -1;  // the header allows only integer list lengths
     }
 }
 

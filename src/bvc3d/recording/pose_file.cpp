@@ -176,10 +176,14 @@ std::vector<PoseRecord> read_poses(const fs::path& file, PoseFormat format) {
     const std::vector<NumberLine> lines = read_pose_lines(file);
     if (format == PoseFormat::detect) format = detect(file, lines);
     switch (format) {
-        case PoseFormat::kitti: return parse_kitti(file, lines);
-        case PoseFormat::tum: return parse_tum(file, lines);
-        case PoseFormat::matrix: return parse_matrix(file, lines);
-        case PoseFormat::detect: break;
+        case PoseFormat::kitti:
+            return parse_kitti(file, lines);
+        case PoseFormat::tum:
+            return parse_tum(file, lines);
+        case PoseFormat::matrix:
+            return parse_matrix(file, lines);
+        case PoseFormat::detect:
+            break;
     }
     throw input_error(file, "unknown pose format");
 }

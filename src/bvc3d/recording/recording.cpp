@@ -95,9 +95,12 @@ namespace {
 const char* extension(ScanWriteFormat f) {
     switch (f) {
         case ScanWriteFormat::pcd_f4:
-        case ScanWriteFormat::pcd_f8: return ".pcd";
-        case ScanWriteFormat::ply: return ".ply";
-        case ScanWriteFormat::kitti_bin: return ".bin";
+        case ScanWriteFormat::pcd_f8:
+            return ".pcd";
+        case ScanWriteFormat::ply:
+            return ".ply";
+        case ScanWriteFormat::kitti_bin:
+            return ".bin";
     }
     return "";
 }
@@ -126,10 +129,9 @@ std::string six_digits(std::size_t i) {
 
 }  // namespace
 
-void write_recording(const fs::path& folder, const std::vector<PointCloud>& clouds, const std::vector<PoseRecord>& poses,
-                     ScanWriteFormat format) {
-    if (clouds.size() != poses.size())
-        throw std::logic_error("write_recording: one pose per scan");
+void write_recording(const fs::path& folder, const std::vector<PointCloud>& clouds,
+                     const std::vector<PoseRecord>& poses, ScanWriteFormat format) {
+    if (clouds.size() != poses.size()) throw std::logic_error("write_recording: one pose per scan");
     if (clouds.empty()) throw InputError("'" + folder.string() + "': a recording needs at least one scan");
     check_replaceable(folder);
     const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
@@ -152,10 +154,18 @@ void write_recording(const fs::path& folder, const std::vector<PointCloud>& clou
         const std::string name = six_digits(i) + extension(format);
         const fs::path file = temp / name;
         switch (format) {
-            case ScanWriteFormat::pcd_f4: write_pcd(file, clouds[i], PcdEncoding::binary, PcdPrecision::f4); break;
-            case ScanWriteFormat::pcd_f8: write_pcd(file, clouds[i], PcdEncoding::binary, PcdPrecision::f8); break;
-            case ScanWriteFormat::ply: write_ply(file, clouds[i]); break;
-            case ScanWriteFormat::kitti_bin: write_kitti_bin(file, clouds[i]); break;
+            case ScanWriteFormat::pcd_f4:
+                write_pcd(file, clouds[i], PcdEncoding::binary, PcdPrecision::f4);
+                break;
+            case ScanWriteFormat::pcd_f8:
+                write_pcd(file, clouds[i], PcdEncoding::binary, PcdPrecision::f8);
+                break;
+            case ScanWriteFormat::ply:
+                write_ply(file, clouds[i]);
+                break;
+            case ScanWriteFormat::kitti_bin:
+                write_kitti_bin(file, clouds[i]);
+                break;
         }
         list += name;
         if (timed) {

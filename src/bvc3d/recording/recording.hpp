@@ -16,7 +16,7 @@ namespace bvc3d::recording {
 
 struct RecordingOptions {
     PoseFormat pose_format = PoseFormat::detect;
-    double time_tolerance = 0.05;                      // s, for pairing by time
+    double time_tolerance = 0.05;                       // s, for pairing by time
     std::optional<Eigen::Isometry3d> base_from_sensor;  // extrinsics: poses are the base's when given
 };
 

@@ -31,9 +31,12 @@ PointCloud read_scan(const fs::path& file) {
                                             detail::quote_token(file.extension().string()) +
                                             ": expected .pcd, .ply or .bin (KITTI)");
     switch (*format) {
-        case ScanFormat::pcd: return read_pcd(file);
-        case ScanFormat::ply: return read_ply(file);
-        case ScanFormat::kitti_bin: return read_kitti_bin(file);
+        case ScanFormat::pcd:
+            return read_pcd(file);
+        case ScanFormat::ply:
+            return read_ply(file);
+        case ScanFormat::kitti_bin:
+            return read_kitti_bin(file);
     }
     throw detail::input_error(file, "unknown scan format");
 }

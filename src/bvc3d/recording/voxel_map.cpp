@@ -40,8 +40,10 @@ void VoxelMap::add(const PointCloud& scan, const Eigen::Isometry3d& pose) {
         const double lim = static_cast<double>(index_limit);
         if (!(std::abs(fi) < lim && std::abs(fj) < lim && std::abs(fk) < lim))
             throw InputError("map: a point at (" + std::to_string(w.x()) + ", " + std::to_string(w.y()) + ", " +
-                             std::to_string(w.z()) + ") lies beyond the voxel grid's reach; use a larger voxel or --max-range");
-        Cell& c = cells_[pack(static_cast<std::int64_t>(fi), static_cast<std::int64_t>(fj), static_cast<std::int64_t>(fk))];
+                             std::to_string(w.z()) +
+                             ") lies beyond the voxel grid's reach; use a larger voxel or --max-range");
+        Cell& c =
+            cells_[pack(static_cast<std::int64_t>(fi), static_cast<std::int64_t>(fj), static_cast<std::int64_t>(fk))];
         c.x += w.x();
         c.y += w.y();
         c.z += w.z();

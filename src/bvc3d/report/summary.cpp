@@ -71,8 +71,9 @@ std::vector<TrialSummaryRow> read_summaries(const std::vector<std::filesystem::p
         });
         if (any) continue;
         for (auto& r : rows)
-            r.metrics.erase(std::remove_if(r.metrics.begin(), r.metrics.end(), [&](const auto& v) { return v.first == m.name; }),
-                            r.metrics.end());
+            r.metrics.erase(
+                std::remove_if(r.metrics.begin(), r.metrics.end(), [&](const auto& v) { return v.first == m.name; }),
+                r.metrics.end());
     }
     return rows;
 }
@@ -89,21 +90,27 @@ struct Facet {
 std::vector<Facet> facets(const std::vector<TrialSummaryRow>& trials) {
     std::vector<Facet> out{
         {"protocol", [](const TrialSummaryRow& t) { return t.protocol; }, {"protocol", "protocol.kind"}},
-        {"explore_hours", [](const TrialSummaryRow& t) { return num(t.explore_hours); }, {"protocol", "protocol.explore_hours"}},
-        {"sample_hours", [](const TrialSummaryRow& t) { return num(t.sample_hours); }, {"protocol", "protocol.sample_hours"}}};
+        {"explore_hours",
+         [](const TrialSummaryRow& t) { return num(t.explore_hours); },
+         {"protocol", "protocol.explore_hours"}},
+        {"sample_hours",
+         [](const TrialSummaryRow& t) { return num(t.sample_hours); },
+         {"protocol", "protocol.sample_hours"}}};
     if (!trials.empty())
         for (std::size_t i = 0; i < trials.front().parameters.size(); ++i) {
             const std::string key = trials.front().parameters[i].first;
-            out.push_back({"analysis " + key,
-                           [i](const TrialSummaryRow& t) { return i < t.parameters.size() ? t.parameters[i].second : ""; },
-                           {"analysis", "analysis." + key}});
+            out.push_back(
+                {"analysis " + key,
+                 [i](const TrialSummaryRow& t) { return i < t.parameters.size() ? t.parameters[i].second : ""; },
+                 {"analysis", "analysis." + key}});
         }
     return out;
 }
 
 }  // namespace
 
-std::string mixing_problem(const std::vector<TrialSummaryRow>& trials, const std::vector<std::filesystem::path>& files) {
+std::string mixing_problem(const std::vector<TrialSummaryRow>& trials,
+                           const std::vector<std::filesystem::path>& files) {
     // Appended, not "'" + ...: g++ 12 warns falsely on that (-Wrestrict, GCC bug 105329).
     const auto file = [&](std::size_t i) {
         std::string text = i < files.size() ? std::string("'") : std::string("trial ");
@@ -191,9 +198,10 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
     for (const auto& k : keys) os << ' ' << k << " |";
     std::vector<const analysis::Metric*> columns;
     for (const auto& m : analysis::metric_table()) {
-        const bool reported = m.dims == 0 || std::any_of(rows.begin(), rows.end(), [&](const SummaryRow& r) {
-            return std::find(r.metric_names.begin(), r.metric_names.end(), m.name) != r.metric_names.end();
-        });
+        const bool reported =
+            m.dims == 0 || std::any_of(rows.begin(), rows.end(), [&](const SummaryRow& r) {
+                return std::find(r.metric_names.begin(), r.metric_names.end(), m.name) != r.metric_names.end();
+            });
         if (m.digits >= 0 && reported) columns.push_back(&m);
     }
     os << " seeds |";
@@ -203,7 +211,8 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
     os << '\n';
     for (const auto& r : rows) {
         os << '|';
-        for (const auto& k : keys) os << ' ' << (plain ? (k == "model" ? r.model : r.world) : swept_value(r, k)) << " |";
+        for (const auto& k : keys)
+            os << ' ' << (plain ? (k == "model" ? r.model : r.world) : swept_value(r, k)) << " |";
         os << ' ' << r.n_seeds << " |";
         for (const auto* c : columns) {
             const auto it = std::find(r.metric_names.begin(), r.metric_names.end(), c->name);
@@ -222,7 +231,8 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
        << " MI: modality index (DBSCAN clusters per place cell);\n"
           "MSAI: mean spatial aliasing index; decoding: position error of the cosine-nearest rate-map bin.\n";
     if (std::any_of(columns.begin(), columns.end(), [](const analysis::Metric* c) { return c->dims == 3; }))
-        os << "3-D (flying agents, 0.5 m voxels): isotropy = a single field's rate-weighted sd along z over the mean of\n"
+        os << "3-D (flying agents, 0.5 m voxels): isotropy = a single field's rate-weighted sd along z over the mean "
+              "of\n"
               "its sds along x and y (1: round); vertical chance = the median vertical error of a random guess.\n";
     f.commit();
 }
@@ -238,7 +248,8 @@ void write_trials_csv(const std::filesystem::path& path, const std::vector<Trial
         for (const auto& [name, v] : trials.front().metrics) os << ',' << name;
     os << '\n';
     for (const auto& t : trials) {
-        os << csv(t.name) << ',' << csv(t.condition) << ',' << csv(t.model) << ',' << csv(t.world) << ',' << num(t.tilt_deg);
+        os << csv(t.name) << ',' << csv(t.condition) << ',' << csv(t.model) << ',' << csv(t.world) << ','
+           << num(t.tilt_deg);
         for (const auto& k : keys) os << ',' << csv(swept_value(t, k));
         os << ',' << t.seed << ',' << csv(t.protocol) << ',' << num(t.explore_hours) << ',' << num(t.sample_hours);
         for (const auto& [name, v] : t.metrics) os << ',' << num(v);

@@ -77,7 +77,7 @@ struct LidarSpec {
                elevation_labels == o.elevation_labels;
     }
     static const params::Table<LidarSpec>& table();
-    void validate() const;  // throws params::ParamError naming the bad field
+    void validate() const;                    // throws params::ParamError naming the bad field
     static constexpr double max_beams = 1e7;  // rows × azimuth_count: beyond it a scan would not fit
 };
 

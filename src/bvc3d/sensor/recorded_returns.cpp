@@ -8,9 +8,12 @@ namespace bvc3d {
 
 std::string selection_name(ReturnSelection s) {
     switch (s) {
-        case ReturnSelection::upper_half: return "upper_half";
-        case ReturnSelection::all: return "all";
-        case ReturnSelection::horizontal_slice: return "horizontal_slice";
+        case ReturnSelection::upper_half:
+            return "upper_half";
+        case ReturnSelection::all:
+            return "all";
+        case ReturnSelection::horizontal_slice:
+            return "horizontal_slice";
     }
     return "";
 }
@@ -43,9 +46,12 @@ namespace {
 
 bool keeps_elevation(double phi, const RecordedReturnParams& p, ReturnSelection s) {
     switch (s) {
-        case ReturnSelection::upper_half: return phi >= 0;
-        case ReturnSelection::all: return true;
-        case ReturnSelection::horizontal_slice: return std::abs(phi) <= p.slice_half_width;
+        case ReturnSelection::upper_half:
+            return phi >= 0;
+        case ReturnSelection::all:
+            return true;
+        case ReturnSelection::horizontal_slice:
+            return std::abs(phi) <= p.slice_half_width;
     }
     return false;
 }
@@ -86,7 +92,8 @@ recording::PointCloud points_from_returns(const Scan& scan, const Eigen::Matrix3
     cloud.xyz.reserve(3 * scan.size());
     for (const auto& r : scan) {
         const double c = std::cos(r.elevation);
-        const Vec3 v(r.range * c * std::cos(r.azimuth), r.range * c * std::sin(r.azimuth), r.range * std::sin(r.elevation));
+        const Vec3 v(r.range * c * std::cos(r.azimuth), r.range * c * std::sin(r.azimuth),
+                     r.range * std::sin(r.elevation));
         const Vec3 p = R.transpose() * v;
         cloud.xyz.insert(cloud.xyz.end(), {p.x(), p.y(), p.z()});
     }

@@ -61,9 +61,7 @@ TriangleMesh tilted_wall_mesh(const TiltedWall& w) {
     return hexahedron_mesh(bottom, top);
 }
 
-double triangle_double_area(const Vec3& a, const Vec3& b, const Vec3& c) {
-    return (b - a).cross(c - a).norm();
-}
+double triangle_double_area(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a).norm(); }
 
 bool Polygon2::contains(const Vec2& p) const {
     bool inside = false;
@@ -71,8 +69,7 @@ bool Polygon2::contains(const Vec2& p) const {
     for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
         const Vec2& a = points[i];
         const Vec2& b = points[j];
-        if ((a.y() > p.y()) != (b.y() > p.y()) &&
-            p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+        if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
             inside = !inside;
     }
     return inside;

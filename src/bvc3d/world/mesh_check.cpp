@@ -66,10 +66,10 @@ enum class PlyType { i8, u8, i16, u16, i32, u32, f32, f64 };
 
 bool ply_type(std::string_view name, PlyType& t) {
     static const std::pair<const char*, PlyType> names[] = {
-        {"char", PlyType::i8},    {"int8", PlyType::i8},    {"uchar", PlyType::u8},    {"uint8", PlyType::u8},
-        {"short", PlyType::i16},  {"int16", PlyType::i16},  {"ushort", PlyType::u16},  {"uint16", PlyType::u16},
-        {"int", PlyType::i32},    {"int32", PlyType::i32},  {"uint", PlyType::u32},    {"uint32", PlyType::u32},
-        {"float", PlyType::f32},  {"float32", PlyType::f32}, {"double", PlyType::f64}, {"float64", PlyType::f64}};
+        {"char", PlyType::i8},   {"int8", PlyType::i8},     {"uchar", PlyType::u8},   {"uint8", PlyType::u8},
+        {"short", PlyType::i16}, {"int16", PlyType::i16},   {"ushort", PlyType::u16}, {"uint16", PlyType::u16},
+        {"int", PlyType::i32},   {"int32", PlyType::i32},   {"uint", PlyType::u32},   {"uint32", PlyType::u32},
+        {"float", PlyType::f32}, {"float32", PlyType::f32}, {"double", PlyType::f64}, {"float64", PlyType::f64}};
     for (const auto& [n, type] : names)
         if (name == n) {
             t = type;
@@ -81,13 +81,17 @@ bool ply_type(std::string_view name, PlyType& t) {
 std::size_t ply_size(PlyType t) {
     switch (t) {
         case PlyType::i8:
-        case PlyType::u8: return 1;
+        case PlyType::u8:
+            return 1;
         case PlyType::i16:
-        case PlyType::u16: return 2;
+        case PlyType::u16:
+            return 2;
         case PlyType::i32:
         case PlyType::u32:
-        case PlyType::f32: return 4;
-        case PlyType::f64: return 8;
+        case PlyType::f32:
+            return 4;
+        case PlyType::f64:
+            return 8;
     }
     return 1;
 }
@@ -117,14 +121,40 @@ double load_binary(const char* p, PlyType t, bool big) {
     std::memcpy(raw, p, n);
     if (big == (std::endian::native == std::endian::little)) std::reverse(raw, raw + n);
     switch (t) {
-        case PlyType::i8: return static_cast<double>(static_cast<std::int8_t>(raw[0]));
-        case PlyType::u8: return static_cast<double>(static_cast<std::uint8_t>(raw[0]));
-        case PlyType::i16: { std::int16_t v; std::memcpy(&v, raw, 2); return v; }
-        case PlyType::u16: { std::uint16_t v; std::memcpy(&v, raw, 2); return v; }
-        case PlyType::i32: { std::int32_t v; std::memcpy(&v, raw, 4); return v; }
-        case PlyType::u32: { std::uint32_t v; std::memcpy(&v, raw, 4); return v; }
-        case PlyType::f32: { float v; std::memcpy(&v, raw, 4); return v; }
-        case PlyType::f64: { double v; std::memcpy(&v, raw, 8); return v; }
+        case PlyType::i8:
+            return static_cast<double>(static_cast<std::int8_t>(raw[0]));
+        case PlyType::u8:
+            return static_cast<double>(static_cast<std::uint8_t>(raw[0]));
+        case PlyType::i16: {
+            std::int16_t v;
+            std::memcpy(&v, raw, 2);
+            return v;
+        }
+        case PlyType::u16: {
+            std::uint16_t v;
+            std::memcpy(&v, raw, 2);
+            return v;
+        }
+        case PlyType::i32: {
+            std::int32_t v;
+            std::memcpy(&v, raw, 4);
+            return v;
+        }
+        case PlyType::u32: {
+            std::uint32_t v;
+            std::memcpy(&v, raw, 4);
+            return v;
+        }
+        case PlyType::f32: {
+            float v;
+            std::memcpy(&v, raw, 4);
+            return v;
+        }
+        case PlyType::f64: {
+            double v;
+            std::memcpy(&v, raw, 8);
+            return v;
+        }
     }
     return 0;
 }
@@ -170,7 +200,8 @@ std::string declared(const std::vector<PlyElement>& elements) {
 
 void check_ply(std::string_view bytes) {
     const auto end_header = bytes.find("end_header");
-    if (bytes.substr(0, 3) != "ply" || end_header == std::string_view::npos) bad("is not a PLY file (no 'ply' ... 'end_header' header)");
+    if (bytes.substr(0, 3) != "ply" || end_header == std::string_view::npos)
+        bad("is not a PLY file (no 'ply' ... 'end_header' header)");
     std::size_t data_at = bytes.find('\n', end_header);
     data_at = data_at == std::string_view::npos ? bytes.size() : data_at + 1;
     int format = -1;
@@ -183,7 +214,8 @@ void check_ply(std::string_view bytes) {
         at = nl + 1;
         ++line_no;
         const std::string where = "header line " + std::to_string(line_no) + ": ";
-        if (words.empty() || words[0] == "comment" || words[0] == "obj_info" || (line_no == 1 && words[0] == "ply")) continue;
+        if (words.empty() || words[0] == "comment" || words[0] == "obj_info" || (line_no == 1 && words[0] == "ply"))
+            continue;
         if (words[0] == "format") {
             if (words.size() != 3) bad(where + "expected 'format <encoding> 1.0'");
             if (words[1] == "ascii") format = 0;
@@ -257,8 +289,8 @@ void check_ply(std::string_view bytes) {
                 for (std::uint64_t k = 0; k < n; ++k) {
                     if (!data.next(p.type, v)) short_of();
                     if (is_face_index(e, p) && !(v >= 0 && v < static_cast<double>(vertices) && v == std::floor(v)))
-                        bad("face " + std::to_string(i) + " refers to vertex " + number_text(v) +
-                            ", but there are " + std::to_string(vertices) + " vertices");
+                        bad("face " + std::to_string(i) + " refers to vertex " + number_text(v) + ", but there are " +
+                            std::to_string(vertices) + " vertices");
                 }
             }
     if (!data.rest_is_empty()) bad("has data after the " + declared(elements) + " its header declares");
@@ -287,7 +319,8 @@ void check_obj(std::string_view bytes) {
         if (w.empty()) continue;
         const std::string where = "line " + std::to_string(line_no) + ": ";
         const auto numbers = [&](std::size_t least, const char* what) {
-            if (w.size() < least + 1) bad(where + what + " needs " + std::to_string(least) + " numbers, got " + std::to_string(w.size() - 1));
+            if (w.size() < least + 1)
+                bad(where + what + " needs " + std::to_string(least) + " numbers, got " + std::to_string(w.size() - 1));
             for (std::size_t i = 1; i < w.size(); ++i) {
                 double v = 0;
                 if (!parse_real(w[i], v)) bad(where + quoted(w[i]) + " is not a number");
@@ -316,10 +349,14 @@ void check_obj(std::string_view bytes) {
                         long long index = 0;
                         if (!parse_integer(item, index) || index == 0)
                             bad(where + "the face corner " + quoted(w[i]) + " is not a valid vertex reference");
-                        const std::uint64_t defined = kinds[part] == 'v' ? vertices : kinds[part] == 't' ? texcoords : normals;
+                        const std::uint64_t defined = kinds[part] == 'v'   ? vertices
+                                                      : kinds[part] == 't' ? texcoords
+                                                                           : normals;
                         if (index < 0 && static_cast<std::uint64_t>(-index) > defined)
                             bad(where + "the face corner " + quoted(w[i]) + " refers back past the first " +
-                                (kinds[part] == 'v' ? "vertex" : kinds[part] == 't' ? "texture coordinate" : "normal"));
+                                (kinds[part] == 'v'   ? "vertex"
+                                 : kinds[part] == 't' ? "texture coordinate"
+                                                      : "normal"));
                         if (index > 0) deferred.push_back({line_no, index, defined, kinds[part]});
                     }
                     if (slash == std::string_view::npos) break;
@@ -333,7 +370,10 @@ void check_obj(std::string_view bytes) {
     for (const auto& r : deferred) {
         const std::uint64_t total = r.kind == 'v' ? vertices : r.kind == 't' ? texcoords : normals;
         if (static_cast<std::uint64_t>(r.index) > total)
-            bad("line " + std::to_string(r.line) + ": a face refers to " + (r.kind == 'v' ? "vertex " : r.kind == 't' ? "texture coordinate " : "normal ") +
+            bad("line " + std::to_string(r.line) + ": a face refers to " +
+                (r.kind == 'v'   ? "vertex "
+                 : r.kind == 't' ? "texture coordinate "
+                                 : "normal ") +
                 std::to_string(r.index) + ", but the file has " + std::to_string(total));
     }
 }
@@ -361,7 +401,8 @@ void check_ascii_stl(std::string_view bytes) {
     const auto where = [&] { return "line " + std::to_string(i < lines.size() ? lines[i] : line_no) + ": "; };
     const auto expect = [&](std::string_view word) {
         if (i >= t.size()) bad("is truncated: the ASCII STL ends before '" + std::string(word) + "' (no 'endsolid')");
-        if (lower(std::string(t[i])) != word) bad(where() + "expected '" + std::string(word) + "', got " + quoted(t[i]));
+        if (lower(std::string(t[i])) != word)
+            bad(where() + "expected '" + std::string(word) + "', got " + quoted(t[i]));
         ++i;
     };
     const auto number = [&] {
@@ -400,8 +441,8 @@ void check_ascii_stl(std::string_view bytes) {
 // The triangle count of a binary STL header (little-endian uint32 at byte 80).
 std::uint32_t stl_count(std::string_view bytes) {
     const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + 80);
-    return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 | static_cast<std::uint32_t>(b[2]) << 16 |
-           static_cast<std::uint32_t>(b[3]) << 24;
+    return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 |
+           static_cast<std::uint32_t>(b[2]) << 16 | static_cast<std::uint32_t>(b[3]) << 24;
 }
 
 void check_stl(std::string_view bytes) {

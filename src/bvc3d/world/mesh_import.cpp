@@ -54,7 +54,8 @@ Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
     return e;
 }
 
-void collect(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d& parent, TriangleMesh& out, int depth = 0) {
+void collect(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d& parent, TriangleMesh& out,
+             int depth = 0) {
     if (depth > 1000) throw InputError("its node hierarchy is more than 1000 levels deep");
     const Eigen::Matrix4d xf = parent * to_eigen(node->mTransformation);
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
@@ -66,15 +67,16 @@ void collect(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d& pa
             Vec3 v[3];
             for (int k = 0; k < 3; ++k) {
                 if (face.mIndices[k] >= mesh->mNumVertices)
-                    throw InputError("face " + std::to_string(f) + " refers to vertex " + std::to_string(face.mIndices[k]) +
-                                     " of " + std::to_string(mesh->mNumVertices));
+                    throw InputError("face " + std::to_string(f) + " refers to vertex " +
+                                     std::to_string(face.mIndices[k]) + " of " + std::to_string(mesh->mNumVertices));
                 const aiVector3D& p = mesh->mVertices[face.mIndices[k]];
                 v[k] = (xf * Eigen::Vector4d(p.x, p.y, p.z, 1.0)).head<3>();
             }
             for (const auto& c : v)
                 if (!c.allFinite())
-                    throw InputError("a vertex is not finite (values beyond ±3.4e38 do not fit the 32-bit floats "
-                                     "meshes are read in)");
+                    throw InputError(
+                        "a vertex is not finite (values beyond ±3.4e38 do not fit the 32-bit floats "
+                        "meshes are read in)");
             if (triangle_double_area(v[0], v[1], v[2]) > 1e-12) out.add_triangle(v[0], v[1], v[2]);
             if (static_cast<double>(out.size()) > max_mesh_triangles)
                 throw InputError("it holds more than " + format_number(max_mesh_triangles) + " triangles, the limit");
@@ -111,8 +113,8 @@ TriangleMesh load_mesh_file(const std::string& path) {
     WarningCapture::current = &warnings;
     Assimp::Importer importer;
     // Validation checks what assimp built (indices in range, ...) before we read it.
-    const aiScene* scene =
-        importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);
+    const aiScene* scene = importer.ReadFile(
+        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);
     WarningCapture::current = nullptr;
     if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
         throw InputError(where + ": cannot be read as a mesh (" + importer.GetErrorString() + ")");
@@ -120,7 +122,8 @@ TriangleMesh load_mesh_file(const std::string& path) {
         if (data_dropped(w)) {
             while (!w.empty() && (w.back() == '\n' || w.back() == ' ')) w.pop_back();
             const auto colon = w.find(": ");  // "Warn,  T0: <message>"
-            throw InputError(where + ": is inconsistent (" + (colon == std::string::npos ? w : w.substr(colon + 2)) + ")");
+            throw InputError(where + ": is inconsistent (" + (colon == std::string::npos ? w : w.substr(colon + 2)) +
+                             ")");
         }
     TriangleMesh mesh;
     try {

@@ -214,13 +214,15 @@ void RayCaster::cast_packets(Intersect intersect, const Call& call, std::span<co
     }
 }
 
-void RayCaster::cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range,
-                     std::span<double> ranges) const {
+void RayCaster::cast(const Vec3& origin, std::span<const Vec3> dirs, double max_range, std::span<double> ranges) const {
     const Call call{origin, max_range};
     switch (impl_->packet) {
-        case 16: return cast_packets<16, RTCRayHit16>(rtcIntersect16, call, dirs, ranges);
-        case 8: return cast_packets<8, RTCRayHit8>(rtcIntersect8, call, dirs, ranges);
-        default: return cast_packets<4, RTCRayHit4>(rtcIntersect4, call, dirs, ranges);
+        case 16:
+            return cast_packets<16, RTCRayHit16>(rtcIntersect16, call, dirs, ranges);
+        case 8:
+            return cast_packets<8, RTCRayHit8>(rtcIntersect8, call, dirs, ranges);
+        default:
+            return cast_packets<4, RTCRayHit4>(rtcIntersect4, call, dirs, ranges);
     }
 }
 

@@ -37,7 +37,8 @@ private:
         double max_range;
     };
     template <int N, class RayHitN, class Intersect>
-    void cast_packets(Intersect intersect, const Call& call, std::span<const Vec3> dirs, std::span<double> ranges) const;
+    void cast_packets(Intersect intersect, const Call& call, std::span<const Vec3> dirs,
+                      std::span<double> ranges) const;
     template <int N, class RayHitN>
     void refine(const RayHitN& rh, const Call& call, std::span<const Vec3> dirs, std::span<double> ranges) const;
     double refine_other(unsigned geom, unsigned prim, const Call& call, const Vec3& dir, float t_float) const;

@@ -40,15 +40,14 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
     const auto [sx, sy] = lean_signs(p.lean);
     require(std::isfinite(p.tilt_deg) && p.tilt_deg >= 0.0 && p.tilt_deg < 90.0,
             "tilt_deg must be in [0, 90), got " + format_number(p.tilt_deg));
-    require(p.half_width > 0 && p.height > 0 && p.wall_thickness > 0 && p.wall_length > 0,
-            "sizes must be positive");
+    require(p.half_width > 0 && p.height > 0 && p.wall_thickness > 0 && p.wall_length > 0, "sizes must be positive");
     require(p.half_width <= max_coordinate && p.height <= max_coordinate && p.wall_thickness <= max_coordinate,
             "sizes must be at most " + format_number(max_coordinate) + " m");
     require(p.wall_length < 2.0 * p.half_width, "wall_length must be shorter than the arena");
     const double alpha = deg_to_rad(p.tilt_deg);
     const double reach = p.height * std::tan(alpha) + 0.5 * p.wall_thickness / std::cos(alpha);
-    require(reach < p.half_width, "tilt_deg " + format_number(p.tilt_deg) +
-                                      " makes the central walls' tops pass through the outer walls");
+    require(reach < p.half_width,
+            "tilt_deg " + format_number(p.tilt_deg) + " makes the central walls' tops pass through the outer walls");
     require(std::abs(p.start_offset) < p.half_width, "start_offset must lie inside the arena");
     require(std::isfinite(p.flight_clearance) && p.flight_clearance >= 0 && 2 * p.flight_clearance < p.height,
             "flight_clearance must be >= 0 and leave room between floor and ceiling");
@@ -58,8 +57,8 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
     w.tilt_deg = p.tilt_deg;
     const double a = p.half_width, h = p.height;
     auto& m = w.mesh;
-    m.add_quad(Vec3(-a, -a, 0), Vec3(a, -a, 0), Vec3(a, a, 0), Vec3(-a, a, 0));  // floor
-    m.add_quad(Vec3(-a, -a, h), Vec3(-a, a, h), Vec3(a, a, h), Vec3(a, -a, h));  // ceiling
+    m.add_quad(Vec3(-a, -a, 0), Vec3(a, -a, 0), Vec3(a, a, 0), Vec3(-a, a, 0));    // floor
+    m.add_quad(Vec3(-a, -a, h), Vec3(-a, a, h), Vec3(a, a, h), Vec3(a, -a, h));    // ceiling
     m.add_quad(Vec3(-a, -a, 0), Vec3(-a, a, 0), Vec3(-a, a, h), Vec3(-a, -a, h));  // x = -a
     m.add_quad(Vec3(a, -a, 0), Vec3(a, -a, h), Vec3(a, a, h), Vec3(a, a, 0));      // x = +a
     m.add_quad(Vec3(-a, -a, 0), Vec3(-a, -a, h), Vec3(a, -a, h), Vec3(a, -a, 0));  // y = -a
@@ -67,8 +66,12 @@ WorldDescription cross_arena(const CrossArenaParams& p) {
 
     // Wall A runs along x and leans toward sy·y; wall B runs along y and leans toward sx·x.
     // For yaw = 90° the left normal is -x, hence the sign flip on B's tilt.
-    TiltedWall wall{.center = Vec2(0, 0), .length = p.wall_length, .thickness = p.wall_thickness,
-                    .height = h, .yaw = 0.0, .tilt = sy * alpha};
+    TiltedWall wall{.center = Vec2(0, 0),
+                    .length = p.wall_length,
+                    .thickness = p.wall_thickness,
+                    .height = h,
+                    .yaw = 0.0,
+                    .tilt = sy * alpha};
     m.append(tilted_wall_mesh(wall));
     wall.yaw = pi / 2;
     wall.tilt = -sx * alpha;
@@ -91,12 +94,12 @@ namespace {
 // A closed room: floor, ceiling and four walls, the same quads (in the same order) as the room's
 // YAML file in configs/worlds lists.
 void add_room(TriangleMesh& m, double hx, double hy, double h) {
-    m.add_quad(Vec3(-hx, -hy, 0), Vec3(hx, -hy, 0), Vec3(hx, hy, 0), Vec3(-hx, hy, 0));      // floor
-    m.add_quad(Vec3(-hx, -hy, h), Vec3(-hx, hy, h), Vec3(hx, hy, h), Vec3(hx, -hy, h));      // ceiling
-    m.add_quad(Vec3(-hx, -hy, 0), Vec3(-hx, hy, 0), Vec3(-hx, hy, h), Vec3(-hx, -hy, h));    // x = -hx
-    m.add_quad(Vec3(hx, -hy, 0), Vec3(hx, -hy, h), Vec3(hx, hy, h), Vec3(hx, hy, 0));        // x = +hx
-    m.add_quad(Vec3(-hx, -hy, 0), Vec3(-hx, -hy, h), Vec3(hx, -hy, h), Vec3(hx, -hy, 0));    // y = -hy
-    m.add_quad(Vec3(-hx, hy, 0), Vec3(hx, hy, 0), Vec3(hx, hy, h), Vec3(-hx, hy, h));        // y = +hy
+    m.add_quad(Vec3(-hx, -hy, 0), Vec3(hx, -hy, 0), Vec3(hx, hy, 0), Vec3(-hx, hy, 0));    // floor
+    m.add_quad(Vec3(-hx, -hy, h), Vec3(-hx, hy, h), Vec3(hx, hy, h), Vec3(hx, -hy, h));    // ceiling
+    m.add_quad(Vec3(-hx, -hy, 0), Vec3(-hx, hy, 0), Vec3(-hx, hy, h), Vec3(-hx, -hy, h));  // x = -hx
+    m.add_quad(Vec3(hx, -hy, 0), Vec3(hx, -hy, h), Vec3(hx, hy, h), Vec3(hx, hy, 0));      // x = +hx
+    m.add_quad(Vec3(-hx, -hy, 0), Vec3(-hx, -hy, h), Vec3(hx, -hy, h), Vec3(hx, -hy, 0));  // y = -hy
+    m.add_quad(Vec3(-hx, hy, 0), Vec3(hx, hy, 0), Vec3(hx, hy, h), Vec3(-hx, hy, h));      // y = +hy
 }
 
 void add_box(TriangleMesh& m, const Vec3& center, const Vec3& size) {

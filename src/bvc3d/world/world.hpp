@@ -35,7 +35,7 @@ struct SphereSet {
 
 struct WorldDescription {
     std::string name;
-    std::string file;  // the YAML file it came from (errors about its keys name it); empty for presets
+    std::string file;                // the YAML file it came from (errors about its keys name it); empty for presets
     std::optional<double> tilt_deg;  // the tilt of the cross arena, when the world is (or holds) one
     TriangleMesh mesh;
     std::vector<SphereSet> spheres;
@@ -56,7 +56,7 @@ struct CrossArenaParams {
     double height = 2.5;
     double wall_length = 7.0;
     double wall_thickness = 0.3;
-    double start_offset = 4.0;  // start corners at (±offset, ±offset)
+    double start_offset = 4.0;      // start corners at (±offset, ±offset)
     double flight_clearance = 0.2;  // the flight volume: the floor × [clearance, height - clearance]
 
     // The arena as the authors built it in Webots (docs/worlds.md#presets): outer walls 0.3 m thick
