@@ -39,10 +39,9 @@ public:
     explicit ViewData(ViewTarget target);
     const ViewTarget& target() const { return target_; }
 
-    // index, trial?path=, step?path=&i=, world?source= | world?trial= | world?recording=1,
-    // probe?source=&x=&y=&heading= (the default model's view at that pose), recording, scan?i=. Errors are replies with
-    // a status and {"error": message}: 400 bad
-    // request, 403 a path outside the served folder, 404 missing, 422 a file that cannot be read.
+    // index, trial?path=, step?path=&i=, world?source= | world?trial= | world?recording=1, probe?source=&x=&y=&heading=
+    // (the default model's view at that pose), recording, scan?i=. Errors are replies with a status and {"error":
+    // message}: 400 bad request, 403 a path outside the served folder, 404 missing, 422 a file that cannot be read.
     Reply get(const std::string& endpoint, const Query& query);
 
     std::size_t recording_scans() const { return recording_ ? recording_->size() : 0; }

@@ -1,8 +1,7 @@
 #pragma once
 // The BVC equations of docs/model-reference.md#boundary-vector-cells written out literally (plain loops over every
-// return and every
-// cell, no pruning, no shared code with the library), as the oracle for tests and the dense
-// baseline for benchmarks.
+// return and every cell, no pruning, no shared code with the library), as the oracle for tests and the dense baseline
+// for benchmarks.
 #include <cmath>
 #include <vector>
 

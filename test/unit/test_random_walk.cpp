@@ -1,6 +1,5 @@
 // The robot's random walk (docs/model-reference.md#robot-and-random-walk): stays in the arena, never overlaps a wall,
-// turns as specified,
-// covers the floor, and is deterministic by seed.
+// turns as specified, covers the floor, and is deterministic by seed.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,11 +1,9 @@
 #pragma once
 // Agent stage: where the agent goes.
 // Takes: a World (for collision) and a seed, or a given path (which needs no world). Gives: the model steps — when and
-// at
-// which pose the model is updated — one at a time, and its state as text for checkpoints.
-// Kinds of agent: the ground robot's random walk (random_walk.hpp), a given trajectory
-// (trajectory.hpp) and the flying agent (flying_walk.hpp). The trial runner, checkpoints and walk sharing see only this
-// interface.
+// at which pose the model is updated — one at a time, and its state as text for checkpoints.
+// Kinds of agent: the ground robot's random walk (random_walk.hpp), a given trajectory (trajectory.hpp) and the flying
+// agent (flying_walk.hpp). The trial runner, checkpoints and walk sharing see only this interface.
 #include <cstdint>
 #include <memory>
 #include <optional>
