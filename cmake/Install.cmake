@@ -13,6 +13,7 @@ add_library(bvc3d::bvc3d ALIAS bvc3d)
 # on its own against the installed tree).
 set(BVC3D_PRIVATE_HEADERS
   bvc3d/bvc/bvc_kernels.hpp
+  bvc3d/bvc/pruned_sums.hpp
   bvc3d/place/place_kernels.hpp
   bvc3d/core/simd.hpp
   bvc3d/analysis/point_grid.hpp

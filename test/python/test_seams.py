@@ -126,8 +126,8 @@ def test_python_defaults_are_the_cpp_structs():
 
 
 # The stages from the bottom up; a stage may include only stages ranked below it (and itself).
-STAGE_RANK = {"core": 0, "world": 1, "recording": 1, "agent": 2, "sensor": 2, "bvc": 3, "place": 4, "recorder": 5,
-              "analysis": 6, "report": 7, "config": 8, "experiment": 9}
+STAGE_RANK = {"core": 0, "world": 1, "recording": 1, "agent": 2, "sensor": 2, "bvc": 3, "place": 4, "population": 5,
+              "recorder": 6, "analysis": 7, "report": 8, "config": 9, "experiment": 10}
 
 
 def test_lower_stages_never_include_higher_ones():

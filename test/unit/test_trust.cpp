@@ -123,8 +123,7 @@ TEST(WriteFailures, TrialFilesAndCheckpointsFailCleanlyAndHdf5KeepsNothingOpen) 
     GroupCheckpoint c;
     c.fingerprint = "f";
     c.partial = g;
-    c.membrane.assign(1, std::vector<float>(20, 0.0f));
-    c.place_rates = c.membrane;
+    c.states.assign(2, {StateArray{"membrane", {20}, std::vector<float>(20, 0.0f)}});
     const std::string ckpt = message_of([&] {
         FileSizeLimit limit(20000);
         write_checkpoint(d / "c.h5", c);
@@ -158,8 +157,7 @@ TEST(Checkpoints, BrokenOnesSayWhatIsWrong) {
     GroupCheckpoint c;
     c.fingerprint = "f";
     c.partial = tiny_group(50);
-    c.membrane.assign(1, std::vector<float>(20, 0.0f));
-    c.place_rates = c.membrane;
+    c.states.assign(2, {StateArray{"membrane", {20}, std::vector<float>(20, 0.0f)}});
     write_checkpoint(d / "c.h5", c);
     const auto good = read_checkpoint(d / "c.h5");
     ASSERT_TRUE(good.checkpoint) << good.problem;

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "bvc3d/bvc/bvc_kernels.hpp"
+#include "bvc3d/bvc/pruned_sums.hpp"
 #include "bvc3d/bvc/return_check.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
@@ -17,7 +18,27 @@ const BvcParams& validated(const BvcParams& p) {
 }  // namespace
 
 BoundaryVectorLayer::BoundaryVectorLayer(BvcParams params)
-    : p_(std::move(params)), tuning_(validated(p_)), windows_(tuning_), sums_(tuning_), nearest_(tuning_) {}
+    : p_(std::move(params)),
+      tuning_(validated(p_)),
+      windows_(tuning_),
+      sums_(std::make_unique<PrunedSums>(tuning_)),
+      nearest_(tuning_) {}
+
+BoundaryVectorLayer::BoundaryVectorLayer(const BoundaryVectorLayer& other)
+    : p_(other.p_),
+      tuning_(other.tuning_),
+      windows_(other.windows_),
+      sums_(std::make_unique<PrunedSums>(tuning_)),
+      nearest_(tuning_) {}
+
+BoundaryVectorLayer& BoundaryVectorLayer::operator=(const BoundaryVectorLayer& other) {
+    if (this != &other) *this = BoundaryVectorLayer(other);
+    return *this;
+}
+
+BoundaryVectorLayer::BoundaryVectorLayer(BoundaryVectorLayer&&) noexcept = default;
+BoundaryVectorLayer& BoundaryVectorLayer::operator=(BoundaryVectorLayer&&) noexcept = default;
+BoundaryVectorLayer::~BoundaryVectorLayer() = default;
 
 void BoundaryVectorLayer::check_size(std::span<double> out) const {
     if (out.size() != n_cells()) throw InputError("BVC layer: output has the wrong size");
@@ -53,10 +74,10 @@ void BoundaryVectorLayer::raw(std::span<const LidarReturn> returns, std::span<do
         if (!nearest_.raw(returns, out, true)) nearest_.raw(returns, out, false);
         return;
     }
-    const std::size_t valid = sums_.sum_unplanned(returns);
-    sums_.copy_sums(p_, true, out);
+    const std::size_t valid = sums_->sum_unplanned(returns);
+    sums_->copy_sums(p_, true, out);
     const double max_raw = kernels::largest(out.data(), out.size());
-    if (!(pruning::unplanned_bound(tuning_, sums_.weights(), valid) <= pruning::tolerance * max_raw))
+    if (!(pruning::unplanned_bound(tuning_, sums_->weights(), valid) <= pruning::tolerance * max_raw))
         raw_exact(returns, out);
 }
 
@@ -84,7 +105,7 @@ bool BoundaryVectorLayer::rates_pruned(std::span<const LidarReturn> returns, con
         rates(returns, out);
         return true;
     }
-    sums_.sum_planned(returns, plan);
+    sums_->sum_planned(returns, plan);
     return planned_rates(plan, *this, out);
 }
 
@@ -97,7 +118,7 @@ bool BoundaryVectorLayer::can_share_sums(const BvcParams& o) const {
 }
 
 void BoundaryVectorLayer::sum_pruned(std::span<const LidarReturn> returns, const ScanPlan& plan) const {
-    sums_.sum_planned(returns, plan);  // the bound is each reader's own (planned_rates)
+    sums_->sum_planned(returns, plan);  // the bound is each reader's own (planned_rates)
 }
 
 bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn>, const ScanPlan& plan,
@@ -110,9 +131,9 @@ bool BoundaryVectorLayer::rates_pruned_shared(std::span<const LidarReturn>, cons
 
 bool BoundaryVectorLayer::planned_rates(const ScanPlan& plan, const BoundaryVectorLayer& summed,
                                         std::span<double> out) const {
-    summed.sums_.copy_sums(p_, &summed == this, out);
+    summed.sums_->copy_sums(p_, &summed == this, out);
     const double max_raw = kernels::largest(out.data(), out.size());
-    if (!(pruning::planned_bound(tuning_, windows_, plan, summed.sums_.runs()) <= pruning::tolerance * max_raw))
+    if (!(pruning::planned_bound(tuning_, windows_, plan, summed.sums_->runs()) <= pruning::tolerance * max_raw))
         return false;
     normalize(out, max_raw);
     return true;

@@ -8,12 +8,12 @@
 // raw_exact is the definition; raw and rates compute it fast (pruned_sums.hpp: terms that are all but zero left
 // out, within 1e-7 of the largest sum by the bound of truncation_bound.hpp, else the full sum). A layer keeps the
 // fast path's buffers: it is not shared between threads.
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "bvc3d/bvc/bvc_params.hpp"
 #include "bvc3d/bvc/nearest_beam.hpp"
-#include "bvc3d/bvc/pruned_sums.hpp"
 #include "bvc3d/bvc/scan_plan.hpp"
 #include "bvc3d/bvc/truncation_bound.hpp"
 #include "bvc3d/bvc/tuning.hpp"
@@ -21,9 +21,17 @@
 
 namespace bvc3d {
 
+class PrunedSums;  // pruned_sums.hpp, private to the library
+
 class BoundaryVectorLayer {
 public:
     explicit BoundaryVectorLayer(BvcParams params);
+    // A copy has the same parameters and workspaces of its own (their contents carry nothing between calls).
+    BoundaryVectorLayer(const BoundaryVectorLayer& other);
+    BoundaryVectorLayer& operator=(const BoundaryVectorLayer& other);
+    BoundaryVectorLayer(BoundaryVectorLayer&&) noexcept;
+    BoundaryVectorLayer& operator=(BoundaryVectorLayer&&) noexcept;
+    ~BoundaryVectorLayer();
 
     const BvcParams& params() const { return p_; }
     std::size_t n_cells() const { return static_cast<std::size_t>(p_.n_cells()); }
@@ -68,7 +76,7 @@ private:
     LayerTuning tuning_;
     pruning::Windows windows_;
     // The fast paths' workspaces (buffers that a step reuses; their contents carry nothing between calls).
-    mutable PrunedSums sums_;
+    std::unique_ptr<PrunedSums> sums_;  // never null but after a move
     mutable NearestBeamReading nearest_;
 };
 

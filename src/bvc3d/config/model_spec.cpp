@@ -20,7 +20,7 @@ namespace {
 
 // A model reading the horizontal scanner (no elevation layers), 120 distances per direction.
 ModelSpec planar(const std::string& name) {
-    ModelSpec m{name, LidarSpec::horizontal(), {}, {}};
+    ModelSpec m{name, LidarSpec::horizontal(), {}, {}, {}};
     m.bvc.elevations.clear();
     m.bvc.n_per_axis = 120;
     return m;
@@ -28,7 +28,7 @@ ModelSpec planar(const std::string& name) {
 
 // A model reading the spherical scanner's upper half with the given layers.
 ModelSpec layered(const std::string& name, std::vector<double> elevations, int n_per_axis) {
-    ModelSpec m{name, LidarSpec::spherical(), {}, {}};
+    ModelSpec m{name, LidarSpec::spherical(), {}, {}, {}};
     m.bvc.elevations = std::move(elevations);
     m.bvc.n_per_axis = n_per_axis;
     return m;
@@ -36,7 +36,7 @@ ModelSpec layered(const std::string& name, std::vector<double> elevations, int n
 
 // A flying agent's model: the full spherical scanner (both halves) at the body's center.
 ModelSpec flying(const std::string& name, std::vector<double> elevations, int n_per_axis) {
-    ModelSpec m{name, LidarSpec::spherical_full(), {}, {}};
+    ModelSpec m{name, LidarSpec::spherical_full(), {}, {}, {}};
     m.bvc.elevations = std::move(elevations);
     m.bvc.n_per_axis = n_per_axis;
     return m;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bvc3d/bvc/boundary_vector_layer.hpp"
+#include "bvc3d/config/population_spec.hpp"
 #include "bvc3d/place/place_cell_network.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
@@ -17,6 +18,8 @@ struct ModelSpec {
     LidarSpec sensor;
     BvcParams bvc;
     PlaceParams place;
+    // Populations besides the BVC layer ("bvc") and the place cells ("place"), in the order they are made.
+    std::vector<PopulationSpec> populations;
     static constexpr double max_weights = 1e9;  // n_place × BVCs (4 GB of float weights)
     void validate() const;
 };

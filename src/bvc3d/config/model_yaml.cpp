@@ -45,9 +45,18 @@ ModelSpec resolve_model(const std::string& name) {
 }
 
 std::string model_to_yaml(const ModelSpec& m) {
-    return "name: " + m.name + "\nsensor:\n" + params::yaml_lines(LidarSpec::table(), m.sensor, "  ") + "bvc:\n" +
-           params::yaml_lines(BvcParams::table(), m.bvc, "  ") + "place:\n" +
-           params::yaml_lines(PlaceParams::table(), m.place, "  ");
+    std::string text = "name: " + m.name + "\nsensor:\n" + params::yaml_lines(LidarSpec::table(), m.sensor, "  ") +
+                       "bvc:\n" + params::yaml_lines(BvcParams::table(), m.bvc, "  ") + "place:\n" +
+                       params::yaml_lines(PlaceParams::table(), m.place, "  ");
+    if (!m.populations.empty()) {  // only then: the paper's models keep their text and fingerprints
+        text += "populations:\n";
+        for (const PopulationSpec& p : m.populations) {
+            text += "  - name: " + p.name + "\n    kind: " + p.kind + "\n    inputs: [";
+            for (std::size_t i = 0; i < p.inputs.size(); ++i) text += (i ? ", " : "") + p.inputs[i];
+            text += "]\n    recorded: " + std::string(p.recorded ? "true" : "false") + "\n    key: " + p.key + "\n";
+        }
+    }
+    return text;
 }
 
 void write_model(params::CommentedYaml& out, const ModelSpec& m, const std::string& indent) {

@@ -34,9 +34,17 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
     AnalyzedTrial a;
     a.params = t.analysis_params(world);
     const auto& rec = r.models.at(model);
-    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), static_cast<Eigen::Index>(r.x.size()),
-                                                        rec.n_place);
-    a.metrics = analysis::analyze_trial<float>(sample_positions(r, t.agent->dims()), rates, a.params);
+    const auto n = static_cast<Eigen::Index>(r.x.size());
+    const analysis::Points positions = sample_positions(r, t.agent->dims());
+    const Eigen::Map<const analysis::RowMatrixXf> rates(rec.rates.data(), n, rec.n_place);
+    a.metrics = analysis::analyze_trial<float>(positions, rates, a.params);
+    // Every other recorded population, the same way.
+    for (const PopulationRecord& p : rec.populations) {
+        if (!p.recorded || p.cells == 0) continue;
+        const Eigen::Map<const analysis::RowMatrixXf> cells(p.rates.data(), n, static_cast<Eigen::Index>(p.cells));
+        a.populations.emplace_back(
+            p.name, AnalyzedPopulation{analysis::analyze_trial<float>(positions, cells, a.params), a.params});
+    }
     return a;
 }
 
@@ -66,9 +74,13 @@ GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std
     if (paths.size() != trials.size()) throw std::logic_error("one path per trial");
     GroupOutcome out = run_and_analyze(trials, control);
     const WorldDescription world = trials.front().world.is_none() ? WorldDescription{} : trials.front().world.resolve();
-    for (std::size_t k = 0; k < trials.size(); ++k)
+    for (std::size_t k = 0; k < trials.size(); ++k) {
+        std::vector<std::pair<std::string, MetricsRecord>> populations;
+        for (const auto& [name, p] : out.trials[k].populations)
+            populations.emplace_back(name, metrics_record(p.metrics, p.params));
         write_trial_file(paths[k], trial_identity(trials[k], world), out.result, k,
-                         metrics_record(out.trials[k].metrics, out.trials[k].params));
+                         metrics_record(out.trials[k].metrics, out.trials[k].params), populations);
+    }
     if (!control.checkpoint.empty()) remove_checkpoint(control.checkpoint);
     return out;
 }

@@ -12,9 +12,13 @@
 
 namespace bvc3d {
 
-struct AnalyzedTrial {
+struct AnalyzedPopulation {
     analysis::TrialMetrics metrics;
     analysis::AnalysisParams params;  // what the metrics were computed with (extent resolved)
+};
+// A trial's metrics: of its place cells, and of each other recorded population (by name).
+struct AnalyzedTrial : AnalyzedPopulation {
+    std::vector<std::pair<std::string, AnalyzedPopulation>> populations;
 };
 
 struct GroupOutcome {

@@ -46,10 +46,27 @@ void write_metrics(hid_t f, const MetricsRecord& m) {
     for (const auto& a : m.arrays) write_array(g, a);
 }
 
+// A model's other populations: /populations/NAME/ with its rates (samples × cells), what it keeps (weights ...) and
+// its metrics.
+void write_populations(hid_t f, const ModelRecord& rec, std::size_t n,
+                       const std::vector<std::pair<std::string, MetricsRecord>>& metrics) {
+    if (rec.populations.empty()) return;
+    const auto all = h5::create_group(f, "populations");
+    for (const PopulationRecord& p : rec.populations) {
+        const auto g = h5::create_group(all, p.name);
+        if (p.recorded) h5::write(g, "rates", p.rates, {n, p.cells});
+        for (const StateArray& a : p.kept)
+            std::visit([&](const auto& v) { h5::write(g, a.name, v, a.shape); }, a.values);
+        for (const auto& [name, m] : metrics)
+            if (name == p.name) write_metrics(g, m);
+    }
+}
+
 }  // namespace
 
 void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id, const GroupResult& group,
-                      std::size_t model_index, const MetricsRecord& metrics) {
+                      std::size_t model_index, const MetricsRecord& metrics,
+                      const std::vector<std::pair<std::string, MetricsRecord>>& population_metrics) {
     const ModelRecord& rec = group.models.at(model_index);
     const std::size_t n = group.t.size();
     AtomicFile out(path);
@@ -77,6 +94,7 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         h5::write_attr(w, "full_scan_fallbacks", group.stats.full_scan_fallbacks);
         h5::write_attr(w, "end_time", group.stats.end_time);
         write_metrics(f, metrics);
+        write_populations(f, rec, n, population_metrics);
         image = h5::file_image(f);
     }
     out.write(image);

@@ -56,9 +56,11 @@ struct MetricsRecord {
 };
 
 // Writes the file atomically: it appears only when complete. z is written for 3-D trials (id.dims 3)
-// and when any sample has z != 0.
+// and when any sample has z != 0. The model's other populations go to /populations/NAME/ with their metrics
+// (population_metrics: by population name).
 void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id, const GroupResult& group,
-                      std::size_t model_index, const MetricsRecord& metrics);
+                      std::size_t model_index, const MetricsRecord& metrics,
+                      const std::vector<std::pair<std::string, MetricsRecord>>& population_metrics = {});
 
 // A complete trial file's fingerprint and the names of the attributes under /metrics (the metrics
 // it holds, with their parameters); nullopt if the file is missing, broken or not a trial file.

@@ -6,13 +6,26 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/population/population.hpp"
+
 namespace bvc3d {
 
+// A population of a model other than its BVC layer and place cells (population/population.hpp).
+struct PopulationRecord {
+    std::string name;
+    std::size_t cells = 0;
+    bool recorded = false;
+    std::vector<float> rates;      // samples × cells, row-major, if recorded
+    std::vector<StateArray> kept;  // what the trial keeps of it at the end
+};
+
+// A model's records: its place cells and BVC layer (the paper's network), and its other populations.
 struct ModelRecord {
     std::vector<float> rates;    // samples × n_place, row-major
     std::vector<float> bvc;      // samples × n_bvc, if the protocol records them
     std::vector<float> weights;  // n_place × n_bvc
     int n_place = 0, n_bvc = 0;
+    std::vector<PopulationRecord> populations;
 };
 
 struct WalkStats {
@@ -32,8 +45,8 @@ struct GroupCheckpoint {
     std::string fingerprint;  // of the group's configuration
     std::string agent_state;  // Agent::save_state()
     std::int64_t step_index = 0;
-    GroupResult partial;                                    // samples (see below); per model the current weights
-    std::vector<std::vector<float>> membrane, place_rates;  // per model
+    GroupResult partial;                          // samples (see below); the models' records give their shapes
+    std::vector<std::vector<StateArray>> states;  // per population of the group's network, in its order
     // On disk the samples sit in `segments` files holding the first `saved` of them. When writing,
     // `partial` holds only the samples after those; when read back, all of them.
     std::size_t segments = 0, saved = 0;

@@ -1,0 +1,33 @@
+#pragma once
+// Config stage: a population of a model beyond its BVC layer and place cells (population/population.hpp): its name,
+// the populations it reads, and how to make it. Takes: what its kind needs. Gives: the spec a ModelSpec holds, its
+// canonical text (in the model's, hence in fingerprints) and, per trial, the population itself.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bvc3d/population/population.hpp"
+#include "bvc3d/world/world.hpp"
+
+namespace bvc3d {
+
+// What a spec's `make` is given.
+struct PopulationContext {
+    std::uint64_t seed = 0;                // the trial's
+    std::vector<std::size_t> input_sizes;  // cells of each population it reads, in the order of `inputs`
+    const World* world = nullptr;          // null for a trial without one
+};
+
+struct PopulationSpec {
+    std::string name;                 // unique in its model; "bvc" and "place" name the model's own
+    std::string kind;                 // for messages and tables
+    std::vector<std::string> inputs;  // the populations of the same model it reads, by name
+    bool recorded = true;             // its rates are recorded at the sampling steps (and analysed)
+    // Canonical text of everything that changes its results (its kind and parameters): part of the model's.
+    std::string key;
+    std::function<std::unique_ptr<Population>(const PopulationContext&)> make;
+};
+
+}  // namespace bvc3d
