@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"

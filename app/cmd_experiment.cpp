@@ -17,6 +17,7 @@
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/sweep_yaml.hpp"
