@@ -1,22 +1,32 @@
 #include "cli_common.hpp"
 
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 #include <vector>
 
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
-#include "bvc3d/core/memory.hpp"
 
 namespace bvc3d::cli {
+
+std::vector<std::string> split_commas(const std::string& text, EmptyItems empty) {
+    std::vector<std::string> items;
+    std::size_t start = 0;
+    for (std::size_t i = 0; i <= text.size(); ++i)
+        if (i == text.size() || text[i] == ',') {
+            if (empty == EmptyItems::keep || i > start) items.push_back(text.substr(start, i - start));
+            start = i + 1;
+        }
+    return items;
+}
 
 double parse_number(const std::string& s, const std::string& what) {
     double v = 0;
@@ -83,13 +93,7 @@ void warn_if_blocked(const World& world, const Pose& pose) {
 }
 
 Pose parse_pose(const std::string& text) {
-    std::vector<std::string> parts;
-    std::size_t start = 0;
-    for (std::size_t i = 0; i <= text.size(); ++i)
-        if (i == text.size() || text[i] == ',') {
-            parts.push_back(text.substr(start, i - start));
-            start = i + 1;
-        }
+    const auto parts = split_commas(text, EmptyItems::keep);
     if (parts.size() != 3)
         throw InputError("--pose expects X,Y,HEADING (three comma-separated numbers), got '" + text + "'");
     Pose p;  // on the floor, level
@@ -105,59 +109,6 @@ Pose parse_pose(const std::string& text) {
 
 std::string num(double v) { return format_number(v); }
 
-namespace {
-
-// Text as one shell word: as it is when safe, else single-quoted.
-std::string shell_word(const std::string& s) {
-    const bool safe = !s.empty() && s.find_first_not_of(
-                                        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-                                        "_-./:=+,@%") == std::string::npos;
-    if (safe) return s;
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-}  // namespace
-
-std::string PythonCommand::shell_line(const std::string& module, const std::vector<std::string>& args) const {
-    std::string line = "PYTHONPATH=" + shell_word(pythonpath) + " " + shell_word(python) + " -m " + module;
-    for (const auto& a : args) line += " " + shell_word(a);
-    return line;
-}
-
-PythonCommand python_command() {
-    const char* py_env = std::getenv("BVC3D_PYTHON");
-    const char* path_env = std::getenv("BVC3D_PYTHONPATH");
-    PythonCommand c{py_env && *py_env ? py_env : BVC3D_PYTHON, path_env && *path_env ? path_env : BVC3D_PYTHON_DIR};
-    if (const char* existing = std::getenv("PYTHONPATH"); existing && *existing && c.pythonpath != existing)
-        c.pythonpath += std::string(":") + existing;
-    return c;
-}
-
-int run_python_module(const std::string& module, const std::vector<std::string>& args) {
-    const PythonCommand command = python_command();
-    const std::string& python = command.python;
-    const std::string& pythonpath = command.pythonpath;
-    std::vector<std::string> argv_text{python, "-m", module};
-    argv_text.insert(argv_text.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : argv_text) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::fflush(stdout);  // our lines first, then the module's
-    const pid_t pid = ::fork();
-    if (pid < 0) return -1;
-    if (pid == 0) {
-        ::setenv("PYTHONPATH", pythonpath.c_str(), 1);
-        ::execv(python.c_str(), argv.data());
-        std::perror(("bvc3d: cannot run " + python).c_str());
-        ::_exit(127);
-    }
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 const char* const extent_help =
     "Rate-map grid: 'data' (each trajectory's own bounds, the default), 'arena' (the walkable region's) or "
     "XMIN,XMAX,YMIN,YMAX in meters";
@@ -169,13 +120,7 @@ ExtentOption parse_extent(const std::string& text) {
         e.kind = ExtentOption::Kind::arena;
         return e;
     }
-    std::vector<std::string> parts;
-    std::size_t start = 0;
-    for (std::size_t i = 0; i <= text.size(); ++i)
-        if (i == text.size() || text[i] == ',') {
-            parts.push_back(text.substr(start, i - start));
-            start = i + 1;
-        }
+    const auto parts = split_commas(text, EmptyItems::keep);
     if (parts.size() != 4) throw InputError("--extent expects data, arena or XMIN,XMAX,YMIN,YMAX, got '" + text + "'");
     e.kind = ExtentOption::Kind::bounds;
     e.bounds = analysis::Extent{parse_number(parts[0], "--extent: XMIN"), parse_number(parts[1], "--extent: XMAX"),
@@ -194,21 +139,36 @@ void apply_extent(const ExtentOption& e, TrialConfig& t) {
     if (e.kind == ExtentOption::Kind::bounds) t.analysis.extent = e.bounds;
 }
 
-int check_jobs(int jobs) {
-    if (jobs < 0) throw InputError("--jobs must be >= 0 (0: one per core), got " + std::to_string(jobs));
-    if (jobs > max_jobs)
-        throw InputError("--jobs " + std::to_string(jobs) + " is more than the limit of " + std::to_string(max_jobs));
-    return jobs;
+namespace {
+
+// Ctrl-C (SIGINT) or SIGTERM (mpirun passing on a Ctrl-C, a batch system's time limit) asks running
+// trials to checkpoint and stop; a second signal ends the program at once.
+extern "C" void on_stop_signal(int sig) {
+    stop_flag().store(true);
+    std::signal(sig, SIG_DFL);
 }
 
-const char* const no_memory_check_help = "Run even when the estimated memory exceeds what the machine has available";
+}  // namespace
 
-void check_run_memory(const std::vector<TrialConfig>& trials, int jobs, bool skip) {
-    if (skip) return;
-    const std::string what =
-        trials.size() == 1 ? "this trial" : "this run (" + std::to_string(trials.size()) + " trials)";
-    check_memory(estimate_memory(trials, jobs), what,
-                 "shorten sample_hours, use fewer --jobs or smaller models, or pass --no-memory-check to try anyway");
+std::atomic<bool>& stop_flag() {
+    static std::atomic<bool> stop{false};  // set from the SIGINT handler
+    return stop;
 }
+
+InterruptGuard::InterruptGuard() {
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+}
+InterruptGuard::~InterruptGuard() {
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+}
+
+void exit_interrupted() {
+    std::cerr << "\nbvc3d: interrupted; finished trials are kept. Run the same command again to resume.\n";
+    std::exit(130);
+}
+
+ProgressStyle progress_style() { return ::isatty(STDERR_FILENO) ? ProgressStyle::terminal : ProgressStyle::lines; }
 
 }  // namespace bvc3d::cli

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
@@ -15,7 +16,9 @@
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/experiment/elevation_chooser.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "recording_options.hpp"
+#include "run_options.hpp"
 
 namespace bvc3d::cli {
 
@@ -27,6 +30,7 @@ struct ChooseOptions {
     ChooserParams params;
     RecordingOptions recording;
     PreprocessOptions preprocess;
+    RunOptions run;  // --jobs
 };
 
 std::shared_ptr<const AgentSpec> named_agent(const std::string& name) {
@@ -98,7 +102,9 @@ void choose(const ChooseOptions& o) {
     const Exploration exploration = exploration_of(o);
     const auto& agent = exploration.agent;
     const ChooserDefaults defaults = chooser_defaults(*agent);
+    o.run.check();
     ChooserParams p = o.params;
+    p.jobs = o.run.jobs;
     std::tie(p.min_layers, p.max_layers) = parse_layers(o.layers);
     p.elevation_min = o.elevation_min.value_or(defaults.symmetric_range ? -p.elevation_max : p.elevation_min);
     ModelSpec base = model_preset(defaults.model);
@@ -164,9 +170,8 @@ void add_adaptive_command(CLI::App& app) {
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
     cmd->add_option("--sensor", o->sensor,
                     "Sensor preset or YAML file (default: spherical on the ground, spherical-full when flying)");
-    cmd->add_option("--agent", o->agent,
-                    "Who explores: ground (the paper's random walk, default) or flying (the flying agent; the world "
-                    "needs a flight volume)");
+    const std::string who = "; default ground (a flying agent's world needs a flight volume)";
+    cmd->add_option("--agent", o->agent, "Who explores: " + agent_names_text() + who);
     cmd->add_option("--scans", o->scans,
                     "Instead of a world: a recording's scans (folder, list or file); its poses are the walk, its scans "
                     "the returns");
@@ -185,7 +190,7 @@ void add_adaptive_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--seed", o->params.seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
     cmd->add_option("--sets", o->sets, "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
-    cmd->add_option("--jobs", o->params.jobs, "Threads sharing the candidates; 0 (the default): one per core");
+    o->run.add_jobs(*cmd, "Threads sharing the candidates; 0 (the default): one per core");
     cmd->add_option("--out", o->out, "Model YAML file to write")->required();
     cmd->callback([o] { choose(*o); });
 }

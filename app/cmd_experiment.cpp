@@ -1,24 +1,18 @@
-// bvc3d run / paper / analyze: trials, the paper's experiment, and analysis of trial files.
-#include <sys/wait.h>
-#include <unistd.h>
-
+// bvc3d run / paper / analyze / summarize: trials, the paper's experiment, and analysis of trial files.
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
+#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
-#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/protocols.hpp"
 #include "bvc3d/config/sweep_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
@@ -28,219 +22,24 @@
 #include "bvc3d/experiment/pipeline.hpp"
 #include "bvc3d/report/summary.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
+#include "run_options.hpp"
+#include "summary_report.hpp"
 
 namespace bvc3d::cli {
 
 namespace {
 
-// Ctrl-C (SIGINT) or SIGTERM (mpirun passing on a Ctrl-C, a batch system's time limit) asks running
-// trials to checkpoint and stop; a second signal ends the program at once.
-extern "C" void on_stop_signal(int sig) {
-    stop_flag().store(true);
-    std::signal(sig, SIG_DFL);
-}
-
-std::vector<std::string> split(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
-// How the report child process ended: its exit status (-1 if it could not run or died by a
-// signal) and the last line it printed on standard error.
-struct ReportRun {
-    int status = -1;
-    std::string error_text, last_error_line;  // all it wrote to standard error, and its last line
-};
-
-// Runs the report module as a child process (no shell). Its standard error is kept, to say why it
-// failed (report_failure); the caller decides what of it to show.
-ReportRun run_report(const PythonCommand& command, const std::filesystem::path& dir) {
-    std::fflush(stdout);  // our lines first, then the report's
-    std::fflush(stderr);
-    int pipe_fds[2];
-    if (::pipe(pipe_fds) != 0) return {};
-    const pid_t pid = ::fork();
-    if (pid < 0) {
-        ::close(pipe_fds[0]);
-        ::close(pipe_fds[1]);
-        return {};
-    }
-    if (pid == 0) {
-        ::close(pipe_fds[0]);
-        ::dup2(pipe_fds[1], STDERR_FILENO);
-        ::close(pipe_fds[1]);
-        ::setenv("PYTHONPATH", command.pythonpath.c_str(), 1);
-        ::execl(command.python.c_str(), command.python.c_str(), "-m", "bvc3d.report", dir.c_str(),
-                static_cast<char*>(nullptr));
-        std::perror(("bvc3d: cannot run " + command.python).c_str());
-        ::_exit(127);
-    }
-    ::close(pipe_fds[1]);
-    ReportRun run;
-    std::string& text = run.error_text;
-    char buf[4096];
-    for (;;) {
-        const ssize_t n = ::read(pipe_fds[0], buf, sizeof buf);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
-        text.append(buf, static_cast<std::size_t>(n));
-    }
-    ::close(pipe_fds[0]);
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
-    run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::string tail = text;
-    while (!tail.empty() && (tail.back() == '\n' || tail.back() == '\r')) tail.pop_back();
-    const auto nl = tail.rfind('\n');
-    run.last_error_line = nl == std::string::npos ? tail : tail.substr(nl + 1);
-    return run;
-}
-
-// True if a PNG file is complete (ends with its IEND chunk).
-bool png_complete(const std::filesystem::path& file) {
-    static const char iend[] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xae', '\x42', '\x60', '\x82'};
-    std::ifstream in(file, std::ios::binary | std::ios::ate);
-    if (!in || in.tellg() < 12) return false;
-    in.seekg(-12, std::ios::end);
-    char tail[12];
-    return static_cast<bool>(in.read(tail, 12)) && std::equal(tail, tail + 12, iend);
-}
-
-// After a failed report: nothing half-written stays. Temporary files, and figures that do not end
-// where a PNG ends, are removed (and returned); complete figures stay.
-std::vector<std::filesystem::path> remove_partial_report(const std::filesystem::path& dir) {
-    std::vector<std::filesystem::path> removed;
-    std::error_code ec;
-    for (const auto& folder : {dir, dir / "figures"}) {
-        if (!std::filesystem::is_directory(folder, ec)) continue;
-        for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
-            const auto name = e.path().filename().string();
-            // The report's own temporaries ("report.md.tmp") and ours ("x.csv.tmp<pid>-<n>").
-            const auto at = name.rfind(".tmp");
-            const bool temporary =
-                at != std::string::npos && name.find_first_not_of("0123456789-", at + 4) == std::string::npos;
-            const bool broken_png = e.path().extension() == ".png" && !png_complete(e.path());
-            if (e.is_regular_file(ec) && (temporary || broken_png) && std::filesystem::remove(e.path(), ec))
-                removed.push_back(e.path());
-        }
-    }
-    return removed;
-}
-
-// Why a report failed, from its last line: Python's "OSError: [Errno 28] No space left on device"
-// becomes "cannot write 'DIR/figures/msai.png': No space left on device" (the file from the error,
-// or the half-written figure that was removed). Empty `os_error` for any other failure.
-std::string report_failure(const ReportRun& run, const std::vector<std::filesystem::path>& removed, bool& os_error) {
-    const std::string& line = run.last_error_line;
-    const auto errno_at = line.find("[Errno ");
-    const auto close = errno_at == std::string::npos ? std::string::npos : line.find("] ", errno_at);
-    os_error = close != std::string::npos;
-    if (os_error) {
-        std::string reason = line.substr(close + 2), file;
-        const auto quote = reason.find(": '");
-        if (quote != std::string::npos && reason.back() == '\'') {
-            file = reason.substr(quote + 3, reason.size() - quote - 4);
-            reason.resize(quote);
-        } else if (!removed.empty()) {
-            file = removed.front().string();
-        }
-        return file.empty() ? "writing the figures failed: " + reason : "cannot write '" + file + "': " + reason;
-    }
-    if (run.status < 0) return "the report process could not run or was killed";
-    return line.empty() ? "the report exited with status " + std::to_string(run.status) : printable(line);
-}
-
-}  // namespace
-
-std::atomic<bool>& stop_flag() {
-    static std::atomic<bool> stop{false};  // set from the SIGINT handler
-    return stop;
-}
-
-InterruptGuard::InterruptGuard() {
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-}
-InterruptGuard::~InterruptGuard() {
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
-}
-
-void exit_interrupted() {
-    std::cerr << "\nbvc3d: interrupted; finished trials are kept. Run the same command again to resume.\n";
-    std::exit(130);
-}
-
-ProgressStyle progress_style() { return ::isatty(STDERR_FILENO) ? ProgressStyle::terminal : ProgressStyle::lines; }
-
-ExperimentOutcome run_local_experiment(const std::vector<TrialConfig>& trials, const std::filesystem::path& out,
-                                       const LocalRun& how) {
-    check_jobs(how.jobs);
-    if (how.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-    check_run_memory(trials, how.jobs, how.no_memory_check);
-    ExperimentOptions opts;
-    opts.out_dir = out;
-    opts.jobs = how.jobs;
-    opts.progress = progress_style();
-    opts.checkpoint_minutes = how.checkpoint_minutes;
-    opts.stop = &stop_flag();
-    opts.on_trial_done = how.on_done;
-    InterruptGuard guard;
-    try {
-        return run_experiment(trials, opts);
-    } catch (const Interrupted&) {
-        exit_interrupted();
-    }
-}
-
-void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome) {
-    std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", n_trials, out.c_str(), outcome.ran,
-                outcome.skipped, outcome.wall_seconds);
-    if (outcome.steps > 0)
-        std::printf(", %.0f walk steps/s, %.0f model steps/s", outcome.steps / outcome.wall_seconds,
-                    outcome.model_steps / outcome.wall_seconds);
-    std::printf("\n");
-}
-
-void summarize(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report,
-               bool allow_mixed) {
-    const auto trials = read_summaries(files);
-    if (const auto problem = mixing_problem(trials, files); !problem.empty() && !allow_mixed)
-        throw InputError(problem + "; one table would mix them (summarize them apart, or pass --allow-mixed)");
-    const auto rows = summarize(trials);
-    write_trials_csv(out / "trials.csv", trials);
-    write_summary_csv(out / "summary.csv", rows);
-    write_summary_markdown(out / "summary.md", rows);
-    if (!report) return;
-    const PythonCommand command = python_command();
-    const ReportRun run = run_report(command, out);
-    if (run.status == 0) {
-        std::fputs(run.error_text.c_str(), stderr);  // the report's own warnings
-        return;
-    }
-    const auto removed = remove_partial_report(out);
-    bool os_error = false;
-    const std::string why = report_failure(run, removed, os_error);
-    if (!os_error) std::fputs(run.error_text.c_str(), stderr);  // a bug's traceback is worth showing
-    throw InputError("the report (figures) failed: " + why + "; the trial files and summary are in '" + out.string() +
-                     "'; rerun it with:\n  " + command.shell_line("bvc3d.report", {out.string()}));
-}
-
-namespace {
-
-struct RunOptions {
-    std::string config, world, lean, model, protocol, extent, out, trajectory, agent;
+struct TrialOptions {
+    std::string config, world, lean, model, protocol, extent, trajectory, agent;
     std::optional<double> tilt, explore_hours, sample_hours, hours;
     std::optional<std::uint64_t> seed;
-    bool record_bvc = false, no_memory_check = false;
-    double checkpoint_minutes = 10;
+    bool record_bvc = false;
+    RunOptions run;  // --out: the trial file; --checkpoint-minutes; --no-memory-check
 };
 
 // The trial `bvc3d run` runs: the YAML file's, with the flags on top.
-TrialConfig run_config(const RunOptions& o) {
+TrialConfig run_config(const TrialOptions& o) {
     TrialConfig t = o.config.empty() ? TrialConfig{} : config::load_trial_file(o.config);
     if (!o.world.empty()) t.world = WorldSpec{o.world, std::nullopt, "+x+y"};
     if (o.tilt) t.world.tilt_deg = o.tilt;
@@ -262,7 +61,7 @@ TrialConfig run_config(const RunOptions& o) {
     if (o.sample_hours) t.protocol.sample_hours = *o.sample_hours;
     if (o.record_bvc) t.protocol.record_bvc = true;
     if (!o.extent.empty()) apply_extent(parse_extent(o.extent), t);
-    if (o.checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
+    o.run.check();
     t.check_runnable();  // fail early on bad worlds, start points and robots
     return t;
 }
@@ -306,7 +105,8 @@ void run_one(const TrialConfig& t, const std::filesystem::path& out, double chec
 
 void add_run(CLI::App& app) {
     auto* cmd = app.add_subcommand("run", "Run one trial and write its HDF5 file");
-    auto o = std::make_shared<RunOptions>();
+    auto o = std::make_shared<TrialOptions>();
+    o->run.checkpoint_minutes = 10;
     cmd->add_option("--config", o->config, "Trial YAML file (docs/experiments.md); flags below override it");
     cmd->add_option("--world", o->world, "World preset or YAML file (default cross)");
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
@@ -314,9 +114,8 @@ void add_run(CLI::App& app) {
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
     cmd->add_option("--trajectory", o->trajectory,
                     "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
-    cmd->add_option(
-        "--agent", o->agent,
-        "random_walk or ground (the ground robot, default), flight or flying (the flying agent; docs/flying.md)");
+    cmd->add_option("--agent", o->agent,
+                    "The agent, by name: " + agent_names_text() + "; default " + agent_kinds().front().name);
     cmd->add_option("--seed", o->seed, "Random seed, 0 .. 2^64 - 1 (default 0)")->check(seed_check);
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (the paper's, default) or online");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
@@ -324,47 +123,42 @@ void add_run(CLI::App& app) {
     cmd->add_option("--hours", o->hours, "Shorten both phases to this many simulated hours");
     cmd->add_flag("--record-bvc", o->record_bvc, "Also record the BVC rates");
     cmd->add_option("--extent", o->extent, extent_help);
-    cmd->add_option("--out", o->out, "Trial file to write (default results/<trial name>.h5)");
-    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
-                    "Checkpoint every this many simulated minutes (0: only on Ctrl-C)")
-        ->capture_default_str();
-    cmd->add_flag("--no-memory-check", o->no_memory_check, no_memory_check_help);
+    o->run.add_out(*cmd, "Trial file to write (default results/<trial name>.h5)");
+    o->run.add_checkpoint_minutes(*cmd);
+    o->run.add_no_memory_check(*cmd);
     cmd->footer("Ctrl-C checkpoints and stops; running the same command again resumes and gives the same file.");
     cmd->callback([o] {
         const TrialConfig t = run_config(*o);
-        const std::filesystem::path out =
-            o->out.empty() ? std::filesystem::path("results") / (t.name() + ".h5") : std::filesystem::path(o->out);
-        require_not_directory(out, "--out");
-        ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
-        const OutputLock lock(file_lock_path(out), "trial file '" + out.string() + "'");
+        const std::filesystem::path out = o->run.out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
+                                                             : std::filesystem::path(o->run.out);
+        const OutputLock lock = lock_output_file(out);
         if (trial_file_complete(out, t)) {
             std::cerr << "bvc3d: " << out.string() << " is complete with this configuration; nothing to do\n";
             return;
         }
-        check_run_memory({t}, 1, o->no_memory_check);
-        run_one(t, out, o->checkpoint_minutes);
+        o->run.check_memory({t}, 1);
+        run_one(t, out, o->run.checkpoint_minutes);
     });
 }
 
 struct PaperOptions {
-    std::string out = "results/paper", models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol, extent;
+    std::string models = "2d,3d-0.1,3d-0.2,3d-3l", tilts = "0,30,45,60", protocol, extent;
     std::string preset = "spec", choices;
-    int seeds = 1, jobs = 0;
+    int seeds = 1;
     std::optional<double> hours;
-    double checkpoint_minutes = 0;
-    bool no_report = false, no_memory_check = false;
+    RunOptions run{"results/paper"};
 };
 
 // Models × tilts × seeds, seeds slowest.
 std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
     std::vector<ModelSpec> models;
-    for (const auto& m : split(o.models)) models.push_back(config::resolve_model(m));
+    for (const auto& m : split_commas(o.models)) models.push_back(config::resolve_model(m));
     if (models.empty()) throw InputError("--models lists no model");
     std::vector<double> tilts;
-    for (const auto& t : split(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
+    for (const auto& t : split_commas(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
     std::vector<std::string> choices = paper_preset(o.preset).choices;
-    for (const auto& c : split(o.choices)) choices.push_back(c);
+    for (const auto& c : split_commas(o.choices)) choices.push_back(c);
     const double n_trials =
         static_cast<double>(o.seeds) * static_cast<double>(models.size()) * static_cast<double>(tilts.size());
     if (o.seeds < 1) throw InputError("--seeds must be >= 1, got " + std::to_string(o.seeds));
@@ -382,6 +176,7 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
                 TrialConfig t;
                 t.world = WorldSpec{"cross", tilt, "+x+y"};
                 t.model = m;
+                t.protocol = protocol_preset("paper");
                 t.seed = static_cast<std::uint64_t>(seed);
                 apply_authors_choices(t, choices);
                 if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
@@ -396,10 +191,11 @@ void add_paper(CLI::App& app) {
     auto* cmd =
         app.add_subcommand("paper", "Run the paper's experiment: models x tilted worlds x seeds, summary, figures");
     auto o = std::make_shared<PaperOptions>();
-    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
+    o->run.add_experiment_options(*cmd);
     cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
-    cmd->add_option("--hours", o->hours, "Shorten both phases to H simulated hours (default: the paper's 4 + 4)");
-    cmd->add_option("--jobs", o->jobs, "Trials in parallel; 0 (the default): one per core");
+    cmd->add_option("--hours", o->hours,
+                    "Shorten both phases to H simulated hours (default: the paper's " +
+                        protocol_hours_text(protocol_preset("paper")) + ")");
     cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
     cmd->add_option("--tilts", o->tilts, "Comma-separated tilts of the cross arena, degrees")->capture_default_str();
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
@@ -411,28 +207,16 @@ void add_paper(CLI::App& app) {
         "--authors-choices", o->choices,
         "Comma-separated authors' choices to switch on besides the preset's (docs/reproduction.md):" + choice_names);
     cmd->add_option("--extent", o->extent, extent_help);
-    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
-                    "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
-    cmd->add_flag("--no-report", o->no_report, "Skip the figures (trial files and summary only)");
-    cmd->add_flag("--no-memory-check", o->no_memory_check, no_memory_check_help);
     cmd->footer(
         "Writes one HDF5 file per trial, trials.csv, summary.csv, summary.md, and the figures and report.md (the\n"
         "Python module bvc3d.report, run with " BVC3D_PYTHON
         " or $BVC3D_PYTHON). Completed trials are skipped on\n"
         "a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
-        check_jobs(o->jobs);
-        if (o->checkpoint_minutes < 0) throw InputError("--checkpoint-minutes must be >= 0");
-        const auto trials = paper_trials(*o);
-        check_runnable(trials);  // before anything is written
-        ensure_writable_directory(o->out);
-        const OutputLock lock(folder_lock_path(o->out), "output folder '" + o->out + "'");
-        const ExperimentOutcome outcome =
-            run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, o->no_memory_check, {}});
-        print_outcome(trials.size(), o->out, outcome);
-        summarize(o->out, outcome.files, !o->no_report);
-        std::printf("summary: %s/summary.md%s\n", o->out.c_str(),
-                    o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
+        o->run.check();
+        run_experiment_in_folder(paper_trials(*o), o->run);
+        std::printf("summary: %s/summary.md%s\n", o->run.out.c_str(),
+                    o->run.no_report ? "" : (", report: " + o->run.out + "/report.md").c_str());
     });
 }
 
@@ -564,7 +348,7 @@ void add_summarize(CLI::App& app) {
         if (!std::filesystem::is_directory(o->dir, ec))
             throw InputError("'" + o->dir + "' is not a folder" +
                              (std::filesystem::exists(o->dir, ec) ? "" : " (it does not exist)"));
-        const OutputLock lock(folder_lock_path(o->dir), "output folder '" + o->dir + "'");
+        const OutputLock lock = lock_output_folder(o->dir);
         std::vector<std::filesystem::path> candidates, files;
         for (const auto& e : std::filesystem::directory_iterator(o->dir))
             if (e.path().extension() == ".h5") candidates.push_back(e.path());

@@ -1,33 +1,33 @@
 // bvc3d flight: the flying agents' experiment (docs/flying.md), models × worlds × seeds.
-#include <sstream>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
 
-#include "bvc3d/agent/flying_walk.hpp"
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/protocols.hpp"
 #include "bvc3d/core/error.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
+#include "run_options.hpp"
 
 namespace bvc3d::cli {
 
 namespace {
 
+// The agent of the experiment: its kind says which protocol it runs.
+const AgentKind& flying_kind() { return agent_kind("flight"); }
+
 struct FlightOptions {
-    std::string out = "results/flight", models = "fly-up,fly-5l,fly-9l", worlds = "flight-room,atrium,cross-60",
-                protocol;
-    int seeds = 1, jobs = 0;
+    std::string models = "fly-up,fly-5l,fly-9l", worlds = "flight-room,atrium,cross-60", protocol;
+    int seeds = 1;
     std::optional<double> hours, explore_hours, sample_hours;
-    double checkpoint_minutes = 0;
-    bool no_report = false;
+    RunOptions run{"results/flight"};
 };
 
-std::vector<std::string> split_list(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
-// Models × worlds × seeds, seeds slowest; the protocol of docs/flying.md (8 h + 8 h) unless shortened.
+// Models × worlds × seeds, seeds slowest; the flying agent's protocol (docs/flying.md) unless shortened.
 std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
     if (o.seeds < 1) throw InputError("--seeds must be >= 1");
     for (const auto& [h, name] :
@@ -35,11 +35,11 @@ std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
         if (h && !(*h > 0 || (*h == 0 && std::string(name) == "--explore-hours")))
             throw InputError(std::string(name) + " must be a positive number of hours");
     std::vector<ModelSpec> models;
-    for (const auto& m : split_list(o.models)) models.push_back(config::resolve_model(m));
+    for (const auto& m : split_commas(o.models)) models.push_back(config::resolve_model(m));
     if (models.empty()) throw InputError("--models lists no model");
-    const auto worlds = split_list(o.worlds);
+    const auto worlds = split_commas(o.worlds);
     if (worlds.empty()) throw InputError("--worlds lists no world");
-    const auto agent = std::make_shared<FlightSpec>();
+    const auto agent = flying_kind().make_default();
     std::vector<TrialConfig> trials;
     for (int seed = 0; seed < o.seeds; ++seed)
         for (const auto& w : worlds)
@@ -49,7 +49,7 @@ std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
                 t.model = m;
                 t.set_agent(agent);
                 t.seed = static_cast<std::uint64_t>(seed);
-                t.protocol.explore_hours = t.protocol.sample_hours = 8.0;
+                t.protocol = protocol_preset(flying_kind().protocol);
                 if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
                 if (o.hours) t.protocol.explore_hours = t.protocol.sample_hours = *o.hours;
                 if (o.explore_hours) t.protocol.explore_hours = *o.explore_hours;
@@ -66,32 +66,27 @@ void add_flight_command(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "flight", "Run the flying agents' experiment: models x worlds x seeds, 3-D place fields, summary, figures");
     auto o = std::make_shared<FlightOptions>();
-    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
+    o->run.add_experiment_options(*cmd);
     cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
     cmd->add_option("--worlds", o->worlds, "Comma-separated worlds with a flight volume (presets or YAML files)")
         ->capture_default_str();
     cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
-    cmd->add_option("--hours", o->hours, "Both phases this many simulated hours (default 8 + 8)");
+    cmd->add_option("--hours", o->hours,
+                    "Both phases this many simulated hours (default " +
+                        protocol_hours_text(protocol_preset(flying_kind().protocol)) + ")");
     cmd->add_option("--explore-hours", o->explore_hours, "Simulated hours of exploration (learning on)");
     cmd->add_option("--sample-hours", o->sample_hours, "Simulated hours of sampling (recorded)");
-    cmd->add_option("--jobs", o->jobs, "Trials in parallel (default: every core)");
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
-    cmd->add_option("--checkpoint-minutes", o->checkpoint_minutes,
-                    "Checkpoint running trials every this many simulated minutes (0: only on Ctrl-C)");
-    cmd->add_flag("--no-report", o->no_report, "Skip the figures (trial files and summary only)");
     cmd->footer(
         "The flying agent (a 0.2 m sphere on a 3-D random walk) in each world's flight volume; 3-D rate maps on\n"
         "0.5 m voxels, DBSCAN min_samples 10, field isotropy, horizontal and vertical decoding (docs/flying.md).\n"
         "Writes one HDF5 file per trial (format version 2), trials.csv, summary.csv, summary.md, and the figures\n"
         "and report.md. Completed trials are skipped on a rerun; Ctrl-C stops cleanly and can be resumed.");
     cmd->callback([o] {
-        const auto trials = flight_trials(*o);
-        const ExperimentOutcome outcome =
-            run_local_experiment(trials, o->out, LocalRun{o->jobs, o->checkpoint_minutes, false, {}});
-        print_outcome(trials.size(), o->out, outcome);
-        summarize(o->out, outcome.files, !o->no_report);
-        std::printf("summary: %s/summary.md%s\n", o->out.c_str(),
-                    o->no_report ? "" : (", report: " + o->out + "/report.md").c_str());
+        o->run.check();
+        run_experiment_in_folder(flight_trials(*o), o->run);
+        std::printf("summary: %s/summary.md%s\n", o->run.out.c_str(),
+                    o->run.no_report ? "" : (", report: " + o->run.out + "/report.md").c_str());
     });
 }
 

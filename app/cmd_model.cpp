@@ -10,6 +10,7 @@
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
 
 namespace bvc3d::cli {
 

@@ -9,7 +9,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/config/model_yaml.hpp"
@@ -25,7 +24,10 @@
 #include "bvc3d/recording/recording.hpp"
 #include "bvc3d/recording/voxel_map.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
+#include "python_module.hpp"
 #include "recording_options.hpp"
+#include "run_options.hpp"
 
 namespace bvc3d::cli {
 
@@ -35,14 +37,6 @@ namespace fs = std::filesystem;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-std::vector<std::string> split_list(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
 }
 
 // A progress line on a terminal ("\r  what i/n"), nothing otherwise.
@@ -145,7 +139,7 @@ void add_replay(CLI::App& app) {
             replay_trial(source, config::resolve_model(o->model), o->learn, weights_from(o->weights), o->seed);
         const fs::path out =
             o->out.empty() ? fs::path("results") / (t.world_label() + "_" + t.model.name + ".h5") : fs::path(o->out);
-        ensure_writable_directory(out.has_parent_path() ? out.parent_path() : ".");
+        const OutputLock lock = lock_output_file(out);
         const std::size_t n = source.path->steps().size();
         ProgressLine line;
         RunControl control;
@@ -320,7 +314,7 @@ void add_localize(CLI::App& app) {
     cmd->callback([o] {
         if (o->rates != "bvc" && o->rates != "place") throw InputError("--rates must be 'bvc' or 'place'");
         const bool bvc = o->rates == "bvc";
-        const auto models = split_list(o->models);
+        const auto models = split_commas(o->models);
         if (models.empty()) throw InputError("--model lists no model");
         const RecordedReturnParams pre = o->preprocess.get();
 
@@ -349,7 +343,7 @@ void add_localize(CLI::App& app) {
             templates = side(o->templates, o->template_poses);
             queries = side(o->queries, o->query_poses);
         }
-        ensure_writable_directory(o->out);
+        const OutputLock lock = lock_output_folder(o->out);
 
         // Every model on each recording at once: one replay per recording, its scans read once.
         std::vector<ModelSpec> specs;
@@ -403,7 +397,7 @@ void add_localize(CLI::App& app) {
             if (r.n_undecoded)
                 std::printf("  %s: %zu queries undecoded (no positive similarity)\n", row.model.c_str(), r.n_undecoded);
         }
-        if (!o->no_figure && run_python_module("bvc3d.localization_figure", {o->out}) != 0)
+        if (!o->no_figure && run_python_module("bvc3d.localization_figure", {o->out}).status != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
                              python_command().shell_line("bvc3d.localization_figure", {o->out}));
         std::printf("tables: %s/localization.md, localization.csv, queries.csv%s\n", o->out.c_str(),

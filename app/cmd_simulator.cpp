@@ -11,6 +11,8 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/memory.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
+#include "run_options.hpp"
 
 namespace bvc3d::cli {
 

@@ -9,6 +9,7 @@
 
 #include "bvc3d/core/error.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
 
 namespace {
 

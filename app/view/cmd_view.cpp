@@ -8,6 +8,7 @@
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "view/export.hpp"
 #include "view/safe_path.hpp"
 #include "view/server.hpp"

@@ -266,6 +266,20 @@ void bind_voxel_functions(pyb::module_& a) {
 
 void bind_analysis(pyb::module_& m) {
     auto a = m.def_submodule("analysis", "Analysis stage (use bvc3d.analysis)");
+    a.def(
+        "defaults",
+        [](int dims) {
+            if (dims != 2 && dims != 3) throw InputError("dims must be 2 or 3, got " + std::to_string(dims));
+            const auto p = an::AnalysisParams::defaults(dims);
+            pyb::dict d;
+            for (const auto& f : an::AnalysisParams::table().fields()) d[f.key.c_str()] = from_value(f.get(p));
+            d["voxel"] = p.voxel;  // not a key of the table (trial files of 2-D trials do not record it)
+            return d;
+        },
+        pyb::arg("dims"),
+        "The analysis parameters' defaults for positions of `dims` (2 or 3) coordinates, by the keys of the C++ "
+        "table (AnalysisParams::table()), and the voxel side: what bvc3d.analysis takes as its defaults");
+    a.attr("decoding_templates") = an::AnalysisParams::table().find("decoding_templates")->choices;
     bind_sample_functions<float>(a);  // first: taken only for float32 input, without conversion
     bind_sample_functions<double>(a);
     bind_voxel_functions<float>(a);

@@ -4,8 +4,10 @@
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/authors.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/protocols.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/experiment/elevation_chooser.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
@@ -41,19 +43,22 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     t.model = config::resolve_model(model);
     t.world = WorldSpec{world, tilt_deg, t.world.lean};
     t.seed = seed_of(seed, "seed");
-    const bool flying = kwargs.contains("agent") && agent_by_name(pyb::str(kwargs["agent"]))->kind() == "flight";
-    if (kwargs.contains("flight") && !flying)
+    const auto agent = kwargs.contains("agent") ? agent_by_name(pyb::str(kwargs["agent"])) : nullptr;
+    const bool flight = agent && dynamic_cast<const FlightSpec*>(agent.get());
+    if (kwargs.contains("flight") && !flight)
         throw InputError("flight= (the flying agent's parameters) needs agent='flight'");
-    if (flying) {
-        FlightParams flight;
-        if (kwargs.contains("flight") && !kwargs["flight"].is_none())
-            apply_kwargs(flight, FlightParams::table(), kwargs["flight"].cast<pyb::kwargs>());
-        t.set_agent(std::make_shared<FlightSpec>(flight));
-        // The flying agents' protocol (docs/flying.md): 8 h + 8 h unless the keywords say otherwise.
-        t.protocol.explore_hours = t.protocol.sample_hours = 8.0;
+    if (agent) {
+        t.set_agent(agent);
+        // The protocol of the agent's kind (docs/flying.md: 8 h + 8 h when flying) unless the keywords say otherwise.
+        t.protocol = protocol_preset(agent_kind_of(*agent).protocol);
+    }
+    if (flight && kwargs.contains("flight") && !kwargs["flight"].is_none()) {
+        FlightParams params;
+        apply_kwargs(params, FlightParams::table(), kwargs["flight"].cast<pyb::kwargs>());
+        t.set_agent(std::make_shared<FlightSpec>(params));
     }
     if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) {
-        if (flying) throw InputError("give agent='flight' or trajectory=, not both");
+        if (agent) throw InputError("give agent= or trajectory=, not both");
         t.set_agent(trajectory_of(kwargs["trajectory"]));
     }
     if (kwargs.contains("authors_choices"))
@@ -128,10 +133,13 @@ void bind_experiment(pyb::module_& m) {
 (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded, and
 metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset or world YAML;
 tilt_deg: for world="cross" or "cross-webots"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
-follow instead of the random walk; agent="flight" for the flying agent (docs/flying.md: a fly-*
-model, a world with a flight volume, 8 h + 8 h unless given, 3-D metrics), with flight=dict(...)
-for its parameters (see flying_walk); authors_choices: a list of the authors' choices to switch on (as
-`bvc3d paper --authors-choices`; ["all"] for all of them; protocol keywords still apply after them).
+follow instead of the random walk; agent: the agent by name, )doc" +
+         agent_names_text() + R"doc(; agent="flight" is the flying agent (docs/flying.md: a fly-* model,
+a world with a flight volume, )doc" +
+         protocol_hours_text(protocol_preset(agent_kind("flight").protocol)) +
+         R"doc( h unless given, 3-D metrics), with flight=dict(...) for its parameters (see
+flying_walk); authors_choices: a list of the authors' choices to switch on (as `bvc3d paper
+--authors-choices`; ["all"] for all of them; protocol keywords still apply after them).
 Protocol keywords and their defaults:
 )doc" + describe(Protocol::table(), Protocol{}))
             .c_str());

@@ -22,6 +22,11 @@ import numpy as np
 
 from ._core import analysis as _an
 
+# The defaults are the C++ analysis parameters' (AnalysisParams::table(), the ones trial files record
+# and `bvc3d config` prints): for 2-D positions, and for 3-D ones (DBSCAN's min_samples 10).
+_D2 = _an.defaults(2)
+_D3 = _an.defaults(3)
+
 __all__ = [
     "hexbin",
     "rate_maps",
@@ -117,7 +122,7 @@ def _d_th(d_th):
     return d_th
 
 
-_TEMPLATES = ("rate_maps", "means")
+_TEMPLATES = tuple(_an.decoding_templates)
 
 
 def _count(n, name):
@@ -128,7 +133,7 @@ def _count(n, name):
 
 def _templates(templates, name="templates"):
     if templates not in _TEMPLATES:
-        raise ValueError(f"{name} must be 'rate_maps' or 'means', got {templates!r}")
+        raise ValueError(f"{name} must be {' or '.join(map(repr, _TEMPLATES))}, got {templates!r}")
     return templates
 
 
@@ -145,7 +150,7 @@ def _centers_maps(centers, maps):
     return c, m, was_1d
 
 
-def hexbin(x, y, values, gridsize=50, extent=None):
+def hexbin(x, y, values, gridsize=_D2["gridsize"], extent=None):
     """Mean of ``values`` per hexagonal bin, exactly as matplotlib's hexbin computes it.
 
     Parameters: x, y (n,) positions; values (n,) or (n, C) (float32 or float64), all columns
@@ -164,7 +169,7 @@ def hexbin(x, y, values, gridsize=50, extent=None):
     return centers, (means[:, 0] if was_1d else means), counts
 
 
-def rate_maps(x, y, rates, gridsize=50, quantile=0.1, extent=None):
+def rate_maps(x, y, rates, gridsize=_D2["gridsize"], quantile=_D2["quantile"], extent=None):
     """Thresholded, normalized rate maps (docs/analysis.md).
 
     Per cell (column of ``rates``): the mean rate per visited bin (``hexbin``), then values below
@@ -179,7 +184,7 @@ def rate_maps(x, y, rates, gridsize=50, quantile=0.1, extent=None):
     return centers, (maps[:, 0] if was_1d else maps)
 
 
-def dbscan_cluster_count(points, eps=1.0, min_samples=20):
+def dbscan_cluster_count(points, eps=_D2["eps"], min_samples=_D2["min_samples"]):
     """Number of clusters ``sklearn.cluster.DBSCAN(eps, min_samples).fit(points)`` finds
     (labels >= 0), for (N, 2) or (N, 3) points; identical to scikit-learn 1.2.1 for any input,
     including points at exactly ``eps`` from each other. 0 for no points."""
@@ -190,7 +195,7 @@ def dbscan_cluster_count(points, eps=1.0, min_samples=20):
     return int(_an.dbscan_cluster_count(p, eps, min_samples))
 
 
-def modality(centers, maps, eps=1.0, min_samples=20):
+def modality(centers, maps, eps=_D2["eps"], min_samples=_D2["min_samples"]):
     """Modality index per cell: the DBSCAN cluster count (``dbscan_cluster_count``) over the
     centers of the bins where the cell's map is > 0, in bin order.
 
@@ -214,7 +219,7 @@ def modality_summary(counts):
     return dict(_an.modality_summary(counts.astype(np.int64, copy=False)))
 
 
-def aliasing(centers, maps, d_th=2.0):
+def aliasing(centers, maps, d_th=_D2["d_th"]):
     """Spatial aliasing (docs/analysis.md).
 
     ``SAI_i = (1/N) * sum over j != i with |c_i - c_j| > d_th of cos(a_i, a_j)`` where a_i is row i
@@ -227,7 +232,8 @@ def aliasing(centers, maps, d_th=2.0):
     return sai, float(msai)
 
 
-def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, templates="rate_maps"):
+def decoding_error(x, y, rates, gridsize=_D2["gridsize"], extent=None, quantile=_D2["quantile"],
+                   templates=_D2["decoding_templates"]):
     """Localization error of a population-vector decoder (docs/analysis.md).
 
     Templates (``templates="rate_maps"``, the reference decoder): the rate maps of the first ``n // 2``
@@ -253,7 +259,7 @@ def decoding_error(x, y, rates, gridsize=50, extent=None, quantile=0.1, template
                                    _templates(templates)))
 
 
-def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
+def cell_stats(x, y, rates, gridsize=_D2["gridsize"], quantile=_D2["quantile"], extent=None):
     """Per-cell statistics from the rate maps, as a dict of (n_cells,) arrays:
 
     * ``peak_rate``: maximum of the cell's mean-rate map;
@@ -271,8 +277,9 @@ def cell_stats(x, y, rates, gridsize=50, quantile=0.1, extent=None):
             _an.cell_stats(x, y, r, _gridsize(gridsize), _quantile(quantile), _extent(extent)).items()}
 
 
-def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_th=2.0, extent=None,
-            decoding_templates="rate_maps", mi_quantile=None, skip_samples=0, msai_bins=0):
+def analyze(x, y, rates, gridsize=_D2["gridsize"], quantile=_D2["quantile"], eps=_D2["eps"],
+            min_samples=_D2["min_samples"], d_th=_D2["d_th"], extent=None, decoding_templates=_D2["decoding_templates"],
+            mi_quantile=None, skip_samples=_D2["skip_samples"], msai_bins=_D2["msai_bins"]):
     """Every metric of one trial in one call (the C++ entry point the experiment uses).
 
     Returns a dict: ``centers``, ``counts``, ``mean_maps``, ``maps``, ``bin_area_m2``,
@@ -294,7 +301,7 @@ def analyze(x, y, rates, gridsize=50, quantile=0.1, eps=1.0, min_samples=20, d_t
     eps, min_samples = _dbscan_params(eps, min_samples)
     out = dict(_an.analyze(x, y, r, _gridsize(gridsize), _quantile(quantile), eps, min_samples, _d_th(d_th),
                            _extent(extent), _templates(decoding_templates, "decoding_templates"),
-                           -1.0 if mi_quantile is None else _quantile(mi_quantile),
+                           _D2["mi_quantile"] if mi_quantile is None else _quantile(mi_quantile),
                            _count(skip_samples, "skip_samples"),
                            _count(msai_bins, "msai_bins")))
     out["decoding"] = dict(out["decoding"])
@@ -326,7 +333,7 @@ def _volume(volume):
     return tuple(float(x) for x in v)
 
 
-def voxel_rate_maps(positions, rates, voxel=0.5, volume=None, quantile=0.1):
+def voxel_rate_maps(positions, rates, voxel=_D3["voxel"], volume=None, quantile=_D3["quantile"]):
     """3-D rate maps on cubic voxels (docs/flying.md#analysis), as ``rate_maps`` on hexagons.
 
     Voxels of side ``voxel`` from the lower corner of ``volume`` (xmin, xmax, ymin, ymax, zmin, zmax;
@@ -343,7 +350,7 @@ def voxel_rate_maps(positions, rates, voxel=0.5, volume=None, quantile=0.1):
     return centers, (maps[:, 0] if was_1d else maps), counts
 
 
-def dbscan_labels(points, eps=1.0, min_samples=10):
+def dbscan_labels(points, eps=_D3["eps"], min_samples=_D3["min_samples"]):
     """``sklearn.cluster.DBSCAN(eps, min_samples).fit(points).labels_``, identical for (N, 2) or (N, 3)
     points: per point its cluster (numbered as scikit-learn numbers them) or -1 for noise."""
     p = np.ascontiguousarray(points, dtype=np.float64)
@@ -353,7 +360,7 @@ def dbscan_labels(points, eps=1.0, min_samples=10):
     return np.asarray(_an.dbscan_labels(p, eps, min_samples), dtype=np.int64)
 
 
-def isotropy(centers, maps, modality, eps=1.0, min_samples=10):
+def isotropy(centers, maps, modality, eps=_D3["eps"], min_samples=_D3["min_samples"]):
     """Field isotropy per cell (docs/flying.md#analysis): for a cell with ``modality`` 1, its field is
     the one DBSCAN cluster among the voxels where its map is > 0 (noise left out), each voxel weighted
     by its map value; isotropy = the weighted sd of the field's z over the mean of its weighted sds
@@ -370,8 +377,8 @@ def isotropy(centers, maps, modality, eps=1.0, min_samples=10):
     return np.asarray(_an.isotropy(c, m, [int(v) for v in mi], eps, min_samples))
 
 
-def analyze3d(positions, rates, voxel=0.5, volume=None, quantile=0.1, eps=1.0, min_samples=10, d_th=2.0,
-              decoding_templates="rate_maps"):
+def analyze3d(positions, rates, voxel=_D3["voxel"], volume=None, quantile=_D3["quantile"], eps=_D3["eps"],
+              min_samples=_D3["min_samples"], d_th=_D3["d_th"], decoding_templates=_D3["decoding_templates"]):
     """Every metric of one trial of 3-D positions (a flying agent), on the code paths of ``analyze``:
     voxel rate maps, modality (DBSCAN in 3-D, default min_samples 10), SAI/MSAI over voxel centers,
     decoding with its horizontal and vertical parts, cell statistics, isotropy.

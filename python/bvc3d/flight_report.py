@@ -1,7 +1,7 @@
 """Figures for the flying agents' experiment (`bvc3d flight`, docs/flying.md).
 
 bvc3d.report calls ``make_flight_report`` for a folder whose trial files hold flying agents' trials
-(format version 2: positions x, y, z). The figures follow the report's conventions: each says which
+(format version 2: positions x, y, z). The figures follow the conventions of bvc3d.figures: each says which
 worlds, models and seeds it shows, axes are in meters, legends sit outside the axes, and bars are one
 trial's values or means ± sd over seeds (error bars of non-negative quantities stop at 0).
 """
@@ -12,7 +12,7 @@ import warnings
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import report
+from . import figures
 
 try:
     import h5py
@@ -183,8 +183,8 @@ def isotropy_figure(folder):
         ax.set_xlabel("isotropy: sd z / mean sd x, y")
         ax.set_ylabel("cells with MI = 1")
         ax.set_title(w, fontsize=9)
-    report.legend_outside(axes[0][-1], "model (fields)")
-    seeds = report.seed_list(folder.seeds)
+    figures.legend_outside(axes[0][-1], "model (fields)")
+    seeds = figures.seed_list(folder.seeds)
     fig.suptitle(f"Isotropy of single 3-D fields, every MI = 1 cell of seed{'s' if len(folder.seeds) > 1 else ''} "
                  f"{seeds} pooled (values beyond the axis are drawn at its ends)", fontsize=10)
     fig.tight_layout()
@@ -200,16 +200,16 @@ def bar_positions(folder):
 
 
 def isotropy_bars(folder):
-    fig = report.bars_figure(folder, "isotropy_median")
+    fig = figures.bars_figure(folder, "isotropy_median")
     ax = fig.axes[0]
     ax.axhline(1.0, color="k", ls="--", lw=1, label="1: round (bats)")
-    report.legend_outside(ax, "model")
+    figures.legend_outside(ax, "model")
     fig.tight_layout()
     return fig
 
 
 def vertical_bars(folder):
-    fig = report.bars_figure(folder, "decode_vertical_median_m")
+    fig = figures.bars_figure(folder, "decode_vertical_median_m")
     ax = fig.axes[0]
     pos = bar_positions(folder)
     xs = [pos[m, w] for m in folder.models for w in folder.worlds]
@@ -218,7 +218,7 @@ def vertical_bars(folder):
     lo, hi = ax.get_ylim()
     top = max([hi] + [y for y in ys if not math.isnan(y)])
     ax.set_ylim(lo, top * 1.05)
-    report.legend_outside(ax, "model")
+    figures.legend_outside(ax, "model")
     fig.tight_layout()
     return fig
 
@@ -235,7 +235,7 @@ def worlds_figure(folder):
         path = folder.file(folder.models[0], w)
         if path and os.path.exists(path):
             with h5py.File(path, "r") as f:
-                source = report.fmt(f.attrs.get("world_source", w))
+                source = figures.fmt(f.attrs.get("world_source", w))
         try:
             worlds.append((w, bvc3d.World.preset(source or w)))
         except ValueError:
@@ -277,17 +277,18 @@ def worlds_figure(folder):
 
 def make_flight_report(folder, figdir):
     """Draws the figures; returns (file name, sentence) pairs for report.md."""
-    figures = []
+    drawn = []
 
     def add(name, sentence, make):
         fig = make()
         if fig is None:
             return
-        report.save(fig, os.path.join(figdir, name))
-        figures.append((name, sentence))
+        figures.save(fig, os.path.join(figdir, name))
+        drawn.append((name, sentence))
 
     seed = folder.seeds[0]
-    one = f"seed {seed}" + (f" (the first of seeds {report.seed_list(folder.seeds)})" if len(folder.seeds) > 1 else "")
+    first = f" (the first of seeds {figures.seed_list(folder.seeds)})" if len(folder.seeds) > 1 else ""
+    one = f"seed {seed}{first}"
     bars = f"Bars: {folder.spread_text()}."
     add("worlds.png", "The worlds in 3-D (floor and ceiling left out) with their flight volumes (blue): the flying "
         "agent's body, a 0.2 m sphere, stays inside.", lambda: worlds_figure(folder))
@@ -296,22 +297,22 @@ def make_flight_report(folder, figdir):
     add("fields3d.png", f"One single 3-D field (MI = 1) per model in {folder.worlds[0]} ({one}): maximum projections "
         "onto the three planes and slices through the peak voxel, axes in meters.", lambda: fields_figure(folder))
     add("frac_unimodal.png", f"Fraction of place cells with exactly one 3-D field (MI = 1). {bars}",
-        lambda: report.bars_figure(folder, "frac_unimodal"))
+        lambda: figures.bars_figure(folder, "frac_unimodal"))
     add("frac_multimodal.png",
         f"Fraction of multimodal place cells (MI > 1): cells that fire in several places. {bars}",
-        lambda: report.bars_figure(folder, "frac_multimodal"))
+        lambda: figures.bars_figure(folder, "frac_multimodal"))
     add("mi_mean.png", f"Mean modality index of the active cells (1: a single field). {bars}",
-        lambda: report.bars_figure(folder, "mean_mi_active"))
+        lambda: figures.bars_figure(folder, "mean_mi_active"))
     add("isotropy.png", f"Median isotropy of the single fields (sd along z over the mean sd along x and y); the dashed "
         f"line is a round field, as the bats' fields were. {bars}", lambda: isotropy_bars(folder))
     add("isotropy_hist.png",
         "The isotropy of every single field, all seeds pooled: the distribution behind the medians.",
         lambda: isotropy_figure(folder))
     add("msai.png", f"Mean spatial aliasing index over voxels (d_th 2 m in 3-D): lower is better. {bars}",
-        lambda: report.bars_figure(folder, "msai"))
+        lambda: figures.bars_figure(folder, "msai"))
     add("decoding_horizontal.png", f"Median horizontal (x, y) part of the decoding error. {bars}",
-        lambda: report.bars_figure(folder, "decode_horizontal_median_m"))
+        lambda: figures.bars_figure(folder, "decode_horizontal_median_m"))
     add("decoding_vertical.png", "Median vertical (z) part of the decoding error, with the error of a decoder that "
         f"guesses a voxel at random (black marks): a code that does not know the height decodes z at chance. {bars}",
         lambda: vertical_bars(folder))
-    return figures
+    return drawn

@@ -28,16 +28,12 @@ except ImportError:  # pragma: no cover - Debian's python3-h5py is a dependency
     h5py = None
 
 from ._core import metric_table
+from .figures import (DIGITS, DPI, METRICS, TINY, bars_figure, error_bars, fmt,  # noqa: F401 (the report's names)
+                      legend_outside, mark_small_bars, save, seed_list)
 
-DPI = 120
-# Metrics with a figure of their own: (axis label, title), from the analysis stage's one table.
-METRICS = {m["name"]: (m["label"], m["title"]) for m in metric_table if m["title"]}
-DIGITS = {m["name"]: m["digits"] for m in metric_table}
 METRIC_NAMES = {m["name"] for m in metric_table}
 # Units of the analysis parameters a trial file's /metrics attributes record (the others have none).
 UNITS = {"eps": "m", "d_th": "m"}
-# A bar lower than this fraction of the axis height is hard to see: it gets a mark and its value.
-TINY = 0.015
 
 
 def read_csv(path):
@@ -50,25 +46,6 @@ def num(s):
         return float(s)
     except (TypeError, ValueError):
         return math.nan
-
-
-def fmt(v):
-    """A number as short text (45, 0.1, 1e-06), anything else as it is."""
-    if isinstance(v, bytes):
-        v = v.decode()
-    if isinstance(v, (int, np.integer)) and not isinstance(v, bool):
-        return str(int(v))
-    if isinstance(v, (float, np.floating)):
-        return f"{float(v):g}"
-    return str(v)
-
-
-def seed_list(seeds):
-    """Seeds as short text: "0", "0, 1, 4", "0–9"."""
-    seeds = sorted(seeds)
-    if len(seeds) > 2 and seeds == list(range(seeds[0], seeds[-1] + 1)):
-        return f"{seeds[0]}–{seeds[-1]}"
-    return ", ".join(map(str, seeds))
 
 
 def protocol_text(attrs):
@@ -179,85 +156,37 @@ def hexmap(ax, centers, values, extent=None, cmap="viridis", vmin=None, vmax=Non
                      reduce_C_function=np.mean, linewidths=0.0)
 
 
-def legend_outside(ax, title):
-    """The legend to the right of the axes, where it cannot cover data."""
-    return ax.legend(title=title, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8,
-                     title_fontsize=8, frameon=False)
+# The paper report's bar figures come from the metric table (bar_metrics). Their files keep the
+# names they had before; a metric added to the table gets <name>.png. A note adds to a figure's
+# sentence what its title does not say.
+BAR_FILES = {"frac_active": "mi_active.png", "mean_mi_active": "mi_mean.png", "frac_multimodal": "mi_multimodal.png",
+             "decode_median_m": "decoding.png", "frac_undecoded": "decoding_coverage.png"}
+BAR_NOTES = {
+    "mean_mi_active": "fields per cell; 1 is a single place field",
+    "frac_multimodal": "cells that fire in several places",
+    "msai": "lower is better",
+    "decode_median_m": "each sample of the second half decoded to the cosine-nearest rate-map bin of the first "
+                       "half, the direct measure of localization",
+    "frac_undecoded": "samples with no positive similarity to any template, which the decoding errors leave out",
+    "decode_median_all_m": "the undecoded samples counted at chance",
+}
 
 
-def error_bars(means, sds, clip):
-    """Asymmetric (2, n) error bars: +sd up, -sd down, but not below 0 when the quantity cannot be negative."""
-    means, sds = np.asarray(means, float), np.nan_to_num(np.asarray(sds, float))
-    sds = np.where(np.isnan(means), 0.0, sds)
-    lower = np.minimum(sds, np.maximum(np.nan_to_num(means), 0.0)) if clip else sds
-    return np.vstack([lower, sds])
+def bar_metrics(dims=2):
+    """The metrics drawn as bars: those of the metric table with a figure of their own (a title) that
+    trials of ``dims``-coordinate positions report, in the table's order."""
+    return [m["name"] for m in metric_table if m["title"] and m["dims"] in (0, dims)]
 
 
-def mark_small_bars(ax, bars, means, tops, digits):
-    """Bars too low to see (0, or below TINY of the axis height) get a thick line at their base and their
-    value written above them (n/a for a missing value)."""
-    lo, hi = ax.get_ylim()
-    marks = []
-    for bar, mean, top in zip(bars, means, tops):
-        if not (math.isnan(mean) or abs(mean) < TINY * (hi - lo)):
-            continue
-        x0, width = bar.get_x(), bar.get_width()
-        ax.plot([x0, x0 + width], [0, 0], color=bar.get_facecolor(), lw=3, solid_capstyle="butt", zorder=3)
-        text = "n/a" if math.isnan(mean) else (f"{mean:.{digits}f}" if digits >= 0 else f"{mean:g}")
-        marks.append(ax.annotate(text, xy=(x0 + width / 2, 0 if math.isnan(top) else top), xytext=(0, 2),
-                                 textcoords="offset points", rotation=90, ha="center", va="bottom", fontsize=6.5))
-    return marks
+def bar_file(metric):
+    return BAR_FILES.get(metric, f"{metric}.png")
 
 
-def bars_figure(folder, metric):
-    """One bar per model and world (mean ± sd over seeds, or one trial), as a matplotlib Figure."""
-    label, title = METRICS[metric]
-    fig, ax = plt.subplots(figsize=(7, 3.6))
-    n = len(folder.models)
-    width = 0.8 / max(n, 1)
-    x = np.arange(len(folder.worlds))
-    clip = folder.non_negative(metric)
-    drawn = []
-    for i, m in enumerate(folder.models):
-        stats = [folder.stat(m, w, metric) for w in folder.worlds]
-        means = np.array([s[0] for s in stats])
-        yerr = error_bars(means, [s[1] for s in stats], clip) if folder.replicated() else None
-        bars = ax.bar(x + (i - (n - 1) / 2) * width, np.nan_to_num(means), width, yerr=yerr, label=m, capsize=2)
-        tops = np.nan_to_num(means) + (yerr[1] if yerr is not None else 0)
-        drawn.append((bars, means, np.where(np.isnan(means), np.nan, tops)))
-    lo, hi = ax.get_ylim()
-    if hi - lo <= 0 or (clip and hi <= 0):
-        ax.set_ylim(0, 1)
-    elif clip:
-        ax.set_ylim(bottom=min(lo, 0.0))
-    marks = [m for bars, means, tops in drawn for m in mark_small_bars(ax, bars, means, tops, DIGITS.get(metric, 3))]
-    lo, hi = ax.get_ylim()
-    if any(m.xy[1] > lo + 0.8 * (hi - lo) for m in marks):  # a value label high up: room for its text
-        ax.set_ylim(top=hi + 0.15 * (hi - lo))
-    if folder.tilt_axis():
-        ax.set_xticks(x, [f"{folder.tilt[w]:g}" for w in folder.worlds])
-        ax.set_xlabel("tilt of the central walls (°), cross arena")
-    else:
-        ax.set_xticks(x, folder.worlds)
-        ax.set_xlabel("world")
-    ax.set_ylabel(label)
-    ax.set_title(f"{title}\n{folder.spread_text()}", fontsize=10)
-    legend_outside(ax, "model")
-    fig.tight_layout()
-    return fig
-
-
-def save(fig, out):
-    """Writes a figure; a failed write names its file (Pillow removes what it wrote and raises an
-    OSError without a file name)."""
-    try:
-        fig.savefig(out, dpi=DPI)
-    except OSError as e:
-        if e.errno is None or e.filename:
-            raise
-        raise OSError(e.errno, e.strerror, str(out)) from e
-    finally:
-        plt.close(fig)
+def bar_sentence(folder, metric):
+    """What a bar figure shows, for report.md: its title, the axes, the note, what a bar is."""
+    per = "per model and tilt" if folder.tilt_axis() else "per model and world"
+    note = f": {BAR_NOTES[metric]}" if metric in BAR_NOTES else ""
+    return f"{METRICS[metric][1]}, {per}{note}. Bars: {folder.spread_text()}."
 
 
 def fig_bars(folder, metric, out):
@@ -574,7 +503,6 @@ def make_report(path):
 
     seed = folder.seeds[0]
     one = f"seed {seed}" + (f" (the first of seeds {seed_list(folder.seeds)})" if len(folder.seeds) > 1 else "")
-    bars = f"Bars: {folder.spread_text()}."
     add("environments.png", "The arenas in 3-D (ceiling and floor left out): the central cross walls lean toward the "
         "+x,+y corner by the given tilt while their footprint stays put.", lambda p: fig_environments(folder, p))
     add("trajectory.png", f"The robot's random walk during the sampling phase of one trial "
@@ -583,23 +511,11 @@ def make_report(path):
     add("place_fields.png", f"Rate maps of two example place cells at the largest tilt ({one}): a multimodal (aliased, "
         "MI > 1) cell of the first model and a unimodal (MI = 1) cell of the last model. A model without a cell of "
         "that kind shows another cell, and the panel's title says so.", lambda p: fig_place_fields(folder, p))
-    add("mi_active.png", f"Fraction of place cells with at least one field (MI > 0), per model and tilt. {bars}",
-        lambda p: fig_bars(folder, "frac_active", p))
-    add("mi_mean.png", f"Mean modality index of the active cells: fields per cell; 1 is a single place field. {bars}",
-        lambda p: fig_bars(folder, "mean_mi_active", p))
-    add("mi_multimodal.png", f"Fraction of multimodal place cells (MI > 1): cells that fire in several places. {bars}",
-        lambda p: fig_bars(folder, "frac_multimodal", p))
     add("sai_grid.png", "Spatial aliasing index of every bin: how similar its population vector is to those of "
         f"bins more than d_th away. Bright regions are aliased. One trial per panel: {one}.",
         lambda p: fig_sai_grid(folder, p))
-    add("msai.png", f"Mean spatial aliasing index per model and tilt: lower is better. {bars}",
-        lambda p: fig_bars(folder, "msai", p))
-    add("decoding.png", "Median position error when each sample of the second half is decoded to the cosine-"
-        f"nearest rate-map bin of the first half: the direct measure of localization. {bars}",
-        lambda p: fig_bars(folder, "decode_median_m", p))
-    add("decoding_coverage.png", "Fraction of second-half samples the decoder could not place (no positive similarity "
-        f"to any template): the decoding errors above leave them out. {bars}",
-        lambda p: fig_bars(folder, "frac_undecoded", p))
+    for metric in bar_metrics(dims=2):
+        add(bar_file(metric), bar_sentence(folder, metric), lambda p, metric=metric: fig_bars(folder, metric, p))
     write_report(folder, figures)
     return figures
 

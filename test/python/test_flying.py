@@ -353,6 +353,57 @@ def test_flight_command_refuses_ground_models_and_worlds(tmp_path):
     assert not (tmp_path / "a").exists() or not any((tmp_path / "a").glob("*.h5"))
 
 
+def test_two_flights_into_one_folder_the_second_refuses(tmp_path):
+    """`bvc3d flight` takes the output folder's lock as `paper` does: a second run into the folder of a
+    running one stops at once (status 2) naming the lock and its holder, and writes nothing."""
+    import subprocess
+    import time
+
+    from conftest import CLI, run_cli
+    out = tmp_path / "flight"
+    args = ["flight", "--out", out, "--models", "fly-up", "--worlds", "flight-room", "--hours", "1", "--no-report"]
+    first = subprocess.Popen([CLI, *map(str, args)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        lock = out / ".bvc3d.lock"
+        for _ in range(400):
+            if lock.exists() and lock.read_text():
+                break
+            time.sleep(0.05)
+        assert lock.exists(), "the first flight took no lock"
+        second = run_cli(*args)
+        assert second.returncode == 2, second.stderr
+        assert (f"bvc3d: error: output folder '{out}' is in use by bvc3d process {first.pid}" in second.stderr
+                and f"lock file '{lock}'" in second.stderr), second.stderr
+        assert first.poll() is None and not list(out.glob("*.h5"))  # the first one runs on, alone
+    finally:
+        first.kill()
+        first.wait()
+
+
+def test_flight_memory_check_and_no_memory_check(tmp_path):
+    """A flight too long for the machine's memory is refused before it starts, and says how to go on
+    anyway; `--no-memory-check` is accepted as by the other experiments."""
+    from conftest import run_cli
+    base = ["flight", "--models", "fly-up", "--worlds", "flight-room", "--no-report"]
+    big = run_cli(*base, "--out", tmp_path / "big", "--explore-hours", "0", "--sample-hours", "9000")
+    assert big.returncode == 2 and "needs about" in big.stderr and "--no-memory-check" in big.stderr, big.stderr
+    assert not (tmp_path / "big").exists()  # refused before anything was written
+    small = run_cli(*base, "--out", tmp_path / "small", "--hours", "0.01", "--jobs", "1", "--no-memory-check")
+    assert small.returncode == 0, small.stderr
+    assert (tmp_path / "small" / "flight-room_fly-up_seed0.h5").exists()
+
+
+def test_the_flying_protocol_is_one_for_the_command_and_python():
+    """`bvc3d flight` and run_trial(agent="flight") state the same default protocol, from one table."""
+    import re
+
+    from conftest import run_cli
+    help_text = run_cli("flight", "--help", check=True).stdout
+    command = re.search(r"--hours FLOAT +Both phases this many simulated hours \(default (\d+) \+ (\d+)\)", help_text)
+    python = re.search(r"a world with a flight volume, (\d+) \+ (\d+) h unless given", bvc3d.run_trial.__doc__)
+    assert command and python and command.groups() == python.groups() == ("8", "8")
+
+
 def test_flight_tables_field_pairs_of_a_stacked_cell():
     """A cell with two round fields, one above the other (4 m apart in z, 0.5 m in x): the script's
     field pairs give the distances between the fields' weighted centroids."""

@@ -4,6 +4,7 @@ low to see are marked with their value, error bars of non-negative quantities st
 report.md states the protocol, durations, seeds and analysis parameters read from the trial files."""
 import csv
 import math
+import pathlib
 import re
 
 import h5py
@@ -390,3 +391,27 @@ def test_report_states_protocol_durations_seeds_and_analysis(tmp_path):
     report.write_report(folder, [])
     text = (tmp_path / "mixed" / "report.md").read_text()
     assert lines in text
+
+
+def test_the_paper_report_lists_its_bar_figures_from_the_metric_table(three_seeds, monkeypatch):
+    """As the sweep report does, a ground experiment's report draws a bar figure for every metric of the
+    table with a title that ground trials report (the figures of old keep their file names), and one
+    for a metric added to the table, with no other change."""
+    from bvc3d import figures
+    fake = {"name": "fake_metric", "heading": "fake", "label": "fake (units)", "title": "A metric only this test has",
+            "digits": 2, "dims": 0}
+    monkeypatch.setattr(report, "metric_table", [*bvc3d.metric_table, fake])
+    monkeypatch.setitem(figures.METRICS, "fake_metric", (fake["label"], fake["title"]))
+    drawn = dict(report.make_report(three_seeds.path))
+    expected = [report.bar_file(m["name"]) for m in bvc3d.metric_table if m["title"] and m["dims"] in (0, 2)]
+    assert expected and set(expected) <= set(drawn)
+    assert {"mi_active.png", "mi_mean.png", "mi_multimodal.png", "msai.png", "decoding.png",
+            "decoding_coverage.png"} <= set(drawn)
+    assert not [m for m in bvc3d.metric_table if m["dims"] == 3 and report.bar_file(m["name"]) in drawn]
+    assert drawn["fake_metric.png"] == ("A metric only this test has, per model and tilt. Bars: mean ± sd over 3 "
+                                        "seeds (0–2); error bars stop at 0.")
+    assert drawn["msai.png"].startswith("Mean spatial aliasing index, per model and tilt: lower is better.")
+    path = pathlib.Path(three_seeds.path)
+    text = (path / "report.md").read_text()
+    for name in drawn:
+        assert f"(figures/{name})" in text and (path / "figures" / name).stat().st_size > 1000

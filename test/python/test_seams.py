@@ -125,6 +125,50 @@ def test_python_defaults_are_the_cpp_structs():
         bvc3d.BoundaryVectorLayer(n_dir=2.5)
 
 
+def printed_analysis(*config_args):
+    """The analysis keys and values `bvc3d config` prints: the C++ table's defaults, by another path."""
+    text = run_cli("config", *config_args, check=True).stdout
+    section = text[text.index("\nanalysis:\n"):].splitlines()[2:]
+    values = {}
+    for line in section:
+        m = re.match(r"  (\w+): (\S+)", line)
+        if not m:
+            break
+        values[m.group(1)] = m.group(2)
+    return values
+
+
+def test_analysis_defaults_are_the_cpp_table(tmp_path):
+    """bvc3d.analysis repeats no number: every keyword default of its functions is the value `bvc3d
+    config` prints for a ground trial's analysis (2-D functions) or a flying one's (3-D functions)."""
+    import inspect
+
+    from bvc3d import analysis as A
+    flying = tmp_path / "fly.yaml"
+    flying.write_text("world: flight-room\nmodel: fly-up\nflight: {}\n")
+    for dims, printed, functions in (
+            (2, printed_analysis(), [A.hexbin, A.rate_maps, A.dbscan_cluster_count, A.modality, A.aliasing,
+                                     A.decoding_error, A.cell_stats, A.analyze]),
+            (3, printed_analysis("--trial", flying), [A.voxel_rate_maps, A.dbscan_labels, A.isotropy, A.analyze3d])):
+        assert printed["min_samples"] == ("20" if dims == 2 else "10")
+        checked = 0
+        for f in functions:
+            for name, p in inspect.signature(f).parameters.items():
+                key = {"templates": "decoding_templates"}.get(name, name)
+                # extent (None: the data's own bounds) and mi_quantile (None: -1) are said in Python's words.
+                if key in printed and key not in ("extent", "mi_quantile"):
+                    assert str(p.default) == printed[key] or p.default == float(printed[key]), (f.__name__, name)
+                    checked += 1
+        assert checked >= (20 if dims == 2 else 10)
+    # mi_quantile None is the table's -1 (the same quantile as the maps): both give the same modality.
+    rng = np.random.default_rng(0)
+    x, y = rng.uniform(-4, 4, 400), rng.uniform(-4, 4, 400)
+    rates = rng.random((400, 6))
+    assert list(A.analyze(x, y, rates)["modality"]) == list(A.analyze(x, y, rates, mi_quantile=0.1)["modality"])
+    voxel = inspect.signature(A.voxel_rate_maps).parameters["voxel"].default
+    assert voxel == bvc3d._core.analysis.defaults(3)["voxel"] == 0.5  # docs/flying.md#analysis
+
+
 # The stages from the bottom up; a stage may include only stages ranked below it (and itself).
 STAGE_RANK = {"core": 0, "world": 1, "recording": 1, "agent": 2, "sensor": 2, "bvc": 3, "place": 4, "population": 5,
               "recorder": 6, "analysis": 7, "report": 8, "config": 9, "experiment": 10}

@@ -1,6 +1,7 @@
 // The seams new kinds of thing enter through (docs/architecture.md): the pose, agents (a trajectory
-// fed from arrays and files), return sources (returns fed from arrays), analysis in 3-D, and the
-// parameter tables. Oracles: the definitions written out in the tests, brute force, hand-made cases.
+// fed from arrays and files; kinds found through one registry, paired with models by what they can
+// do), return sources (returns fed from arrays), analysis in 3-D, and the parameter tables. Oracles:
+// the definitions written out in the tests, brute force, hand-made cases.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,9 +11,12 @@
 
 #include "../support/bvc_reference.hpp"
 #include "../support/temp_dir.hpp"
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/protocols.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
@@ -204,6 +208,109 @@ TEST(Seams, TrajectoryFilesWithAndWithoutHeaders) {
     EXPECT_EQ(config::load_trial_file(yaml.string()).agent->kind(), "trajectory");
     const auto both = dir.write("both.yaml", "trajectory: " + header.string() + "\nrobot: {speed: 1}\n");
     EXPECT_THROW(config::load_trial_file(both.string()), ConfigError);
+}
+
+// --- agents: one registry, checks by what an agent can do -----------------------------------------
+
+namespace {
+
+// A kind of agent defined only here, moving as it is told: no registry entry and a kind() string no
+// check knows. Whatever asks what it can do must get the answer from the spec itself.
+class TestAgentSpec : public AgentSpec {
+public:
+    TestAgentSpec(Locomotion moves, int dims) : moves_(moves), dims_(dims) {}
+    std::string kind() const override { return "test_agent"; }
+    Locomotion locomotion() const override { return moves_; }
+    int dims() const override { return dims_; }
+    void validate() const override {}
+    void check_world(const WorldDescription&) const override {}
+    std::unique_ptr<Agent> make(const World*, std::uint64_t) const override { return nullptr; }
+    std::string key() const override { return "agent: test\n"; }
+    double steps_per_second() const override { return 1.0; }
+    void write_yaml(params::CommentedYaml&) const override {}
+
+private:
+    Locomotion moves_;
+    int dims_;
+};
+
+}  // namespace
+
+TEST(Seams, ModelPresetsPairWithAgentsByHowTheyMove) {
+    // Presets made for the ground robot refuse flying agents and the fly-* presets refuse agents on the
+    // ground, whatever their kind; a given path takes any preset (the path is the data).
+    struct Case {
+        Locomotion moves;
+        int dims;
+        const char* model;
+        const char* refusal;  // "" when the pair is accepted
+    };
+    const Case cases[] = {
+        {Locomotion::ground, 2, "fly-up", "is a preset for flying agents"},
+        {Locomotion::ground, 3, "fly-5l", "is a preset for flying agents"},
+        {Locomotion::ground, 2, "3d-0.2", ""},
+        {Locomotion::flying, 3, "3d-0.2", "is a preset for the ground robot"},
+        {Locomotion::flying, 2, "2d", "is a preset for the ground robot"},
+        {Locomotion::flying, 3, "fly-up", ""},
+        {Locomotion::given_path, 2, "fly-9l", ""},
+        {Locomotion::given_path, 3, "3d-3l", ""},
+    };
+    for (const auto& c : cases) {
+        TrialConfig t;
+        t.world = WorldSpec{"flight-room", std::nullopt, "+x+y"};
+        t.model = model_preset(c.model);
+        t.set_agent(std::make_shared<TestAgentSpec>(c.moves, c.dims));
+        const std::string what =
+            std::string(c.model) + " on a test agent of locomotion " + std::to_string(static_cast<int>(c.moves));
+        if (*c.refusal == '\0') {
+            EXPECT_NO_THROW(t.validate()) << what;
+            continue;
+        }
+        try {
+            t.validate();
+            ADD_FAILURE() << "accepted: " << what;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(c.refusal), std::string::npos) << what << ": " << e.what();
+        }
+    }
+}
+
+TEST(Seams, AgentKindsAreFoundByNameByYamlKeyAndBySpec) {
+    const TempDir dir("seams");
+    const auto keys = config::trial_keys();
+    for (const auto& k : agent_kinds()) {
+        EXPECT_NE(std::find(keys.begin(), keys.end(), k.yaml_key), keys.end()) << k.yaml_key;
+        EXPECT_NO_THROW(protocol_preset(k.protocol)) << k.name;
+        if (!k.make_default) continue;  // a kind that needs data is not chosen by name
+        const auto spec = k.make_default();
+        EXPECT_EQ(spec->kind(), k.name);
+        EXPECT_EQ(&agent_kind_of(*spec), &k);
+        for (const auto& name : k.aliases) EXPECT_EQ(agent_by_name(name)->kind(), k.name) << name;
+        EXPECT_EQ(agent_by_name(k.name)->key(), spec->key());
+        // Its YAML key with no parameters gives the same agent back.
+        const auto yaml =
+            dir.write("agent.yaml", k.yaml_key + ": {}\nworld: flight-room\n" +
+                                        (spec->locomotion() == Locomotion::flying ? "model: fly-up\n" : ""));
+        EXPECT_EQ(config::load_trial_file(yaml.string()).agent->key(), spec->key()) << k.name;
+    }
+    // A parameter in the YAML reaches the agent through its kind's table.
+    const auto fly = dir.write("fly.yaml", "world: flight-room\nmodel: fly-up\nflight: {radius: 0.3}\n");
+    const auto* flight = dynamic_cast<const FlightSpec*>(config::load_trial_file(fly.string()).agent.get());
+    ASSERT_NE(flight, nullptr);
+    EXPECT_EQ(flight->flight().radius, 0.3);
+    // Unknown names are refused with the names there are; two kinds in one trial are refused.
+    try {
+        agent_by_name("hover");
+        ADD_FAILURE() << "accepted 'hover'";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("agent 'hover' is not one of random_walk or ground"), std::string::npos) << what;
+        EXPECT_NE(what.find("flight or flying"), std::string::npos) << what;
+    }
+    EXPECT_THROW(agent_by_name("trajectory"), InputError);  // needs its rows
+    EXPECT_THROW(agent_kind_of(TestAgentSpec(Locomotion::ground, 2)), InputError);
+    const auto two = dir.write("two.yaml", "robot: {}\nflight: {}\n");
+    EXPECT_THROW(config::load_trial_file(two.string()), ConfigError);
 }
 
 // --- return sources ---------------------------------------------------------------------------

@@ -3,7 +3,8 @@
 // Takes: a World (for collision) and a seed, or a given path (which needs no world). Gives: the model steps — when and
 // at which pose the model is updated — one at a time, and its state as text for checkpoints.
 // Kinds of agent: the ground robot's random walk (random_walk.hpp), a given trajectory (trajectory.hpp) and the flying
-// agent (flying_walk.hpp). The trial runner, checkpoints and walk sharing see only this interface.
+// agent (flying_walk.hpp), registered in config/agent_kinds.hpp. The trial runner, checkpoints and walk sharing see
+// only this interface; other stages ask a spec what it can do (dims(), locomotion()), never which kind it is.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -44,13 +45,19 @@ public:
     virtual void restore_state(const std::string& state) = 0;  // InputError if it does not fit
 };
 
+// How an agent moves, which decides the model presets made for it: on the floor (the ground robot's
+// presets: the scanner above the floor), flying (the fly-* presets: the scanner at the body's center,
+// looking down too), or along a given path (any preset: the path is the data).
+enum class Locomotion { ground, flying, given_path };
+
 // A kind of agent and its parameters: what a trial configuration holds. Trials whose agents have
 // equal key() in the same world with the same seed take the same steps, so they can share them.
 class AgentSpec {
 public:
     virtual ~AgentSpec() = default;
-    virtual std::string kind() const = 0;  // "random_walk", "trajectory", "flight"
-    virtual void validate() const = 0;     // InputError naming the bad parameter
+    virtual std::string kind() const = 0;  // its name in config/agent_kinds.hpp: "random_walk", "trajectory", "flight"
+    virtual Locomotion locomotion() const = 0;
+    virtual void validate() const = 0;  // InputError naming the bad parameter
     // Whether the agent can run in this world (a random walk: every start point has room for the
     // robot, and the world has a floor to walk on; a trajectory: every row lies inside the world; a
     // flying agent: the world has a flight volume that holds its body): InputError naming the world's key

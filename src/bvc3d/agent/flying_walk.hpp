@@ -90,6 +90,7 @@ public:
     explicit FlightSpec(FlightParams flight = {}) : flight_(flight) {}
     const FlightParams& flight() const { return flight_; }
     std::string kind() const override { return "flight"; }
+    Locomotion locomotion() const override { return Locomotion::flying; }
     void validate() const override { flight_.validate(); }
     std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;
     std::string key() const override;

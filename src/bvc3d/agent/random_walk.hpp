@@ -102,6 +102,7 @@ public:
     explicit RandomWalkSpec(RobotParams robot = {}) : robot_(robot) {}
     const RobotParams& robot() const { return robot_; }
     std::string kind() const override { return "random_walk"; }
+    Locomotion locomotion() const override { return Locomotion::ground; }
     void validate() const override { robot_.validate(); }
     void check_world(const WorldDescription& world) const override;
     std::unique_ptr<Agent> make(const World* world, std::uint64_t seed) const override;

@@ -53,6 +53,7 @@ public:
     const std::string& source() const { return source_; }
     const std::vector<ModelStep>& steps() const { return *steps_; }
     std::string kind() const override { return "trajectory"; }
+    Locomotion locomotion() const override { return Locomotion::given_path; }
     int dims() const override { return dims_; }
     void validate() const override {}
     // Every pose lies within the world's geometry (a path in another frame is a mistake).

@@ -8,7 +8,6 @@
 #include <set>
 #include <sstream>
 
-#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
@@ -88,13 +87,6 @@ Protocol::Kind parse_protocol(const std::string& name) {
     throw InputError("protocol '" + name + "' is not one of explore_then_sample, online");
 }
 
-std::shared_ptr<const AgentSpec> agent_by_name(const std::string& name) {
-    if (name == "random_walk" || name == "ground") return std::make_shared<RandomWalkSpec>();
-    if (name == "flight" || name == "flying") return std::make_shared<FlightSpec>();
-    throw InputError("agent '" + name +
-                     "' is not one of random_walk (or ground: the paper's robot), flight (or flying)");
-}
-
 void TrialConfig::set_agent(std::shared_ptr<const AgentSpec> a) {
     if (a->dims() != agent->dims()) {  // the analysis defaults follow the positions' dimension
         const auto defaults = analysis::AnalysisParams::defaults(a->dims());
@@ -122,15 +114,17 @@ void TrialConfig::validate() const {
     protocol.validate();
     agent->validate();
     analysis.validate();
-    // A preset made for one kind of agent on the other (custom models are the user's call).
+    // A preset made for one way of moving on an agent that moves the other way (custom models, and
+    // given paths, are the user's call).
     if (const std::string preset = config::preset_name_of(model); !preset.empty()) {
         const bool flying_model = find_model_preset(preset)->flying;
-        if (flying_model && agent->kind() == "random_walk")
+        const Locomotion moves = agent->locomotion();
+        if (flying_model && moves == Locomotion::ground)
             throw InputError("model '" + preset +
                              "' is a preset for flying agents (its scanner sits at the body's "
                              "center and looks down too): the ground robot uses 2d, 3d-0.1, 3d-0.2, 3d-3l or 2d-8beam; "
                              "or fly with it (trial key flight:, --agent flight)");
-        if (!flying_model && agent->kind() == "flight")
+        if (!flying_model && moves == Locomotion::flying)
             throw InputError("model '" + preset +
                              "' is a preset for the ground robot (its scanner sits on the robot, "
                              "above the floor): flying agents use fly-up, fly-5l or fly-9l (docs/flying.md#models)");

@@ -101,9 +101,4 @@ void check_runnable(const std::vector<TrialConfig>& trials);
 std::string protocol_name(Protocol::Kind k);
 Protocol::Kind parse_protocol(const std::string& name);
 
-// An agent by name, with its default parameters (the CLI's --agent, Python's agent=): "random_walk"
-// or "ground" (the paper's robot), "flight" or "flying" (the flying agent, docs/flying.md).
-// InputError naming the choices for any other name.
-std::shared_ptr<const AgentSpec> agent_by_name(const std::string& name);
-
 }  // namespace bvc3d

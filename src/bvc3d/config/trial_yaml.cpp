@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "bvc3d/agent/flying_walk.hpp"
-#include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/format.hpp"
@@ -13,21 +12,13 @@ namespace bvc3d::config {
 
 namespace {
 
-// A path inside a YAML file is relative to that file (preset names are left alone).
-std::string relative_to(const YamlView& v, const std::string& s) {
-    if (std::filesystem::path(s).is_absolute()) return s;
-    const auto candidate = std::filesystem::path(v.directory()) / s;
-    std::error_code ec;
-    return std::filesystem::exists(candidate, ec) ? candidate.string() : s;
-}
-
 WorldSpec world_from(const YamlView& v) {
     WorldSpec w;
     if (v.is_scalar()) {
-        w.source = relative_to(v, v.as_string());
+        w.source = path_in_file(v, v.as_string());
     } else {
         v.expect_map({"source", "tilt_deg", "lean"});
-        w.source = relative_to(v, v.get("source", w.source));
+        w.source = path_in_file(v, v.get("source", w.source));
         if (v.has("tilt_deg")) w.tilt_deg = v["tilt_deg"].as_double();
         w.lean = v.get("lean", w.lean);
     }
@@ -45,7 +36,7 @@ ModelSpec model_from(const YamlView& v) {
     if (!v.is_scalar()) return model_from_yaml(v);
     const std::string name = v.as_string();
     try {
-        return resolve_model(relative_to(v, name));
+        return resolve_model(path_in_file(v, name));
     } catch (const ConfigError&) {
         throw;
     } catch (const InputError& e) {
@@ -75,35 +66,13 @@ void analysis_from(const YamlView& v, TrialConfig& t) {
     t.arena_extent = extent == "arena";
 }
 
-std::shared_ptr<const AgentSpec> agent_from(const YamlView& v) {
-    if (v.has("robot") + v.has("trajectory") + v.has("flight") > 1)
-        v.fail(
-            "give one of 'robot' (the random walk's robot), 'trajectory' (a given path) or 'flight' (the flying "
-            "agent), not several");
-    if (v.has("flight")) {
-        FlightParams flight;
-        read_table(v["flight"], flight, FlightParams::table());
-        return std::make_shared<FlightSpec>(flight);
-    }
-    if (v.has("trajectory")) {
-        const YamlView file = v["trajectory"];
-        try {
-            return std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(relative_to(file, file.as_string())));
-        } catch (const ConfigError&) {
-            throw;
-        } catch (const InputError& e) {
-            file.fail(e.what());
-        }
-    }
-    RobotParams robot;
-    if (v.has("robot")) read_table(v["robot"], robot, RobotParams::table());
-    return std::make_shared<RandomWalkSpec>(robot);
-}
-
 }  // namespace
 
 std::vector<std::string> trial_keys() {
-    return {"world", "model", "seed", "protocol", "robot", "trajectory", "analysis", "flight"};
+    std::vector<std::string> keys{"world", "model", "seed", "protocol", "analysis"};
+    const auto agents = agent_yaml_keys();
+    keys.insert(keys.end() - 1, agents.begin(), agents.end());
+    return keys;
 }
 
 TrialConfig trial_from_yaml(const YamlView& v) {
@@ -113,7 +82,7 @@ TrialConfig trial_from_yaml(const YamlView& v) {
     if (v.has("model")) t.model = model_from(v["model"]);
     if (v.has("seed")) t.seed = v["seed"].as_uint64();
     if (v.has("protocol")) read_table(v["protocol"], t.protocol, Protocol::table());
-    t.set_agent(agent_from(v));
+    t.set_agent(agent_from_yaml(v));
     if (v.has("analysis")) analysis_from(v["analysis"], t);
     t.origin = v.file();
     // What the sections allow one by one may still not fit together (too short a protocol for
@@ -121,7 +90,10 @@ TrialConfig trial_from_yaml(const YamlView& v) {
     try {
         t.validate();
     } catch (const params::ParamError& e) {
-        for (const char* section : {"protocol", "robot", "analysis"})
+        std::vector<std::string> sections{"protocol"};
+        for (const auto& agent : agent_yaml_keys()) sections.push_back(agent);
+        sections.push_back("analysis");
+        for (const auto& section : sections)
             if (v.has(section) && v[section].is_map() && v[section].has(e.key())) v[section][e.key()].fail(e.reason());
         v.fail(e.what());
     } catch (const InputError& e) {  // a model and an agent that do not go together: name the file

@@ -116,6 +116,13 @@ void YamlView::fail_key(const std::string& key, const std::string& reason) const
     throw ConfigError(file_, child_path(key), reason + location());
 }
 
+std::string path_in_file(const YamlView& v, const std::string& path) {
+    if (std::filesystem::path(path).is_absolute()) return path;
+    const auto candidate = std::filesystem::path(v.directory()) / path;
+    std::error_code ec;
+    return std::filesystem::exists(candidate, ec) ? candidate.string() : path;
+}
+
 void YamlView::expect_map(std::initializer_list<const char*> allowed) const {
     expect_map(std::vector<std::string>(allowed.begin(), allowed.end()));
 }

@@ -70,6 +70,10 @@ private:
     std::string file_, path_;
 };
 
+// A path written in the YAML file of `v`: relative to that file's folder when such a file exists there;
+// anything else (absolute paths, preset names) as it is.
+std::string path_in_file(const YamlView& v, const std::string& path);
+
 // One optional member of a mapping and the field it fills.
 struct Field {
     const char* key;

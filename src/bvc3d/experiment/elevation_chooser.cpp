@@ -168,7 +168,7 @@ void ChooserParams::validate(int n_dir) const {
 }
 
 ChooserDefaults chooser_defaults(const AgentSpec& agent) {
-    if (agent.dims() == 3) return {"fly-5l", "spherical-full", true};
+    if (agent.locomotion() == Locomotion::flying) return {"fly-5l", "spherical-full", true};
     return {"3d-0.2", "spherical", false};
 }
 

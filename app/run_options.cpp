@@ -1,0 +1,117 @@
+#include "run_options.hpp"
+
+#include <cstdio>
+
+#include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/cancel.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/memory.hpp"
+#include "cli_common.hpp"
+#include "summary_report.hpp"
+
+namespace bvc3d::cli {
+
+const char* const jobs_help = "Trials in parallel; 0 (the default): one per core";
+const char* const no_memory_check_help = "Run even when the estimated memory exceeds what the machine has available";
+
+CLI::Option* RunOptions::add_out(CLI::App& cmd, const std::string& help) {
+    auto* option = cmd.add_option("--out", out, help);
+    return out.empty() ? option : option->capture_default_str();
+}
+
+CLI::Option* RunOptions::add_jobs(CLI::App& cmd, const std::string& help) {
+    return cmd.add_option("--jobs", jobs, help);
+}
+
+CLI::Option* RunOptions::add_checkpoint_minutes(CLI::App& cmd) {
+    return cmd
+        .add_option("--checkpoint-minutes", checkpoint_minutes,
+                    "Checkpoint every this many simulated minutes (0: only on Ctrl-C)")
+        ->capture_default_str();
+}
+
+CLI::Option* RunOptions::add_no_memory_check(CLI::App& cmd) {
+    return cmd.add_flag("--no-memory-check", no_memory_check, no_memory_check_help);
+}
+
+CLI::Option* RunOptions::add_no_report(CLI::App& cmd) {
+    return cmd.add_flag("--no-report", no_report, "Skip the figures (trial files and summary only)");
+}
+
+void RunOptions::add_experiment_options(CLI::App& cmd, const std::string& out_help) {
+    add_out(cmd, out_help);
+    add_jobs(cmd);
+    add_checkpoint_minutes(cmd);
+    add_no_report(cmd);
+    add_no_memory_check(cmd);
+}
+
+void RunOptions::check() const {
+    if (jobs < 0) throw InputError("--jobs must be >= 0 (0: one per core), got " + std::to_string(jobs));
+    if (jobs > max_jobs)
+        throw InputError("--jobs " + std::to_string(jobs) + " is more than the limit of " + std::to_string(max_jobs));
+    if (!(checkpoint_minutes >= 0)) throw InputError("--checkpoint-minutes must be >= 0");
+}
+
+void RunOptions::check_memory(const std::vector<TrialConfig>& trials, int threads) const {
+    if (no_memory_check) return;
+    const std::string what =
+        trials.size() == 1 ? "this trial" : "this run (" + std::to_string(trials.size()) + " trials)";
+    bvc3d::check_memory(
+        estimate_memory(trials, threads), what,
+        "shorten sample_hours, use fewer --jobs or smaller models, or pass --no-memory-check to try anyway");
+}
+
+std::string output_folder_text(const std::filesystem::path& folder) {
+    return "output folder '" + folder.string() + "'";
+}
+
+OutputLock lock_output_folder(const std::filesystem::path& folder) {
+    ensure_writable_directory(folder);
+    return OutputLock(folder_lock_path(folder), output_folder_text(folder));
+}
+
+OutputLock lock_output_file(const std::filesystem::path& file) {
+    require_not_directory(file, "--out");
+    ensure_writable_directory(file.has_parent_path() ? file.parent_path() : ".");
+    return OutputLock(file_lock_path(file), "trial file '" + file.string() + "'");
+}
+
+void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome) {
+    std::printf("%zu trials in %s (%d run, %d already complete) in %.1f s", n_trials, out.c_str(), outcome.ran,
+                outcome.skipped, outcome.wall_seconds);
+    if (outcome.steps > 0)
+        std::printf(", %.0f walk steps/s, %.0f model steps/s", outcome.steps / outcome.wall_seconds,
+                    outcome.model_steps / outcome.wall_seconds);
+    std::printf("\n");
+}
+
+ExperimentOutcome run_experiment_in_folder(const std::vector<TrialConfig>& trials, const RunOptions& o,
+                                           const FolderRunHooks& hooks) {
+    o.check();  // before anything is written
+    check_runnable(trials);
+    o.check_memory(trials, o.jobs);
+    const OutputLock lock = lock_output_folder(o.out);
+    if (hooks.under_lock) hooks.under_lock();
+    ExperimentOptions opts;
+    opts.out_dir = o.out;
+    opts.jobs = o.jobs;
+    opts.progress = progress_style();
+    opts.checkpoint_minutes = o.checkpoint_minutes;
+    opts.stop = &stop_flag();
+    opts.on_trial_done = hooks.on_trial_done;
+    ExperimentOutcome outcome;
+    {
+        InterruptGuard guard;
+        try {
+            outcome = run_experiment(trials, opts);
+        } catch (const Interrupted&) {
+            exit_interrupted();
+        }
+    }
+    print_outcome(trials.size(), o.out, outcome);
+    summarize(o.out, outcome.files, !o.no_report);
+    return outcome;
+}
+
+}  // namespace bvc3d::cli
