@@ -5,6 +5,8 @@ find_package(assimp REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(CLI11 REQUIRED)
+# Gazebo (SDF) worlds: Debian's libsdformat-dev (SDFormat 12, the reference parser).
+find_package(sdformat12 REQUIRED)
 find_package(Threads REQUIRED)
 
 if(BVC3D_WITH_MPI)
