@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/world/ray_caster.hpp"
 
@@ -42,13 +43,36 @@ double storey_ceiling(const WorldDescription& w, const FloorMap& map) {
 }  // namespace
 
 std::vector<FloorLevel> building_floors(const GazeboScene& scene) {
-    std::vector<char> ground(scene.mesh.size(), 0);
+    // Horizontal triangles with no headroom (the underside of a slab, a shelf under another) are
+    // not floors: each is tried at 7 points, and left out unless most have room above them.
+    constexpr double headroom = 0.5;  // m
+    const FloorOptions options;
+    const RayCaster caster(scene.mesh, scene.spheres);
+    std::vector<char> skip(scene.mesh.size(), 0);
+    for (std::size_t t = 0; t < scene.mesh.size(); ++t) {
+        const auto c = scene.mesh.corners(t);
+        const Vec3 n = (c[1] - c[0]).cross(c[2] - c[0]);
+        if (!(std::abs(n.z()) >= std::cos(deg_to_rad(options.max_tilt_deg)) * n.norm())) continue;
+        int room = 0;
+        for (const auto& [a, b] : {std::pair{1.0 / 3, 1.0 / 3},
+                                   {0.8, 0.1},
+                                   {0.1, 0.8},
+                                   {0.1, 0.1},
+                                   {0.45, 0.45},
+                                   {0.45, 0.1},
+                                   {0.1, 0.45}}) {
+            const Vec3 p = c[0] + a * (c[1] - c[0]) + b * (c[2] - c[0]) + Vec3(0, 0, 1e-3);
+            room += caster.cast(p, Vec3::UnitZ(), headroom) == RayCaster::no_hit;
+        }
+        skip[t] = room < 4;
+    }
+    std::vector<char> ground = skip;
     for (const auto& p : scene.parts)
         if (p.ground_plane)
             std::fill(ground.begin() + static_cast<std::ptrdiff_t>(p.first_triangle),
                       ground.begin() + static_cast<std::ptrdiff_t>(p.first_triangle + p.triangle_count), 1);
-    auto levels = floor_levels(scene.mesh, ground);
-    return levels.empty() ? floor_levels(scene.mesh) : levels;
+    auto levels = floor_levels(scene.mesh, ground, options);
+    return levels.empty() ? floor_levels(scene.mesh, skip, options) : levels;
 }
 
 WorldDescription building_world(const BuildingSpec& spec) {

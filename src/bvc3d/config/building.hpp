@@ -37,7 +37,8 @@ struct BuildingSpec {
 WorldDescription building_world(const BuildingSpec& spec);
 
 // The floors of a building file (their heights in the file's frame, lowest first), as
-// building_world() chooses among them: Gazebo's ground plane is a floor only when there is no other.
+// building_world() chooses among them: horizontal geometry with at least 0.5 m of room above it;
+// Gazebo's ground plane is a floor only when there is no other.
 std::vector<FloorLevel> building_floors(const GazeboScene& scene);
 
 // A world YAML with an `sdf` key (docs/buildings.md#world-yaml): sdf, model_path, geometry,

@@ -117,7 +117,8 @@ struct Piece {
 // One <include> of model://NAME that SDFormat handed to us (the custom model parser below): a model
 // to place by its file's own geometry. Its pose comes from SDFormat's pose graph.
 struct Include {
-    std::string name;             // the model's name where it is included
+    std::string name;             // its <name>, else NAME (until the model's file is read)
+    bool named = false;           // the <include> gave a <name>
     std::string parent;           // the enclosing model's scoped name ("a::b"), "" for the world
     std::string model;            // NAME of model://NAME
     std::string folder;           // the model's folder; "" for a built-in
@@ -324,6 +325,7 @@ sdf::InterfaceModelPtr Loader::intercept(const sdf::NestedInclude& inc) {
     Include i;
     i.model = inc.Uri().rfind("model://", 0) == 0 ? inc.Uri().substr(8) : inc.Uri();
     i.name = inc.LocalModelName().value_or(i.model);
+    i.named = inc.LocalModelName().has_value();
     i.parent = inc.AbsoluteParentName();
     const std::string& resolved = inc.ResolvedFileName();
     if (resolved.rfind(builtin_marker, 0) != 0) i.folder = fs::path(resolved).parent_path().string();
@@ -596,10 +598,9 @@ void Loader::read_templates(const std::vector<std::size_t>& todo) {
         const sdf::Model* m = root.Model();
         if (!m) fail(Place{tp.file, 0, ""}, "holds no <model> (a model's file must)");
         tp.name = m->Name();
-        // SDFormat placed the model at its own pose; its geometry is kept in its own frame.
-        ignition::math::Pose3d own;
-        m->SemanticPose().Resolve(own, "world");
-        tp.own_pose = to_iso(own);
+        // Its own <pose> (a file's top model has no frame to resolve it against: it is the raw pose);
+        // its geometry is kept in its own frame.
+        tp.own_pose = to_iso(m->RawPose());
         check_pose(tp.own_pose, place_of(m->Element(), tp.name), "the model's pose");
         walk_model(*m, Iso::Identity(), "", tp.pieces);
         for (auto& p : tp.pieces) p.path = p.path.substr(1);  // "/link/visual" -> "link/visual"
@@ -715,7 +716,9 @@ void Loader::expand(const std::vector<Piece>& pieces, const std::vector<Include>
     for (const auto& p : pieces) emit(p, frame * p.pose, prefix + "/" + p.path);
     for (const auto& inc : includes) {
         const int t = template_of(inc);
-        const std::string path = prefix + "/" + slashed(inc.parent.empty() ? inc.name : inc.parent + "::" + inc.name);
+        // Without a <name>, an included model keeps the name in its file (as SDFormat names it).
+        const std::string name = inc.named || templates_[t].builtin ? inc.name : templates_[t].name;
+        const std::string path = prefix + "/" + slashed(inc.parent.empty() ? name : inc.parent + "::" + name);
         if (std::find(stack.begin(), stack.end(), t) != stack.end()) {
             std::string chain;
             for (int s : stack) chain += templates_[s].model + " -> ";
@@ -753,13 +756,13 @@ GazeboScene Loader::load() {
                 m.SemanticPose().Resolve(pose, "world");
                 const Iso f = to_iso(pose);
                 check_pose(f, place_of(m.Element(), scene_.name + "/" + m.Name()), "its pose");
-                walk_model(m, f, m.Name(), pieces);
+                walk_model(m, f, scene_.name + "/" + m.Name(), pieces);
             }
         } else if (const sdf::Model* model = root.Model()) {  // a model file: the model is the world
             scene_.name = model->Name();
             ignition::math::Pose3d pose;
             model->SemanticPose().Resolve(pose, "world");
-            walk_model(*model, to_iso(pose), model->Name(), pieces);
+            walk_model(*model, to_iso(pose), scene_.name, pieces);
         } else {
             throw InputError("Gazebo world '" + file_ + "': holds neither a <world> nor a <model>");
         }
@@ -768,7 +771,7 @@ GazeboScene Loader::load() {
     load_templates();
     std::vector<int> stack;
     // Pieces of models written in the world file itself, then every include.
-    for (const auto& p : pieces) emit(p, p.pose, scene_.name + "/" + p.path);
+    for (const auto& p : pieces) emit(p, p.pose, p.path);
     expand({}, top, Iso::Identity(), scene_.name, stack);
     if (scene_.parts.empty())
         throw InputError("Gazebo world '" + file_ + "': has no " +
