@@ -21,7 +21,7 @@ std::string levels_text(const std::vector<FloorLevel>& levels) {
 }
 
 // The median height of the first geometry above the floor's held cells (at most ~4000 of them,
-// evenly spread): the storey's ceiling.
+// evenly spread): the storey's ceiling (infinity when most of the floor is under the open sky).
 double storey_ceiling(const WorldDescription& w, const FloorMap& map) {
     const RayCaster caster(w.mesh, w.spheres);
     const std::size_t held = static_cast<std::size_t>(std::count(map.held.begin(), map.held.end(), 1));
@@ -33,9 +33,9 @@ double storey_ceiling(const WorldDescription& w, const FloorMap& map) {
             if (!map.held[static_cast<std::size_t>(y) * map.nx + x] || k++ % stride) continue;
             const Vec3 from(map.box.min().x() + (x + 0.5) * map.cell, map.box.min().y() + (y + 0.5) * map.cell, 1e-3);
             const double up = caster.cast(from, Vec3::UnitZ(), 1e3);
-            if (up != RayCaster::no_hit) heights.push_back(from.z() + up);
+            heights.push_back(up == RayCaster::no_hit ? up : from.z() + up);  // open sky: infinity
         }
-    if (heights.empty()) return 0.0;
+    if (heights.empty()) return RayCaster::no_hit;
     std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2), heights.end());
     return heights[heights.size() / 2];
 }
@@ -125,6 +125,9 @@ WorldDescription building_world(const BuildingSpec& spec) {
     if (spec.flight) {
         const double ceiling = storey_ceiling(w, map);
         const double clearance = spec.flight->clearance;
+        if (ceiling == RayCaster::no_hit)
+            throw InputError(where + ": the floor at " + format_number(floor.z) +
+                             " m is under the open sky: a storey flight volume needs a ceiling");
         if (!(ceiling - clearance > clearance))
             throw InputError(where + ": the storey at " + format_number(floor.z) + " m is " + format_number(ceiling) +
                              " m high: no room for a flight volume " + format_number(clearance) +

@@ -462,9 +462,10 @@ const LidarSpec* find_builtin_sensor(const std::string& name) {
     return nullptr;
 }
 
-std::string builtin_sensor_list() {
+// "vlp16, hdl32, ..." (quoted: "'vlp16', 'hdl32', ...").
+std::string lidar_model_list(bool quoted = false) {
     std::string list;
-    for (const auto& [n, spec] : builtin_sensors()) list += (list.empty() ? "" : ", ") + n;
+    for (const auto& m : lidar_models()) list += (list.empty() ? "" : ", ") + (quoted ? "'" + m.name + "'" : m.name);
     return list;
 }
 
@@ -481,9 +482,10 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
     if (v.is_scalar()) {
         const std::string name = v.as_string();
         if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
-        v.fail("expected a sensor name (" + builtin_sensor_list() + ") or a sensor mapping");
+        v.fail("expected horizontal, spherical, spherical-full, spherical-authors, a LiDAR model (" +
+               lidar_model_list() + "), or a sensor mapping");
     }
-    if (!v.is_map()) v.fail("expected a sensor name (" + builtin_sensor_list() + ") or a sensor mapping");
+    if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping (or a LiDAR model's name)");
     const std::string preset = v.get("preset", "");
     const bool own_rows = v.has("elevations") || v.has("elevations_deg");
     LidarSpec s;
@@ -502,7 +504,7 @@ LidarSpec sensor_from_yaml(const YamlView& v) {
         s = rows == "upper" ? upper_rows(lidar_model_spec(*model)) : lidar_model_spec(*model);
     } else if (!preset.empty()) {
         v["preset"].fail("unknown sensor preset '" + preset +
-                         "' (expected horizontal, spherical or a LiDAR model: " + builtin_sensor_list() + ")");
+                         "' (expected horizontal, spherical or a LiDAR model: " + lidar_model_list() + ")");
     } else if (!own_rows) {
         v.fail("a custom sensor needs 'elevations_deg' (or a 'preset')");
     } else {
@@ -536,8 +538,10 @@ LidarSpec resolve_sensor(const std::string& name) {
     if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
     std::error_code ec;
     if (!std::filesystem::exists(name, ec))
-        throw InputError("sensor '" + name + "' is neither a sensor name (" + builtin_sensor_list() +
-                         ") nor an existing YAML file");
+        throw InputError(
+            "sensor '" + name +
+            "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors', a LiDAR model (" +
+            lidar_model_list(true) + ") nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }

@@ -133,6 +133,7 @@ struct Template {
     std::string model;  // NAME
     std::string folder, file;
     std::string name;                // its <model> name
+    std::string where;               // the element path of its first <include>, for messages
     Iso own_pose = Iso::Identity();  // its own <pose>, used when an <include> gives none
     std::vector<Piece> pieces;       // in its model frame
     std::vector<Include> includes;   // nested includes, frames in its model frame
@@ -299,7 +300,9 @@ private:
                        std::vector<Piece>& out) const;
     void load_templates();
     void read_templates(const std::vector<std::size_t>& todo);
-    int template_of(const Include& inc);
+    // The model an include places (read later by load_templates); `where` is the include's element
+    // path, for messages about the model's file.
+    int template_of(const Include& inc, const std::string& where);
     void expand(const std::vector<Piece>& pieces, const std::vector<Include>& includes, const Iso& frame,
                 const std::string& prefix, std::vector<int>& stack);
     void emit(const Piece& piece, const Iso& pose, const std::string& path);
@@ -524,10 +527,11 @@ void Loader::walk_model(const sdf::Model& m, const Iso& frame, const std::string
     }
 }
 
-int Loader::template_of(const Include& inc) {
+int Loader::template_of(const Include& inc, const std::string& where) {
     const std::string key = inc.folder.empty() ? builtin_marker + inc.model : inc.folder;
     if (const auto it = template_by_folder_.find(key); it != template_by_folder_.end()) return it->second;
     Template t;
+    t.where = where;
     t.model = inc.model;
     t.folder = inc.folder;
     t.name = inc.model;
@@ -569,7 +573,8 @@ void Loader::load_templates() {
         for (std::size_t t = next; t < end; ++t)
             for (std::size_t k = 0; k < templates_[t].includes.size(); ++k) {
                 const Include inc = templates_[t].includes[k];  // template_of may add templates
-                template_of(inc);
+                template_of(inc, templates_[t].where + "/" +
+                                     slashed(inc.parent.empty() ? inc.name : inc.parent + "::" + inc.name));
             }
         next = end;
     }
@@ -601,9 +606,10 @@ void Loader::read_templates(const std::vector<std::size_t>& todo) {
         // Its own <pose> (a file's top model has no frame to resolve it against: it is the raw pose);
         // its geometry is kept in its own frame.
         tp.own_pose = to_iso(m->RawPose());
-        check_pose(tp.own_pose, place_of(m->Element(), tp.name), "the model's pose");
-        walk_model(*m, Iso::Identity(), "", tp.pieces);
-        for (auto& p : tp.pieces) p.path = p.path.substr(1);  // "/link/visual" -> "link/visual"
+        check_pose(tp.own_pose, place_of(m->Element(), tp.where), "the model's pose");
+        walk_model(*m, Iso::Identity(), tp.where, tp.pieces);
+        for (auto& p : tp.pieces)
+            p.path = p.path.substr(tp.where.size() + 1);  // "w/crate/link/visual" -> "link/visual"
         const Iso to_model = tp.own_pose.inverse();
         for (Include inc : nested) {
             // The enclosing model's scoped name starts with the file's model: keep what is inside it.
@@ -715,7 +721,7 @@ void Loader::expand(const std::vector<Piece>& pieces, const std::vector<Include>
                     const std::string& prefix, std::vector<int>& stack) {
     for (const auto& p : pieces) emit(p, frame * p.pose, prefix + "/" + p.path);
     for (const auto& inc : includes) {
-        const int t = template_of(inc);
+        const int t = template_of(inc, prefix + "/" + inc.name);
         // Without a <name>, an included model keeps the name in its file (as SDFormat names it).
         const std::string name = inc.named || templates_[t].builtin ? inc.name : templates_[t].name;
         const std::string path = prefix + "/" + slashed(inc.parent.empty() ? name : inc.parent + "::" + name);
@@ -767,7 +773,8 @@ GazeboScene Loader::load() {
             throw InputError("Gazebo world '" + file_ + "': holds neither a <world> nor a <model>");
         }
     }
-    for (const auto& inc : top) template_of(inc);
+    for (const auto& inc : top)
+        template_of(inc, scene_.name + "/" + slashed(inc.parent.empty() ? inc.name : inc.parent + "::" + inc.name));
     load_templates();
     std::vector<int> stack;
     // Pieces of models written in the world file itself, then every include.
