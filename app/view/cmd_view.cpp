@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "bvc3d/config/world_yaml.hpp"
-#include "bvc3d/world/gazebo_world.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/world/gazebo_world.hpp"
 #include "cli_common.hpp"
 #include "view/export.hpp"
 #include "view/safe_path.hpp"
@@ -142,8 +142,8 @@ void add_view_command(CLI::App& app) {
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("paths", o->paths,
-                    "A trial file (.h5), two to compare side by side, a results folder, a world YAML or Gazebo world, or a preset "
-                    "(default: the cross arena)");
+                    "A trial file (.h5), two to compare side by side, a results folder, a world YAML or Gazebo world, "
+                    "or a world preset (default: the cross arena)");
     cmd->add_option("--port", o->port, "Port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
     cmd->add_option("--scans", o->scans, "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");

@@ -20,8 +20,9 @@ from conftest import SOURCE_DIR
 GAZEBO = SOURCE_DIR.parent / "shared" / "data" / "gazebo"
 HOSPITAL = GAZEBO / "aws-robomaker-hospital-world"
 HOUSE = GAZEBO / "aws-robomaker-small-house-world"
-needs_data = pytest.mark.skipif(not HOSPITAL.is_dir() or not HOUSE.is_dir(),
-                                reason=f"the Gazebo worlds are not in {GAZEBO} (shared data, not part of the repository)")
+needs_data = pytest.mark.skipif(
+    not HOSPITAL.is_dir() or not HOUSE.is_dir(),
+    reason=f"the Gazebo worlds are not in {GAZEBO} (shared data, not part of the repository)")
 
 RADIUS, HEIGHT, STEP = 0.25, 0.10, 0.02  # the robot's body and the buildings' step height
 

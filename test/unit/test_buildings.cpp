@@ -120,10 +120,12 @@ struct TestWorld {
   <pose>0 0 5 0 0 0.3</pose>
   <link name="body"><pose>0.5 0 0 0 0 0</pose>
     <visual name="box"><pose>0 0 0.25 0 0 0</pose><geometry><box><size>1 2 0.5</size></box></geometry></visual>
-    <collision name="box"><pose>0 0 0.25 0 0 0</pose><geometry><box><size>1.2 2.2 0.5</size></box></geometry></collision>
+    <collision name="box"><pose>0 0 0.25 0 0 0</pose>
+      <geometry><box><size>1.2 2.2 0.5</size></box></geometry></collision>
   </link>
   <model name="lid"><pose>0 0 1 0 0 0</pose>
-    <link name="top"><visual name="ball"><pose>0.2 0 0 0 0 0</pose><geometry><sphere><radius>0.3</radius></sphere></geometry></visual></link>
+    <link name="top"><visual name="ball"><pose>0.2 0 0 0 0 0</pose>
+      <geometry><sphere><radius>0.3</radius></sphere></geometry></visual></link>
   </model>
   <include><uri>model://bolt</uri><pose>0 0.5 2 0 0 0</pose></include>
 </model></sdf>
@@ -152,7 +154,8 @@ struct TestWorld {
     <model name="inner"><pose>1 0 0 0 0 0</pose>
       <link name="L"><pose>0 1 0 0 0 0.2</pose>
         <visual name="wall"><pose>0 0 1 0 0 0</pose><geometry><box><size>0.2 3 2</size></box></geometry></visual>
-        <visual name="post"><pose>1 0 1 0 0 0</pose><geometry><cylinder><radius>0.3</radius><length>2</length></cylinder></geometry></visual>
+        <visual name="post"><pose>1 0 1 0 0 0</pose>
+          <geometry><cylinder><radius>0.3</radius><length>2</length></cylinder></geometry></visual>
       </link>
     </model>
   </model>
