@@ -55,6 +55,9 @@ void add_route_command(CLI::App& app) {
         o->route.validate();
         require_not_directory(o->out, "--out");
         const World world(config::resolve_world(o->world));
+        if (const auto& out = world.description().left_out; !out.empty())
+            std::cerr << "bvc3d: warning: " << out.size()
+                      << " included models were not found and are left out (first: " << out.front() << ")\n";
         const RobotParams robot;
         std::vector<ModelStep> steps;
         if (o->tour) {

@@ -131,6 +131,9 @@ flight volume filling the storey. The chosen floor is moved to z = 0 (World.floo
             },
             "Sets of spheres of one radius each: dicts of centers (N, 3) and radius")
         .def_property_readonly(
+            "left_out", [](const World& w) { return w.description().left_out; },
+            "Models the world file includes that were not found and left out (missing_models='skip'): 'NAME at PATH'")
+        .def_property_readonly(
             "floor_z", [](const World& w) { return w.description().floor_z; },
             "How far a building was moved down so that its floor is at z = 0 (its file's z = world z + floor_z)")
         .def_property_readonly(

@@ -111,6 +111,7 @@ WorldDescription building_world(const BuildingSpec& spec) {
     w.spheres = std::move(scene.spheres);
     for (auto& set : w.spheres)
         for (auto& c : set.centers) c.z() -= floor.z;
+    w.left_out = scene.missing_models;
     for (const auto& p : scene.parts)
         w.parts.push_back(
             WorldPart{p.path, p.shape, p.file, p.first_triangle, p.triangle_count, p.sphere_set, p.sphere_index});

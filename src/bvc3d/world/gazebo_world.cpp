@@ -22,6 +22,7 @@
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 #include <sdf/sdf.hh>
 #pragma GCC diagnostic pop
+#include <console_bridge/console.h>
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
@@ -184,8 +185,16 @@ public:
 
 class ConsoleCapture {
 public:
-    ConsoleCapture() { sdf::Console::Instance()->GetMsgStream().SetStream(&text_); }
-    ~ConsoleCapture() { sdf::Console::Instance()->GetMsgStream().SetStream(&std::cerr); }
+    // urdfdom (SDFormat's fallback for a file it cannot read) logs through console_bridge: quiet
+    // meanwhile, then as it was.
+    ConsoleCapture() : bridge_level_(console_bridge::getLogLevel()) {
+        sdf::Console::Instance()->GetMsgStream().SetStream(&text_);
+        console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+    }
+    ~ConsoleCapture() {
+        sdf::Console::Instance()->GetMsgStream().SetStream(&std::cerr);
+        console_bridge::setLogLevel(bridge_level_);
+    }
     ConsoleCapture(const ConsoleCapture&) = delete;
     ConsoleCapture& operator=(const ConsoleCapture&) = delete;
     // The messages, without their colours and source locations, one per line.
@@ -211,6 +220,7 @@ public:
 
 private:
     std::ostringstream text_;
+    console_bridge::LogLevel bridge_level_;
 };
 
 // "/sdf/world[@name="w"]/model[@name="m"]/include[0]/uri" -> "w/m/include/uri"
@@ -300,6 +310,7 @@ private:
                        std::vector<Piece>& out) const;
     void load_templates();
     void read_templates(const std::vector<std::size_t>& todo);
+    sdf::Errors read_into(sdf::Root& root, const std::string& file);
     // The model an include places (read later by load_templates); `where` is the include's element
     // path, for messages about the model's file.
     int template_of(const Include& inc, const std::string& where);
@@ -580,25 +591,27 @@ void Loader::load_templates() {
     }
 }
 
-// Each model file is read into one SDF document whose element descriptions are made once: SDFormat's
-// own <include> makes them anew for every file (tens of milliseconds each).
-void Loader::read_templates(const std::vector<std::size_t>& todo) {
+// Each model file is read into one SDF document whose element descriptions are made once:
+// Root::Load and SDFormat's own <include> make them anew each time (tens of milliseconds a file).
+sdf::Errors Loader::read_into(sdf::Root& root, const std::string& file) {
     if (!blank_) {
         blank_ = std::make_shared<sdf::SDF>();
         sdf::init(blank_);
     }
+    blank_->Root()->ClearElements();
+    sdf::Errors errors;
+    sdf::readFile(file, config_, blank_, errors);
+    if (!errors.empty()) return errors;
+    return root.Load(blank_, config_);
+}
+
+void Loader::read_templates(const std::vector<std::size_t>& todo) {
     for (std::size_t t : todo) {
         Template& tp = templates_[t];
         std::vector<Include> nested;
         includes_ = &nested;
         sdf::Root root;
-        parse(root, [&](sdf::Root& r) {
-            blank_->Root()->ClearElements();
-            sdf::Errors errors;
-            sdf::readFile(tp.file, config_, blank_, errors);
-            if (!errors.empty()) return errors;
-            return r.Load(blank_, config_);
-        });
+        parse(root, [&](sdf::Root& r) { return read_into(r, tp.file); });
         includes_ = nullptr;
         const sdf::Model* m = root.Model();
         if (!m) fail(Place{tp.file, 0, ""}, "holds no <model> (a model's file must)");
@@ -752,6 +765,8 @@ GazeboScene Loader::load() {
     {
         includes_ = &top;
         sdf::Root root;
+        // Root::Load of the file keeps the world when SDFormat complains about its name (a loaded
+        // SDF document does not): read_into is for model files.
         parse(root, [&](sdf::Root& r) { return r.Load(file_, config_); });
         includes_ = nullptr;
         if (const sdf::World* world = root.WorldByIndex(0)) {

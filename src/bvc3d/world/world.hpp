@@ -63,6 +63,9 @@ struct WorldDescription {
     // door sill); 0: everything above the floor blocks it.
     double step_height = 0.0;
     std::vector<WorldPart> parts;  // named pieces of `mesh` and `spheres` (empty: none named)
+    // Models a building's file includes but that were not found and were left out on request
+    // (docs/buildings.md: missing_models: skip), as "NAME at world/...".
+    std::vector<std::string> left_out;
 
     bool has_geometry() const;
     // The box holding every triangle and sphere (empty for a world without geometry).
