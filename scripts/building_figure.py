@@ -78,9 +78,10 @@ def main():
     ax.set_ylim(-36, 22)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"AWS RoboMaker hospital: a tour ({stats['length']:.0f} m, within 1 m of {100 * stats['coverage']:.1f} %"
-                 f" of the floor,\n{stats['reverse_length']:.0f} m driven again in the opposite direction) and one"
-                 f" os1-64 scan (orange: {mid.sum()} returns off floor and ceiling)", fontsize=8.5)
+    ax.set_title(f"AWS RoboMaker hospital: a tour ({stats['length']:.0f} m, within 1 m of "
+                 f"{100 * stats['coverage']:.1f} % of the floor,\n{stats['reverse_length']:.0f} m driven again in the "
+                 f"opposite direction) and one os1-64 scan (orange: {mid.sum()} returns off floor and ceiling)",
+                 fontsize=8.5)
     fig.tight_layout()
     fig.savefig(args.out, dpi=110)
     print(f"building_figure: wrote {args.out}")

@@ -46,7 +46,7 @@ def nondegenerate(tri):
 @pytest.mark.parametrize("world_file, models", [
     (HOSPITAL / "worlds" / "hospital.world", HOSPITAL / "models"),
     (HOUSE / "worlds" / "small_house.world", HOUSE / "models"),
-])
+], ids=["hospital", "small_house"])
 def test_every_mesh_is_where_its_sdf_pose_puts_it(world_file, models):
     world = bvc3d.World.from_sdf(world_file, missing_models="skip")
     parts = {p["name"]: p for p in world.parts}
@@ -204,3 +204,50 @@ def test_three_storeys_load_and_walk_on_the_chosen_floor():
         assert scan[0, 0] == pytest.approx(0.5, abs=0.01)
     fv = world.flight_volume
     assert fv["z_min"] == pytest.approx(0.2) and 2.5 < fv["z_max"] < 3.0  # a 3 m storey
+
+
+ROOM_WORLD = """<?xml version="1.0"?>
+<sdf version="1.6"><world name="room">{}</world></sdf>
+"""
+
+
+def box(name, center, size, yaw=0.0):
+    return (f'<model name="{name}"><static>true</static><pose>{center[0]} {center[1]} {center[2]} 0 0 {yaw}</pose>'
+            f'<link name="l"><visual name="v"><geometry><box><size>{size[0]} {size[1]} {size[2]}</size></box>'
+            f'</geometry></visual></link></model>')
+
+
+def test_routes_and_tours_of_a_hand_made_world_feed_the_rest(tmp_path, cli):
+    """No shared data needed: a room of SDF boxes, a route and a tour through it, by Python and by the
+    program, written and read back, and a trial that follows the route."""
+    models = [box("floor", (0, 0, -0.1), (8, 8, 0.2)), box("n", (0, 4.05, 1), (8.2, 0.1, 2)),
+              box("s", (0, -4.05, 1), (8.2, 0.1, 2)), box("e", (4.05, 0, 1), (0.1, 8, 2)),
+              box("w", (-4.05, 0, 1), (0.1, 8, 2)), box("pillar", (1, 1, 1), (0.6, 0.6, 2), 0.4)]
+    (tmp_path / "worlds").mkdir()
+    world_file = tmp_path / "worlds" / "room.world"
+    world_file.write_text(ROOM_WORLD.format("\n".join(models)))
+    world = bvc3d.World.from_sdf(world_file)
+    assert [p["name"] for p in world.parts] == [f"room/{m}/l/v" for m in ("floor", "n", "s", "e", "w", "pillar")]
+    assert world.floor_z == 0.0 and len(world.triangles) == 6 * 12
+
+    waypoints = np.array([[-3, -3], [3, -3], [3, 3], [-3, 3]], float)
+    route = bvc3d.route(world, waypoints)
+    assert (route["x"][0], route["y"][0]) == (-3, -3) and (route["x"][-1], route["y"][-1]) == (-3, 3)
+    bvc3d.write_trajectory(tmp_path / "py.csv", route)
+    (tmp_path / "points.txt").write_text("# x y\n-3 -3\n3,-3\n3 3\n-3 3\n")
+    cli("route", "--world", world_file, "--waypoints", tmp_path / "points.txt", "--out", tmp_path / "cli.csv",
+        check=True)
+    assert (tmp_path / "cli.csv").read_text() == (tmp_path / "py.csv").read_text()
+    back = bvc3d.read_trajectory(tmp_path / "cli.csv")
+    for k in ("t", "x", "y", "heading"):
+        np.testing.assert_array_equal(back[k], route[k])
+
+    tour = bvc3d.tour(world)
+    assert tour["stats"]["coverage"] >= 0.9 and tour["stats"]["reverse_length"] >= 10
+    proc = cli("route", "--world", world_file, "--tour", "--out", tmp_path / "tour.csv", check=True)
+    assert "passes within 1 m of" in proc.stdout
+    np.testing.assert_array_equal(bvc3d.read_trajectory(tmp_path / "tour.csv")["x"], tour["x"])
+
+    trial = bvc3d.run_trial(model="2d", world=str(world_file), trajectory=str(tmp_path / "cli.csv"),
+                            explore_hours=0, sample_hours=0.005)
+    np.testing.assert_array_equal(trial["x"], route["x"][:len(trial["x"])])

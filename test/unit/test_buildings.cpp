@@ -610,6 +610,28 @@ TEST(Route, SmoothWithinTheLateralAccelerationAndHeadingAlongTheMotion) {
     }
 }
 
+// Corners too close together for an arc taken at full speed: the robot slows to √(a·R) on them.
+TEST(Route, SlowsDownInTightCorners) {
+    const BodyCollider body(room(10, 10), 0.25, 0.1);
+    const RouteParams p;
+    const auto steps = route_through({{-6, 0}, {-5, 1}, {-4, 0}, {-3, 1}, {-2, 0}, {-1, 1}, {0, 0}}, body, p);
+    double top_lateral = 0, slowest = 1e9;
+    for (std::size_t i = 2; i + 2 < steps.size(); ++i) {
+        const auto& a = steps[i - 1].pose;
+        const auto& b = steps[i].pose;
+        const auto& c = steps[i + 1].pose;
+        const double dt = p.model_dt;
+        const Vec2 v1(b.x - a.x, b.y - a.y), v2(c.x - b.x, c.y - b.y);
+        const Vec2 vel = (v1 + v2) / (2 * dt), acc = (v2 - v1) / (dt * dt);
+        if (vel.norm() < 0.05) continue;
+        top_lateral = std::max(top_lateral, std::abs(vel.x() * acc.y() - vel.y() * acc.x()) / vel.norm());
+        slowest = std::min(slowest, vel.norm());
+    }
+    EXPECT_LE(top_lateral, p.lateral_acceleration * 1.08);
+    EXPECT_GT(top_lateral, p.lateral_acceleration * 0.5);  // the corners are taken near the limit
+    EXPECT_LT(slowest, 0.7 * p.speed);
+}
+
 TEST(Route, TrajectoryFilesReadBackBitForBit) {
     const BodyCollider body(room(5, 5), 0.25, 0.1);
     const auto steps = route_through({{-3, -3}, {3, -2}, {0, 3}}, body);
@@ -654,6 +676,20 @@ TEST(GridPath, ShortestPathsGoAroundInflatedObstacles) {
     const BodyCollider closed(w, 0.25, 0.1);
     const FreeSpaceGrid closed_grid(closed, 0.1);
     EXPECT_TRUE(GridPathFinder(closed_grid, 0.35).shortest_path(*from, *to).empty());
+}
+
+// A ring corridor a tour drives around once: it begins with an out-and-back to drive part of the
+// building the other way.
+TEST(Tour, DrivesBackWhereItWouldNotOtherwise) {
+    WorldDescription w = room(5, 5);
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Vec3(0, 0, 1);
+    w.mesh.append(box_mesh(Vec3(6.6, 6.6, 2)), pose);  // the ring is 1.7 m wide
+    TourParams tp;
+    const Tour t = make_tour(w, 0.25, 0.1, Vec2(-4.1, -4.1), tp);
+    EXPECT_GE(t.stats.reverse_length, tp.min_reverse);
+    EXPECT_GE(t.stats.coverage, tp.min_coverage);
+    EXPECT_EQ(t.waypoints.front(), t.waypoints.back());
 }
 
 TEST(Tour, CoversTheFloorClosesAndDrivesPartOfItBothWays) {
