@@ -271,6 +271,8 @@ std::string join(const std::vector<std::string>& items, const std::string& sep) 
 
 class Loader {
 public:
+    Loader(const Loader&) = delete;  // its callbacks hold `this`
+    Loader& operator=(const Loader&) = delete;
     Loader(const std::string& file, const GazeboOptions& options)
         : file_(file), options_(options), model_path_(gazebo_model_path(file, options)) {
         find_ = [this](const std::string& uri) { return find(uri); };
@@ -336,13 +338,17 @@ private:
 };
 
 sdf::InterfaceModelPtr Loader::intercept(const sdf::NestedInclude& inc) {
+    // Ours are the models find() gave (their model.config, or a built-in's marker); anything else (a
+    // URDF file) SDFormat reads itself, into an ordinary model.
+    const std::string& resolved = inc.ResolvedFileName();
+    const bool builtin = resolved.rfind(builtin_marker, 0) == 0;
+    if (!builtin && fs::path(resolved).filename() != "model.config") return nullptr;
     Include i;
     i.model = inc.Uri().rfind("model://", 0) == 0 ? inc.Uri().substr(8) : inc.Uri();
     i.name = inc.LocalModelName().value_or(i.model);
     i.named = inc.LocalModelName().has_value();
     i.parent = inc.AbsoluteParentName();
-    const std::string& resolved = inc.ResolvedFileName();
-    if (resolved.rfind(builtin_marker, 0) != 0) i.folder = fs::path(resolved).parent_path().string();
+    if (!builtin) i.folder = fs::path(resolved).parent_path().string();
     i.has_pose = inc.IncludeRawPose().has_value();
     i.at = place_of(inc.IncludeElement(), "");
     const std::size_t index = includes_->size();
