@@ -12,5 +12,6 @@ void add_flight_command(CLI::App& app);       // cmd_flight.cpp
 void add_recording_commands(CLI::App& app);   // cmd_recording.cpp: replay, localize, map, export-scans
 void add_view_command(CLI::App& app);         // view/cmd_view.cpp
 void add_adaptive_command(CLI::App& app);     // cmd_adaptive.cpp: choose-elevations
+void add_route_command(CLI::App& app);        // cmd_route.cpp: route, tour
 
 }  // namespace bvc3d::cli

@@ -158,5 +158,6 @@ void bind_model(pyb::module_& m);
 void bind_experiment(pyb::module_& m);
 void bind_analysis(pyb::module_& m);
 void bind_recording(pyb::module_& m);
+void bind_buildings(pyb::module_& m);  // after bind_simulator: it adds to World
 
 }  // namespace bvc3d::py
