@@ -38,6 +38,9 @@ public:
             throw InputError(bag_->where(topic_, i) + ": " + e.what());
         }
     }
+    std::string scan_name(std::size_t i) const override {
+        return bag_->topics()[topic_].name + " #" + std::to_string(i);
+    }
     std::string fingerprint() const override {
         // The files' names and sizes (their contents are not read again), and what is read from them.
         std::uint64_t h = fnv1a(key_);

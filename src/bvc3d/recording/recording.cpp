@@ -43,6 +43,7 @@ class ScanFiles : public ScanStore {
 public:
     ScanFiles(std::vector<ScanEntry> scans, fs::path poses) : scans_(std::move(scans)), poses_(std::move(poses)) {}
     PointCloud load(std::size_t i) const override { return read_scan(scans_.at(i).path); }
+    std::string scan_name(std::size_t i) const override { return scans_.at(i).path.filename().string(); }
     std::string fingerprint() const override {
         std::uint64_t h = fnv1a(detail::read_file(poses_));
         for (const auto& s : scans_) {

@@ -30,6 +30,8 @@ public:
     virtual PointCloud load(std::size_t i) const = 0;
     // Text that changes when the data does (see Recording::fingerprint).
     virtual std::string fingerprint() const = 0;
+    // A short name of scan i for people: its file's name, or its topic and message index.
+    virtual std::string scan_name(std::size_t i) const = 0;
 };
 
 struct Recording {
