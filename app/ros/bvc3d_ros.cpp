@@ -383,6 +383,7 @@ private:
 int main(int argc, char** argv) {
     // Nodes listen on the loopback interface unless told otherwise (ROS_IP or ROS_HOSTNAME).
     if (!std::getenv("ROS_IP") && !std::getenv("ROS_HOSTNAME")) ::setenv("ROS_IP", "127.0.0.1", 0);
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);  // log lines appear as they happen, under roslaunch too
     ros::init(argc, argv, "bvc3d_ros");
     ros::NodeHandle nh, pn("~");
     try {
