@@ -35,4 +35,31 @@ inline std::string as_file(const std::uint8_t* data, std::size_t size, const std
     return path;
 }
 
+// Decodes every message of a bag as its topic's type says (clouds down to their points).
+template <class Bag>
+void read_every_message(const Bag& bag) {
+    using namespace bvc3d::recording;
+    for (std::size_t t = 0; t < bag.topics().size(); ++t)
+        for (std::size_t k = 0; k < bag.topics()[t].count && k < 64; ++k) {
+            try {
+                switch (message_kind(bag.topics()[t].type)) {
+                    case MessageKind::point_cloud2:
+                        cloud_points(bag.cloud(t, k));
+                        break;
+                    case MessageKind::odometry:
+                    case MessageKind::pose_stamped:
+                        bag.pose(t, k);
+                        break;
+                    case MessageKind::tf:
+                        bag.transforms(t, k);
+                        break;
+                    case MessageKind::other:
+                        bag.serialized(t, k);
+                        break;
+                }
+            } catch (const InputError&) {
+            }
+        }
+}
+
 }  // namespace bvc3d::fuzz

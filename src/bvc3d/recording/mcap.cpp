@@ -133,6 +133,7 @@ struct Chunk {
     std::uint64_t uncompressed_size = 0;
     std::uint32_t crc = 0;
     McapCompression compression = McapCompression::none;
+    mutable bool verified = false;  // its CRC was checked (when the file was indexed): not again
 };
 
 struct MessageRef {
@@ -219,13 +220,14 @@ private:
                 break;
             }
         }
-        if (c.crc != 0) {
+        if (c.crc != 0 && !c.verified) {
             const std::uint32_t crc = crc32_of(out.data(), out.size());
             if (crc != c.crc) {
                 char text[64];
                 std::snprintf(text, sizeof text, "CRC 0x%08x where the chunk declares 0x%08x", crc, c.crc);
                 throw InputError(what + ": its records have " + text + " (corrupt)");
             }
+            c.verified = true;
         }
         return out;
     }
@@ -325,8 +327,8 @@ private:
                 else if (compression == "zstd") c.compression = McapCompression::zstd;
                 else if (compression == "lz4") c.compression = McapCompression::lz4;
                 else
-                    throw InputError(where() + ": a chunk compressed with '" + detail::quote_token(compression) +
-                                     "', which is not one of zstd, lz4 or none");
+                    throw InputError(where() + ": a chunk compressed with " + detail::quote_token(compression) +
+                                     ", which is not one of zstd, lz4 or none");
                 const auto [at, size] = f.block<std::uint64_t>();
                 c.offset = content + at;
                 c.size = size;

@@ -45,6 +45,9 @@ Column find_column(const CloudMessage& c, const char* name) {
 // straight loop the compiler keeps in registers.
 template <class T>
 void gather_native(const CloudMessage& c, std::uint64_t row_stride, const Column (&col)[3], PointCloud& out) {
+    // Written through a pointer into room made first (push_back's checks cost as much as the copy).
+    out.xyz.resize(3 * std::size_t{c.width} * c.height);
+    double* o = out.xyz.data();
     const std::uint8_t* base = c.data.data();
     for (std::uint32_t row = 0; row < c.height; ++row) {
         const std::uint8_t* p = base + row * row_stride;
@@ -53,16 +56,16 @@ void gather_native(const CloudMessage& c, std::uint64_t row_stride, const Column
             std::memcpy(&v[0], p + col[0].offset, sizeof(T));
             std::memcpy(&v[1], p + col[1].offset, sizeof(T));
             std::memcpy(&v[2], p + col[2].offset, sizeof(T));
-            const double x = v[0], y = v[1], z = v[2];
-            if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
-                out.xyz.push_back(x);
-                out.xyz.push_back(y);
-                out.xyz.push_back(z);
-            } else {
-                ++out.dropped_nonfinite;
-            }
+            o[0] = v[0];
+            o[1] = v[1];
+            o[2] = v[2];
+            // Branch-free: a point with a non-finite coordinate is written, then overwritten by the next.
+            const bool finite = std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2]);
+            o += finite ? 3 : 0;
+            out.dropped_nonfinite += finite ? 0 : 1;
         }
     }
+    out.xyz.resize(static_cast<std::size_t>(o - out.xyz.data()));
 }
 
 double load_value(const std::uint8_t* p, std::uint32_t size, ByteOrder order) {
@@ -108,10 +111,10 @@ PointCloud cloud_points(const CloudMessage& c) {
                          std::to_string(needed));
     const std::uint64_t points = std::uint64_t{c.width} * c.height;
     PointCloud out;
-    out.xyz.reserve(3 * points);
     const ByteOrder order = c.is_bigendian ? ByteOrder::big : ByteOrder::little;
     const bool native = (order == ByteOrder::little) == (std::endian::native == std::endian::little);
     const bool same = col[0].size == col[1].size && col[1].size == col[2].size;
+    if (!native || !same) out.xyz.reserve(3 * points);
     // A single-row cloud's row_step may be anything (some drivers leave it 0): rows are never stepped.
     const std::uint64_t stride = c.height <= 1 ? row_bytes : c.row_step;
     if (native && same && col[0].size == 4) gather_native<float>(c, stride, col, out);
