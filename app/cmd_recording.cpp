@@ -346,7 +346,8 @@ void add_localize(CLI::App& app) {
                     if (!poses.empty()) throw InputError("'" + what + "' is a trial file: it needs no pose file");
                     s.file = what;
                 } else if (RecordingOptions::is_bag(what)) {
-                    if (!poses.empty()) throw InputError("'" + what + "' is a bag: its poses come from --pose-topic or --tf-frames");
+                    if (!poses.empty())
+                        throw InputError("'" + what + "' is a bag: its poses come from --pose-topic or --tf-frames");
                     s.recording = o->recording.open_bag(what);
                 } else {
                     s.recording = o->recording.open(what, poses);
@@ -569,8 +570,8 @@ void add_bag_info(CLI::App& app) {
             last = total == 0 ? t.last : std::max(last, t.last);
             total += t.count;
         }
-        std::printf("%s: %s, %zu topics, %zu messages, %.3f to %.3f s (%.3f s)\n", path->c_str(),
-                    bag->format().c_str(), bag->topics().size(), total, first, last, last - first);
+        std::printf("%s: %s, %zu topics, %zu messages, %.3f to %.3f s (%.3f s)\n", path->c_str(), bag->format().c_str(),
+                    bag->topics().size(), total, first, last, last - first);
         std::printf("%-28s %-32s %-8s %9s %18s %18s %10s\n", "topic", "type", "encoding", "messages", "first_s",
                     "last_s", "span_s");
         for (std::size_t i = 0; i < bag->topics().size(); ++i) {
@@ -589,8 +590,7 @@ void add_bag_info(CLI::App& app) {
                 std::map<std::string, std::string> links;
                 for (std::size_t k = 0; k < t.count; ++k)
                     for (const auto& x : bag->transforms(i, k)) links[x.child] = x.parent;
-                for (const auto& [child, parent] : links)
-                    std::printf("    %s -> %s\n", parent.c_str(), child.c_str());
+                for (const auto& [child, parent] : links) std::printf("    %s -> %s\n", parent.c_str(), child.c_str());
             } else if (kind == recording::MessageKind::odometry || kind == recording::MessageKind::pose_stamped) {
                 const auto p = bag->pose(i, 0);
                 std::printf("    frame '%s'%s%s\n", p.parent.c_str(), p.child.empty() ? "" : " <- ", p.child.c_str());

@@ -210,8 +210,8 @@ public:
                 "/tf", 100, [this](const tf2_msgs::TFMessage::ConstPtr& m) { poses_.add_tf(*m, false); }, nullptr,
                 hints);
             tf_static_sub_ = nh.subscribe<tf2_msgs::TFMessage>(
-                "/tf_static", 100, [this](const tf2_msgs::TFMessage::ConstPtr& m) { poses_.add_tf(*m, true); },
-                nullptr, hints);
+                "/tf_static", 100, [this](const tf2_msgs::TFMessage::ConstPtr& m) { poses_.add_tf(*m, true); }, nullptr,
+                hints);
         } else if (pose_type == "odometry") {
             pose_sub_ = nh.subscribe<nav_msgs::Odometry>(
                 pose_topic, 100,
@@ -355,8 +355,8 @@ private:
             distance_pub_.publish(distance);
         }
         std_msgs::Float32 latency;
-        latency.data = static_cast<float>(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        latency.data =
+            static_cast<float>(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         latency_pub_.publish(latency);
         std_msgs::Int64 dropped;
         dropped.data = static_cast<std::int64_t>(dropped_.load());

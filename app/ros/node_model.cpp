@@ -117,7 +117,8 @@ struct NodeModel::State {
     }
 };
 
-NodeModel::NodeModel(const NodeParams& params) : s_(std::make_unique<State>(params, config::resolve_model(params.model))) {}
+NodeModel::NodeModel(const NodeParams& params)
+    : s_(std::make_unique<State>(params, config::resolve_model(params.model))) {}
 NodeModel::~NodeModel() = default;
 
 std::size_t NodeModel::n_bvc() const { return s_->layer.n_cells(); }

@@ -325,8 +325,9 @@ RecordingScene::RecordingScene(std::shared_ptr<const recording::Recording> recor
         names.push_back(recording_->store->scan_name(i));
         times.push_back(poses_[i].time ? json(*poses_[i].time) : json(nullptr));
     }
-    json header = {{"kind", "recording"}, {"scans", scans_.size()},      {"names", names},
-                   {"times", times},      {"model", model_json(model_)}, {"paired_by_time", recording_->paired_by_time}};
+    json header = {
+        {"kind", "recording"}, {"scans", scans_.size()},      {"names", names},
+        {"times", times},      {"model", model_json(model_)}, {"paired_by_time", recording_->paired_by_time}};
     blob_ =
         encode_blob(std::move(header), {f32_array("position", std::span<const float>(position), {scans_.size(), 3}),
                                         f32_array("rotation", std::span<const float>(rotation), {scans_.size(), 9})});
@@ -357,7 +358,8 @@ std::string RecordingScene::map_blob() const {
 std::string RecordingScene::scan_blob(std::size_t i) const {
     const auto& poses_ = recording_->poses;
     if (i >= recording_->size())
-        throw InputError("scan " + std::to_string(i) + " is past the recording's " + std::to_string(recording_->size()));
+        throw InputError("scan " + std::to_string(i) + " is past the recording's " +
+                         std::to_string(recording_->size()));
     const auto cloud = recording_->load(i);
     const auto& T = poses_[i].world_from_sensor;
     std::vector<float> xyz, range;

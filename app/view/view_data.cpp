@@ -50,8 +50,7 @@ Reply blob_reply(std::string body) { return Reply{200, "application/octet-stream
 
 ViewData::ViewData(ViewTarget target) : target_(std::move(target)) {
     if (target_.recording)  // opened already: a bad recording fails before serving
-        recording_ =
-            std::make_unique<RecordingScene>(target_.recording, config::resolve_model(target_.model));
+        recording_ = std::make_unique<RecordingScene>(target_.recording, config::resolve_model(target_.model));
 }
 
 Reply ViewData::get(const std::string& endpoint, const Query& query) {
@@ -161,7 +160,8 @@ std::shared_ptr<const World> ViewData::world_by_source(const std::string& source
 }
 
 const RecordingScene& ViewData::recording() {
-    if (!recording_) throw RequestError(404, "no recording is being shown (bvc3d view --scans ... --poses ..., or --bag ...)");
+    if (!recording_)
+        throw RequestError(404, "no recording is being shown (bvc3d view --scans ... --poses ..., or --bag ...)");
     return *recording_;
 }
 

@@ -23,7 +23,7 @@ struct ViewTarget {
     std::string world;                // a world opened first: a preset or a YAML file relative to root
     std::vector<std::string> worlds;  // the worlds offered: presets and YAML files under root
     std::shared_ptr<const bvc3d::recording::Recording> recording;  // a recording (scan files or a bag), opened
-    std::string model = "3d-0.2";                           // the model whose BVCs a recording's page shows
+    std::string model = "3d-0.2";                                  // the model whose BVCs a recording's page shows
 };
 
 struct Reply {

@@ -145,7 +145,8 @@ def main():
     if not ros1:
         lines += list(old.values())
     ros2_folder("ros2-json-encoding", storage_format="json")
-    lines.append(f"ros2-json-encoding | {REPLAY} | ros2-json-encoding; /points; message 0; unknown message encoding 'json'")
+    lines.append(f"ros2-json-encoding | {REPLAY} | ros2-json-encoding; /points; message 0; "
+                 "unknown message encoding 'json'")
     ros2_folder("ros2-corrupt-db", corrupt=True)
     lines.append(f"ros2-corrupt-db | {REPLAY} | bag_0.db3; SQLite")
     (BAGS / "cases.txt").write_text("\n".join(lines) + "\n")

@@ -57,8 +57,7 @@ void read_every_message(const Bag& bag) {
                         bag.serialized(t, k);
                         break;
                 }
-            } catch (const InputError&) {
-            }
+            } catch (const InputError&) {}
         }
 }
 

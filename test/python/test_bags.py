@@ -88,8 +88,8 @@ def test_mcap_clouds_of_any_layout(tmp_path, compression, big):
 def test_ros2_sqlite_bag(tmp_path):
     rng = np.random.default_rng(2)
     clouds, odoms, expected, poses = cloud_bag_messages(rng, big=True)
-    bw.ros2_sqlite(tmp_path / "bag", [(1, "/points", "sensor_msgs/msg/PointCloud2"), (2, "/odom", "nav_msgs/msg/Odometry")],
-                   [(2, t, d) for t, d in odoms] + [(1, t, d) for t, d in clouds])
+    topics = [(1, "/points", "sensor_msgs/msg/PointCloud2"), (2, "/odom", "nav_msgs/msg/Odometry")]
+    bw.ros2_sqlite(tmp_path / "bag", topics, [(2, t, d) for t, d in odoms] + [(1, t, d) for t, d in clouds])
     check_recording(bvc3d.Recording.open_bag(tmp_path / "bag", "/points", pose_topic="/odom"), expected, poses)
 
 

@@ -58,8 +58,8 @@ struct BagFiles {
             poses.push_back(t);
         }
         ros1::write_bag(dir / "scans.bag", clouds, poses, "/points", "/odom");
-        for (const auto& [name, how] : {std::pair{"plain.mcap", McapCompression::none},
-                                        std::pair{"zstd.mcap", McapCompression::zstd}}) {
+        for (const auto& [name, how] :
+             {std::pair{"plain.mcap", McapCompression::none}, std::pair{"zstd.mcap", McapCompression::zstd}}) {
             McapWriter w(dir / name, how);
             const auto points_channel =
                 w.add_channel("/points", "sensor_msgs/msg/PointCloud2", ros2_definition("sensor_msgs/msg/PointCloud2"));
@@ -95,8 +95,8 @@ void BM_ReadBagClouds(benchmark::State& state, std::string file) {
             benchmark::DoNotOptimize(cloud.xyz.data());
         }
     state.SetBytesProcessed(state.iterations() * scans * std::int64_t{points} * 16);
-    state.counters["scans/s"] = benchmark::Counter(static_cast<double>(state.iterations() * scans),
-                                                   benchmark::Counter::kIsRate);
+    state.counters["scans/s"] =
+        benchmark::Counter(static_cast<double>(state.iterations() * scans), benchmark::Counter::kIsRate);
 }
 
 // The same scans as binary PCD files (12 bytes a point on disk; counted at the bag's 16 so that the
@@ -108,8 +108,8 @@ void BM_ReadSameScansAsPcd(benchmark::State& state) {
             benchmark::DoNotOptimize(cloud.xyz.data());
         }
     state.SetBytesProcessed(state.iterations() * scans * std::int64_t{points} * 16);
-    state.counters["scans/s"] = benchmark::Counter(static_cast<double>(state.iterations() * scans),
-                                                   benchmark::Counter::kIsRate);
+    state.counters["scans/s"] =
+        benchmark::Counter(static_cast<double>(state.iterations() * scans), benchmark::Counter::kIsRate);
 }
 
 }  // namespace

@@ -32,8 +32,8 @@ std::size_t BagReader::topic(const std::string& name) const {
         if (topics_[i].name == name) return i;
     std::string list;
     for (const auto& t : topics_) list += (list.empty() ? "" : ", ") + t.name + " (" + t.type + ")";
-    throw InputError(quoted_path(path_) + " has no topic '" + name + "' (its topics: " +
-                     (list.empty() ? "none" : list) + ")");
+    throw InputError(quoted_path(path_) + " has no topic '" + name +
+                     "' (its topics: " + (list.empty() ? "none" : list) + ")");
 }
 
 std::string BagReader::where(std::size_t t, std::size_t k) const {
@@ -46,8 +46,8 @@ void BagReader::expect(std::size_t t, std::size_t k, MessageKind kind) const {
         throw InputError(where(t, k) + ": the topic has " + std::to_string(topic.count) + " messages");
     if (message_kind(topic.type) != kind) {
         const char* wanted = kind == MessageKind::point_cloud2 ? "sensor_msgs/PointCloud2"
-                             : kind == MessageKind::tf        ? "tf2_msgs/TFMessage"
-                                                              : "nav_msgs/Odometry or geometry_msgs/PoseStamped";
+                             : kind == MessageKind::tf         ? "tf2_msgs/TFMessage"
+                                                               : "nav_msgs/Odometry or geometry_msgs/PoseStamped";
         throw InputError(quoted_path(path_) + ", topic '" + topic.name + "' is of type " + topic.type + ", not " +
                          wanted);
     }

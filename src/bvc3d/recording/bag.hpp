@@ -44,7 +44,7 @@ public:
     // Message k of topic t (index into topics()), decoded. The topic must be of the right kind
     // (else an InputError naming its type). Safe to call from several threads.
     CloudMessage cloud(std::size_t t, std::size_t k) const;
-    StampedTransform pose(std::size_t t, std::size_t k) const;  // Odometry or PoseStamped
+    StampedTransform pose(std::size_t t, std::size_t k) const;                     // Odometry or PoseStamped
     std::vector<StampedTransform> transforms(std::size_t t, std::size_t k) const;  // TFMessage
 
     // "'<file>', topic '/points', message 12": where an error is.

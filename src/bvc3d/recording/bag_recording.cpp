@@ -194,8 +194,9 @@ Recording open_bag_recording(std::shared_ptr<const BagReader> bag, const BagSour
         headers.push_back(message_header(*bag, t, k));
         const double stamp = headers.back().stamp;
         if (k > 0 && !(stamp > headers[k - 1].stamp))
-            throw InputError(bag->where(t, k) + ": its stamp " + secs(stamp) + " does not follow the previous cloud's " +
-                             secs(headers[k - 1].stamp) + " (stamps out of order)");
+            throw InputError(bag->where(t, k) + ": its stamp " + secs(stamp) +
+                             " does not follow the previous cloud's " + secs(headers[k - 1].stamp) +
+                             " (stamps out of order)");
         r.scans.push_back({source.bag, stamp});
     }
 
@@ -209,7 +210,8 @@ Recording open_bag_recording(std::shared_ptr<const BagReader> bag, const BagSour
                                  "', not the sensor frame '" + source.tf_sensor + "' of --tf-frames");
             try {
                 PoseRecord p;
-                p.world_from_sensor = tree.lookup(source.tf_fixed, source.tf_sensor, headers[k].stamp, source.tf_tolerance);
+                p.world_from_sensor =
+                    tree.lookup(source.tf_fixed, source.tf_sensor, headers[k].stamp, source.tf_tolerance);
                 p.time = headers[k].stamp;
                 poses.push_back(p);
             } catch (const InputError& e) {
@@ -223,7 +225,8 @@ Recording open_bag_recording(std::shared_ptr<const BagReader> bag, const BagSour
         std::vector<PoseRecord> all = topic_poses(*bag, source.pose_topic);
         if (options.base_from_sensor) apply_extrinsics(all, *options.base_from_sensor);
         try {
-            const ScanPosePairing pairing = pair_scans_with_poses_by_time(scan_times(r.scans), all, options.time_tolerance);
+            const ScanPosePairing pairing =
+                pair_scans_with_poses_by_time(scan_times(r.scans), all, options.time_tolerance);
             for (const std::size_t i : pairing.pose_of_scan) r.poses.push_back(all[i]);
         } catch (const InputError& e) {
             throw InputError(quoted_path(bag->path()) + ", clouds on '" + source.cloud_topic + "' and poses on '" +

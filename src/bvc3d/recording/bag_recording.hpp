@@ -20,9 +20,9 @@ namespace bvc3d::recording {
 struct BagSource {
     std::filesystem::path bag;
     std::string cloud_topic;
-    std::string pose_topic;               // nav_msgs/Odometry or geometry_msgs/PoseStamped; or
-    std::string tf_fixed, tf_sensor;      // the tf chain fixed ← sensor (the clouds' frame)
-    double tf_tolerance = 0.2;            // s: the largest gap between a tf link's samples around a stamp
+    std::string pose_topic;           // nav_msgs/Odometry or geometry_msgs/PoseStamped; or
+    std::string tf_fixed, tf_sensor;  // the tf chain fixed ← sensor (the clouds' frame)
+    double tf_tolerance = 0.2;        // s: the largest gap between a tf link's samples around a stamp
     bool uses_tf() const { return !tf_fixed.empty(); }
 };
 

@@ -38,7 +38,8 @@ void Reader::align(std::size_t n) {
 
 const std::uint8_t* Reader::take(std::size_t n) {
     if (n > data_.size() - pos_)
-        throw InputError("CDR: the message ends" + at(pos_) + ", " + std::to_string(n) + " more bytes needed (truncated)");
+        throw InputError("CDR: the message ends" + at(pos_) + ", " + std::to_string(n) +
+                         " more bytes needed (truncated)");
     const std::uint8_t* p = data_.data() + pos_;
     pos_ += n;
     return p;
@@ -48,7 +49,8 @@ std::uint8_t Reader::u8() { return *take(1); }
 
 std::uint32_t Reader::u32() {
     align(4);
-    return detail::load<std::uint32_t>(reinterpret_cast<const char*>(take(4)), big_ ? ByteOrder::big : ByteOrder::little);
+    return detail::load<std::uint32_t>(reinterpret_cast<const char*>(take(4)),
+                                       big_ ? ByteOrder::big : ByteOrder::little);
 }
 
 double Reader::f64() {

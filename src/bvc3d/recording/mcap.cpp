@@ -138,7 +138,7 @@ struct Chunk {
 
 struct MessageRef {
     std::uint64_t log_time = 0;
-    std::int64_t chunk = -1;           // -1: in the file itself
+    std::int64_t chunk = -1;             // -1: in the file itself
     std::uint64_t offset = 0, size = 0;  // of the message's data, in the file or the uncompressed chunk
 };
 
@@ -214,9 +214,8 @@ private:
                 }
                 LZ4F_freeDecompressionContext(ctx);
                 if (hint != 0 || produced != c.uncompressed_size)
-                    throw InputError(what + ": decompresses to " + std::to_string(produced) +
-                                     (hint != 0 ? "+" : "") + " bytes where " + std::to_string(c.uncompressed_size) +
-                                     " are declared");
+                    throw InputError(what + ": decompresses to " + std::to_string(produced) + (hint != 0 ? "+" : "") +
+                                     " bytes where " + std::to_string(c.uncompressed_size) + " are declared");
                 break;
             }
         }
@@ -243,7 +242,8 @@ private:
             };
             if (end - pos < 9) throw InputError(where() + ": a record header is cut off (truncated)");
             const std::uint8_t op = base[pos];
-            const auto length = detail::load<std::uint64_t>(reinterpret_cast<const char*>(base + pos + 1), ByteOrder::little);
+            const auto length =
+                detail::load<std::uint64_t>(reinterpret_cast<const char*>(base + pos + 1), ByteOrder::little);
             if (length > end - pos - 9)
                 throw InputError(where() + ": a record (opcode " + std::to_string(op) + ") claims " +
                                  std::to_string(length) + " bytes; " + std::to_string(end - pos - 9) +
@@ -293,8 +293,8 @@ private:
                 c.encoding = f.string();
                 const auto found = schemas_.find(schema);
                 if (schema != 0 && found == schemas_.end())
-                    throw InputError(where() + ": channel " + std::to_string(id) + " (" + c.topic +
-                                     ") names schema " + std::to_string(schema) + ", which no record defined before it");
+                    throw InputError(where() + ": channel " + std::to_string(id) + " (" + c.topic + ") names schema " +
+                                     std::to_string(schema) + ", which no record defined before it");
                 c.type = found == schemas_.end() ? "" : found->second;
                 if (!channels_.count(id)) channels_[id] = std::move(c);
                 break;
@@ -352,7 +352,8 @@ private:
         records(file_.data(), 8, n, -1);
         const std::uint64_t footer_end =
             footer_at_ + 9 +
-            detail::load<std::uint64_t>(reinterpret_cast<const char*>(file_.data() + footer_at_ + 1), ByteOrder::little);
+            detail::load<std::uint64_t>(reinterpret_cast<const char*>(file_.data() + footer_at_ + 1),
+                                        ByteOrder::little);
         if (n - footer_end < 8 || std::memcmp(file_.data() + footer_end, magic, 8) != 0)
             throw InputError(quoted_path(path()) + ": no magic after the footer (truncated or corrupt)");
     }
@@ -437,7 +438,8 @@ void McapWriter::record(std::uint8_t op, const std::string& content) {
     file_.write(r);
 }
 
-std::uint16_t McapWriter::add_channel(const std::string& topic, const std::string& type, const std::string& definition) {
+std::uint16_t McapWriter::add_channel(const std::string& topic, const std::string& type,
+                                      const std::string& definition) {
     const std::uint16_t schema = next_schema_++;
     std::string s;
     put_u16(s, schema);

@@ -26,7 +26,8 @@ template <class M>
 M deserialize(const std::vector<std::uint8_t>& bytes) {
     M msg;
     try {
-        ros::serialization::IStream in(const_cast<std::uint8_t*>(bytes.data()), static_cast<std::uint32_t>(bytes.size()));
+        ros::serialization::IStream in(const_cast<std::uint8_t*>(bytes.data()),
+                                       static_cast<std::uint32_t>(bytes.size()));
         ros::serialization::deserialize(in, msg);
     } catch (const ros::Exception& e) {
         throw InputError(std::string("the message is truncated or corrupt (") + e.what() + ")");

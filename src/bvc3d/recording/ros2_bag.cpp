@@ -75,15 +75,14 @@ public:
 
 private:
     [[noreturn]] void fail(const std::string& what) const {
-        throw InputError(quoted_path(path()) + ": " + what + " (SQLite: " +
-                         (db_ ? sqlite3_errmsg(db_) : "out of memory") + ")");
+        throw InputError(quoted_path(path()) + ": " + what +
+                         " (SQLite: " + (db_ ? sqlite3_errmsg(db_) : "out of memory") + ")");
     }
 
     class Statement {
     public:
         Statement(const SqliteBag& bag, const char* sql) : bag_(bag) {
-            if (sqlite3_prepare_v2(bag.db_, sql, -1, &s_, nullptr) != SQLITE_OK)
-                bag.fail("not a ROS 2 bag's database");
+            if (sqlite3_prepare_v2(bag.db_, sql, -1, &s_, nullptr) != SQLITE_OK) bag.fail("not a ROS 2 bag's database");
         }
         ~Statement() { sqlite3_finalize(s_); }
         Statement(const Statement&) = delete;
@@ -191,8 +190,8 @@ std::unique_ptr<BagReader> open_ros2_bag(const fs::path& folder) {
         if (format != "cdr")
             for (const auto& t : bag->topics())
                 if (t.name == name && t.encoding != MessageEncoding::unknown)
-                    throw InputError(quoted_path(metadata) + ": topic '" + name +
-                                     "': unknown message encoding '" + format + "' (ROS 2 bags are read in cdr)");
+                    throw InputError(quoted_path(metadata) + ": topic '" + name + "': unknown message encoding '" +
+                                     format + "' (ROS 2 bags are read in cdr)");
     return bag;
 }
 

@@ -25,8 +25,8 @@ Column find_column(const CloudMessage& c, const char* name) {
     if (!found) {
         std::string names;
         for (const auto& f : c.fields) names += (names.empty() ? "" : ", ") + f.name;
-        throw InputError(std::string("the cloud has no field '") + name + "' (fields: " +
-                         (names.empty() ? "none" : names) + ")");
+        throw InputError(std::string("the cloud has no field '") + name +
+                         "' (fields: " + (names.empty() ? "none" : names) + ")");
     }
     const auto type = static_cast<PointFieldType>(found->datatype);
     if (type != PointFieldType::float32 && type != PointFieldType::float64)
@@ -101,8 +101,8 @@ PointCloud cloud_points(const CloudMessage& c) {
     const Column col[3] = {find_column(c, "x"), find_column(c, "y"), find_column(c, "z")};
     const std::uint64_t row_bytes = std::uint64_t{c.width} * c.point_step;
     if (c.height > 1 && c.row_step < row_bytes)
-        throw InputError("the cloud's row_step " + std::to_string(c.row_step) + " is less than width × point_step = " +
-                         std::to_string(row_bytes));
+        throw InputError("the cloud's row_step " + std::to_string(c.row_step) +
+                         " is less than width × point_step = " + std::to_string(row_bytes));
     // The last row needs only its points; the rows before it a row_step each.
     const std::uint64_t needed = c.height == 0 ? 0 : std::uint64_t{c.height - 1} * c.row_step + row_bytes;
     if (c.data.size() < needed)

@@ -62,7 +62,8 @@ Eigen::Isometry3d TfTree::at(const std::string& child, const Link& link, double 
     };
     if (link.is_static) return make(v.front().translation, v.front().rotation);
     const std::string name = "the tf link " + link.parent + " → " + child;
-    const auto after = std::lower_bound(v.begin(), v.end(), time, [](const Sample& x, double t) { return x.stamp < t; });
+    const auto after =
+        std::lower_bound(v.begin(), v.end(), time, [](const Sample& x, double t) { return x.stamp < t; });
     if (after != v.end() && after->stamp == time) return make(after->translation, after->rotation);
     if (after == v.begin()) {
         if (after->stamp - time > tolerance)
@@ -107,8 +108,8 @@ void TfTree::forget_before(double time) {
     for (auto& [child, link] : links_) {
         if (link.is_static) continue;
         auto& v = link.samples;
-        const auto first = std::lower_bound(v.begin(), v.end(), time,
-                                            [](const Sample& x, double t) { return x.stamp < t; });
+        const auto first =
+            std::lower_bound(v.begin(), v.end(), time, [](const Sample& x, double t) { return x.stamp < t; });
         if (first - v.begin() > 1) v.erase(v.begin(), first - 1);
     }
 }
