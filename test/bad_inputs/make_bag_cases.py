@@ -124,7 +124,12 @@ def ros1_bags():
             bag.write("/points", c, t)
     data = path.read_bytes()
     shutil.rmtree(path.parent)
+    # A cloud whose data array claims 2 GB (the message itself is whole): refused before any allocation.
+    first = struct.pack("<I", 480) + struct.pack("<fff", 3.0, 1.0, 0.0)
+    at = data.index(first)
+    lying = data[:at] + struct.pack("<I", 0x7FFFFFFF) + data[at + 4:]
     return {
+        "ros1-cloud-length-lies.bag": (lying, REPLAY, "/points; message 0; truncated or corrupt"),
         "ros1-truncated.bag": (data[: len(data) * 2 // 3], REPLAY, "ros1-truncated.bag"),
         "ros1-not-a-bag.bag": (b"#ROSBAG V2.0\n" + bytes(range(256)) * 4, REPLAY, "not a readable ROS 1 bag"),
         "ros1-wrong-pose-type.bag": (data, REPLAY.replace("/odom", "/points"), "/points; PointCloud2; not nav_msgs"),

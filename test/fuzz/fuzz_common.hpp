@@ -11,6 +11,7 @@
 #include <string>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/recording/bag.hpp"
 
 namespace bvc3d::fuzz {
 
@@ -36,8 +37,7 @@ inline std::string as_file(const std::uint8_t* data, std::size_t size, const std
 }
 
 // Decodes every message of a bag as its topic's type says (clouds down to their points).
-template <class Bag>
-void read_every_message(const Bag& bag) {
+inline void read_every_message(const recording::BagReader& bag) {
     using namespace bvc3d::recording;
     for (std::size_t t = 0; t < bag.topics().size(); ++t)
         for (std::size_t k = 0; k < bag.topics()[t].count && k < 64; ++k) {
