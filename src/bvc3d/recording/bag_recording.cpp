@@ -1,5 +1,7 @@
 #include "bvc3d/recording/bag_recording.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "bvc3d/core/error.hpp"

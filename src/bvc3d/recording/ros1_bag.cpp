@@ -305,7 +305,8 @@ void check_framing(const std::filesystem::path& file) {
         pos += 4 + header_length;
         const std::uint32_t data_length = u32(pos);
         if (data_length > size - pos - 4) fail(pos, "a record's data claims " + std::to_string(data_length) + " bytes");
-        if (op == std::string(1, '\x05') && compression != "none" && chunk_size > (std::uint64_t{1} << 30))
+        if (op == std::string(1, '\x05') && compression != "none" &&
+            (chunk_size > (std::uint64_t{1} << 30) || chunk_size > 1024 * std::uint64_t{data_length} + (1u << 20)))
             fail(pos, "a chunk claims " + std::to_string(chunk_size) + " bytes uncompressed");
         pos += 4 + data_length;
     }
