@@ -62,6 +62,10 @@ def good():
     return mcap_bytes()
 
 
+def empty_rows(t):
+    return bw.cdr_cloud(t, "lidar", 3_000_000_000, 0, XYZ, 12, b"")
+
+
 def truncated_cloud(t):
     return cloud(t)[:60]
 
@@ -83,6 +87,9 @@ MCAP_CASES = {
                                       "/points; message 2; out of order"),
     "mcap-truncated-message.mcap": (mcap_bytes(msgs=messages(cloud_of=truncated_cloud)), REPLAY,
                                     "/points; message 0; truncated"),
+    # Billions of rows without points (fuzz_cdr's finding: once walked row by row).
+    "mcap-empty-rows.mcap": (mcap_bytes(msgs=messages(cloud_of=empty_rows)), REPLAY,
+                             "/points; message 0; empty cloud"),
     "mcap-bad-quaternion.mcap": (mcap_bytes(msgs=messages(odom_of=lambda t: odom(t, (0, 0, 0, 0.5)))), REPLAY,
                                  "/odom; message 0; quaternion"),
     "mcap-tf-gap.mcap": (tf_gap(), TF_REPLAY, "/points; message 1; gap"),

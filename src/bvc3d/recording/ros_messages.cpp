@@ -98,6 +98,9 @@ void gather_any(const CloudMessage& c, std::uint64_t row_stride, const Column (&
 
 PointCloud cloud_points(const CloudMessage& c) {
     if (c.point_step == 0) throw InputError("the cloud's point_step is 0");
+    // (Rows without points would still be walked one by one: billions of them, for a corrupt height.)
+    if (c.width == 0 || c.height == 0)
+        throw InputError("empty cloud: " + std::to_string(c.height) + " × " + std::to_string(c.width) + " points");
     const Column col[3] = {find_column(c, "x"), find_column(c, "y"), find_column(c, "z")};
     const std::uint64_t row_bytes = std::uint64_t{c.width} * c.point_step;
     if (c.height > 1 && c.row_step < row_bytes)
