@@ -108,11 +108,17 @@ def cosine_revisits(bvc, t, window_scans, window_s, threshold):
     return out
 
 
-def test_node_publishes_what_replay_computes(ros_env, tmp_path, cli):
+POSE_SOURCES = {"odometry": (["--pose-topic", "/odom"], ["pose_topic:=/odom"], "/odom"),
+                "tf": (["--tf-frames", "map,sensor"], ["tf_frames:=map,sensor"], "/tf")}
+
+
+@pytest.mark.parametrize("source", POSE_SOURCES)
+def test_node_publishes_what_replay_computes(ros_env, tmp_path, cli, source):
+    replay_poses, launch_poses, pose_topic = POSE_SOURCES[source]
     bag = tmp_path / "walk.bag"
     cli("export-scans", "--world", "cross", "--hours", "0.006", "--seed", "5", "--format", "ros1", "--out", bag,
         check=True)
-    cli("replay", "--bag", bag, "--cloud-topic", "/points", "--pose-topic", "/odom", "--model", "3d-3l", "--out",
+    cli("replay", "--bag", bag, "--cloud-topic", "/points", *replay_poses, "--model", "3d-3l", "--out",
         tmp_path / "replay.h5", check=True)
     with h5py.File(tmp_path / "replay.h5") as f:
         want_bvc = np.asarray(f["samples/bvc_rates"])
@@ -124,14 +130,14 @@ def test_node_publishes_what_replay_computes(ros_env, tmp_path, cli):
     node_log = open(tmp_path / "node.log", "w")
     # The launch file, as a user starts the node; a short revisit window so that the walk has revisits.
     node = subprocess.Popen(["roslaunch", "--wait", "bvc3d", "bvc3d.launch", "cloud_topic:=/points",
-                             "pose_topic:=/odom", "model:=3d-3l", "revisit_window_scans:=10",
+                             *launch_poses, "model:=3d-3l", "revisit_window_scans:=10",
                              "revisit_window_s:=2.0", "revisit_threshold:=0.05"],
                             env=ros_env, stdout=node_log, stderr=subprocess.STDOUT, start_new_session=True)
     try:
         wait_for(lambda: recorded.exists() and "ready" in recorded.read_text(), 60, "the recorder")
         wait_for(lambda: "bvc3d_ros: model" in (tmp_path / "node.log").read_text(), 60, "the node")
-        play = subprocess.run(["rosbag", "play", "--wait-for-subscribers", "-r", "2", "--topics", "/points", "/odom",
-                               "--", str(bag)], env=ros_env, capture_output=True, text=True, timeout=300)
+        play = subprocess.run(["rosbag", "play", "--wait-for-subscribers", "-r", "2", "--topics", "/points",
+                               pose_topic, "--", str(bag)], env=ros_env, capture_output=True, text=True, timeout=300)
         assert play.returncode == 0, play.stderr
         wait_for(lambda: len(read_recorded(recorded)["place"]) >= len(want_bvc), 30, "every scan's rates")
         time.sleep(0.5)
