@@ -32,6 +32,7 @@
 #include <cstring>
 #include <deque>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "bvc3d/core/error.hpp"
@@ -120,33 +121,40 @@ public:
         }
         changed_.notify_all();
     }
-    // The pose at `stamp`, waiting up to `wait` for data that has not arrived yet; nullopt (and why)
+    // The pose at `stamp`, waiting up to `wait` for data that has not arrived yet: until then only a
+    // pose that later data cannot change is taken (a tf sample at or after the stamp on every link; a
+    // pose stamped at or after it), then the best there is within the tolerances. nullopt (and why)
     // if there is none.
     std::optional<Eigen::Isometry3d> at(double stamp, const std::string& frame, std::chrono::duration<double> wait,
                                         std::string& why) {
         std::unique_lock lock(mutex_);
         const auto until = std::chrono::steady_clock::now() + wait;
         for (;;) {
-            if (auto p = lookup(stamp, frame, why)) return p;
-            if (changed_.wait_until(lock, until) == std::cv_status::timeout) return lookup(stamp, frame, why);
+            if (auto p = lookup(stamp, frame, false, why)) return p;
+            if (changed_.wait_until(lock, until) == std::cv_status::timeout) return lookup(stamp, frame, true, why);
         }
     }
     void wake() { changed_.notify_all(); }
 
 private:
     static constexpr double keep_s = 30;
-    std::optional<Eigen::Isometry3d> lookup(double stamp, const std::string& frame, std::string& why) const {
+    std::optional<Eigen::Isometry3d> lookup(double stamp, const std::string& frame, bool final,
+                                            std::string& why) const {
         if (uses_tf()) {
             if (!frame.empty() && bvc3d::recording::bare_frame(frame) != bvc3d::recording::bare_frame(sensor_)) {
                 why = "the cloud is in frame '" + frame + "', not the sensor frame '" + sensor_ + "'";
                 return std::nullopt;
             }
             try {
-                return tree_.lookup(fixed_, sensor_, stamp, tf_tol_);
+                return tree_.lookup(fixed_, sensor_, stamp, tf_tol_, final);
             } catch (const bvc3d::InputError& e) {
                 why = e.what();
                 return std::nullopt;
             }
+        }
+        if (!final && (poses_.empty() || poses_.back().first < stamp)) {
+            why = "no pose at or after the cloud's stamp yet";
+            return std::nullopt;
         }
         const std::pair<double, Eigen::Isometry3d>* best = nullptr;
         for (const auto& p : poses_)

@@ -76,7 +76,14 @@ struct NodeModel::State {
         }
         if (p.revisit_window_scans < 0 || !(p.revisit_window_s >= 0) || !(p.revisit_threshold >= 0))
             throw InputError("~revisit_window_scans, ~revisit_window_s and ~revisit_threshold must be >= 0");
-        load_templates();
+        try {
+            load_templates();
+        } catch (const InputError& e) {
+            throw InputError(std::string("the templates (~templates_bag with ~templates_cloud_topic and "
+                                         "~templates_pose_topic or ~templates_tf_frames, or ~templates_scans with "
+                                         "~templates_poses): ") +
+                             e.what());
+        }
     }
 
     void load_templates() {

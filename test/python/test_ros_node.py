@@ -66,6 +66,7 @@ def wait_for(predicate, seconds, what):
 RECORDER = r"""
 import sys, rospy
 from std_msgs.msg import Float32MultiArray, Int64, Float32
+from geometry_msgs.msg import PoseStamped
 rospy.init_node("bvc3d_test_recorder", anonymous=True, disable_signals=True)
 out = open(sys.argv[1], "w", buffering=1)
 def writer(tag):
@@ -76,14 +77,16 @@ def writer(tag):
 subs = [rospy.Subscriber("/bvc3d_ros/bvc_rates", Float32MultiArray, writer("bvc"), queue_size=1000),
         rospy.Subscriber("/bvc3d_ros/place_rates", Float32MultiArray, writer("place"), queue_size=1000),
         rospy.Subscriber("/bvc3d_ros/revisit", Int64, writer("revisit"), queue_size=1000),
-        rospy.Subscriber("/bvc3d_ros/revisit_distance", Float32, writer("distance"), queue_size=1000)]
+        rospy.Subscriber("/bvc3d_ros/revisit_distance", Float32, writer("distance"), queue_size=1000),
+        rospy.Subscriber("/bvc3d_ros/decoded_pose", PoseStamped, lambda m: out.write(
+            "decoded %r %r %r\n" % (m.pose.position.x, m.pose.position.y, m.pose.position.z)), queue_size=1000)]
 out.write("ready\n")
 rospy.spin()
 """
 
 
 def read_recorded(path):
-    rows = {"bvc": [], "place": [], "revisit": [], "distance": []}
+    rows = {"bvc": [], "place": [], "revisit": [], "distance": [], "decoded": []}
     for line in pathlib.Path(path).read_text().splitlines():
         tag, *values = line.split()
         if tag in rows:
@@ -108,8 +111,9 @@ def cosine_revisits(bvc, t, window_scans, window_s, threshold):
     return out
 
 
-POSE_SOURCES = {"odometry": (["--pose-topic", "/odom"], ["pose_topic:=/odom"], "/odom"),
-                "tf": (["--tf-frames", "map,sensor"], ["tf_frames:=map,sensor"], "/tf")}
+POSE_SOURCES = {"odometry": (["--pose-topic", "/odom"], ["pose_topic:=/odom", "templates_pose_topic:=/odom"], "/odom"),
+                "tf": (["--tf-frames", "map,sensor"], ["tf_frames:=map,sensor", "templates_tf_frames:=map,sensor"],
+                       "/tf")}
 
 
 @pytest.mark.parametrize("source", POSE_SOURCES)
@@ -124,13 +128,14 @@ def test_node_publishes_what_replay_computes(ros_env, tmp_path, cli, source):
         want_bvc = np.asarray(f["samples/bvc_rates"])
         want_place = np.asarray(f["samples/rates"])
         t = np.asarray(f["samples/t"])
+        xyz = np.c_[f["samples/x"], f["samples/y"], f["samples/z"]]
     recorded = tmp_path / "recorded.txt"
     recorder = subprocess.Popen(["/usr/bin/python3", "-c", RECORDER, str(recorded)], env=ros_env,
                                 start_new_session=True)
     node_log = open(tmp_path / "node.log", "w")
     # The launch file, as a user starts the node; a short revisit window so that the walk has revisits.
     node = subprocess.Popen(["roslaunch", "--wait", "bvc3d", "bvc3d.launch", "cloud_topic:=/points",
-                             *launch_poses, "model:=3d-3l", "revisit_window_scans:=10",
+                             *launch_poses, f"templates_bag:={bag}", "model:=3d-3l", "revisit_window_scans:=10",
                              "revisit_window_s:=2.0", "revisit_threshold:=0.05"],
                             env=ros_env, stdout=node_log, stderr=subprocess.STDOUT, start_new_session=True)
     try:
@@ -160,6 +165,8 @@ def test_node_publishes_what_replay_computes(ros_env, tmp_path, cli, source):
     got = read_recorded(recorded)
     np.testing.assert_array_equal(np.array(got["bvc"], dtype=np.float32), want_bvc)
     np.testing.assert_array_equal(np.array(got["place"], dtype=np.float32), want_place)
+    # The bag's own scans are the templates: each scan decodes to itself, at its own position.
+    np.testing.assert_allclose(np.array(got["decoded"]), xyz, atol=1e-9)
     revisits = cosine_revisits(want_bvc.astype(float), t, 10, 2.0, 0.05)
     assert revisits, "the walk should revisit places"
     assert [int(r[0]) for r in got["revisit"]] == [best for _, best, _ in revisits]

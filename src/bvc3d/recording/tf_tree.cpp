@@ -52,7 +52,8 @@ void TfTree::add(const StampedTransform& t, bool is_static) {
     else link.samples.insert(at, s);
 }
 
-Eigen::Isometry3d TfTree::at(const std::string& child, const Link& link, double time, double tolerance) const {
+Eigen::Isometry3d TfTree::at(const std::string& child, const Link& link, double time, double tolerance,
+                             bool hold_ends) const {
     const auto& v = link.samples;
     const auto make = [](const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
         Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
@@ -73,7 +74,7 @@ Eigen::Isometry3d TfTree::at(const std::string& child, const Link& link, double 
     }
     const Sample& a = *(after - 1);
     if (after == v.end()) {
-        if (time - a.stamp > tolerance)
+        if (time - a.stamp > tolerance || !hold_ends)
             throw InputError(name + " ends at " + secs(a.stamp) + ", " + secs(time - a.stamp) + " before the time " +
                              secs(time) + " (tf tolerance " + secs(tolerance) + ")");
         return make(a.translation, a.rotation);
@@ -88,7 +89,7 @@ Eigen::Isometry3d TfTree::at(const std::string& child, const Link& link, double 
 }
 
 Eigen::Isometry3d TfTree::lookup(const std::string& fixed_frame, const std::string& frame_name, double time,
-                                 double tolerance) const {
+                                 double tolerance, bool hold_ends) const {
     const std::string fixed(bare_frame(fixed_frame)), frame(bare_frame(frame_name));
     Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
     std::string current = frame, chain = frame;
@@ -97,7 +98,7 @@ Eigen::Isometry3d TfTree::lookup(const std::string& fixed_frame, const std::stri
         if (link == links_.end() || hops > links_.size())
             throw InputError("tf has no chain from frame '" + fixed + "' to frame '" + frame + "' (" + chain +
                              (link == links_.end() ? " has no parent)" : " loops)"));
-        m = at(current, link->second, time, tolerance) * m;
+        m = at(current, link->second, time, tolerance, hold_ends) * m;
         current = link->second.parent;
         chain += " → " + current;
     }

@@ -20,8 +20,11 @@ class TfTree {
 public:
     // Frames are compared without leading slashes. A static transform is valid at every time.
     void add(const StampedTransform& transform, bool is_static);
-    // fixed_from_frame at `time` (s); `tolerance` (s) bounds the gap between a link's samples.
-    Eigen::Isometry3d lookup(const std::string& fixed, const std::string& frame, double time, double tolerance) const;
+    // fixed_from_frame at `time` (s); `tolerance` (s) bounds the gap between a link's samples. With
+    // `hold_ends` false, a time after a link's last sample is an error whatever the tolerance (a live
+    // node: the sample that brackets it may still be on its way).
+    Eigen::Isometry3d lookup(const std::string& fixed, const std::string& frame, double time, double tolerance,
+                             bool hold_ends = true) const;
     // Samples older than `time` (s) are forgotten, but for each link's last one before it (a live
     // node's buffer).
     void forget_before(double time);
@@ -38,7 +41,8 @@ private:
         bool is_static = false;
         std::vector<Sample> samples;  // by stamp
     };
-    Eigen::Isometry3d at(const std::string& child, const Link& link, double time, double tolerance) const;
+    Eigen::Isometry3d at(const std::string& child, const Link& link, double time, double tolerance,
+                         bool hold_ends) const;
     std::map<std::string, Link> links_;  // by child frame
 };
 
