@@ -128,7 +128,8 @@ public:
     std::optional<Eigen::Isometry3d> at(double stamp, const std::string& frame, std::chrono::duration<double> wait,
                                         std::string& why) {
         std::unique_lock lock(mutex_);
-        const auto until = std::chrono::steady_clock::now() + wait;
+        const auto until =
+            std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(wait);
         for (;;) {
             if (auto p = lookup(stamp, frame, false, why)) return p;
             if (changed_.wait_until(lock, until) == std::cv_status::timeout) return lookup(stamp, frame, true, why);
