@@ -21,8 +21,10 @@ public:
     explicit SqliteBag(const fs::path& file) : BagReader(file) {
         std::error_code ec;
         if (!fs::is_regular_file(file, ec)) throw InputError(quoted_path(file) + " does not exist or is not a file");
-        if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
-            fail("cannot open it");
+        sqlite3* db = nullptr;
+        const int opened = sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr);
+        db_.reset(db);  // closed whatever happens next (even when opening failed: SQLite gives a handle then too)
+        if (opened != SQLITE_OK) fail("cannot open it");
         std::map<std::int64_t, std::size_t> by_id;
         {
             Statement s(*this, "SELECT id, name, type, serialization_format FROM topics ORDER BY id");
@@ -54,10 +56,6 @@ public:
         }
         select_ = std::make_unique<Statement>(*this, "SELECT data FROM messages WHERE id = ?");
     }
-    ~SqliteBag() override {
-        select_.reset();
-        if (db_) sqlite3_close(db_);
-    }
     std::string format() const override { return "ROS 2 bag (sqlite3)"; }
 
     std::vector<std::uint8_t> serialized(std::size_t t, std::size_t k) const override {
@@ -76,13 +74,14 @@ public:
 private:
     [[noreturn]] void fail(const std::string& what) const {
         throw InputError(quoted_path(path()) + ": " + what +
-                         " (SQLite: " + (db_ ? sqlite3_errmsg(db_) : "out of memory") + ")");
+                         " (SQLite: " + (db_ ? sqlite3_errmsg(db_.get()) : "out of memory") + ")");
     }
 
     class Statement {
     public:
         Statement(const SqliteBag& bag, const char* sql) : bag_(bag) {
-            if (sqlite3_prepare_v2(bag.db_, sql, -1, &s_, nullptr) != SQLITE_OK) bag.fail("not a ROS 2 bag's database");
+            if (sqlite3_prepare_v2(bag.db_.get(), sql, -1, &s_, nullptr) != SQLITE_OK)
+                bag.fail("not a ROS 2 bag's database");
         }
         ~Statement() { sqlite3_finalize(s_); }
         Statement(const Statement&) = delete;
@@ -104,7 +103,8 @@ private:
         sqlite3_stmt* s_ = nullptr;
     };
 
-    sqlite3* db_ = nullptr;
+    // Declared first: closed last, after the statements (a constructor that throws closes it too).
+    std::unique_ptr<sqlite3, int (*)(sqlite3*)> db_{nullptr, sqlite3_close};
     std::vector<std::vector<std::int64_t>> rows_;  // per topic, the message rows in time order
     std::unique_ptr<Statement> select_;
     mutable std::mutex mutex_;
