@@ -83,19 +83,21 @@ struct Exploration {
 };
 
 Exploration exploration_of(const ChooseOptions& o) {
-    if (o.scans.empty() && o.poses.empty()) {
+    if (o.scans.empty() && o.poses.empty() && !o.recording.has_bag()) {
         const auto agent = named_agent(o.agent.empty() ? "ground" : o.agent);
         const std::string world = o.world.empty() ? "cross" : o.world;
         return {agent, std::nullopt,
                 "world " + world + (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "") + ", agent " +
                     (o.agent.empty() ? "ground" : o.agent)};
     }
-    if (o.scans.empty()) throw InputError("--poses needs --scans");
+    if (o.scans.empty() && !o.recording.has_bag()) throw InputError("--poses needs --scans");
     if (!o.world.empty() || o.tilt || !o.agent.empty())
-        throw InputError("a recording is its own walk: give --scans and --poses, or --world (and --agent), not both");
-    const ReplaySource source = recorded_source(o.recording.open(o.scans, o.poses), o.preprocess.get());
+        throw InputError(
+            "a recording is its own walk: give --scans and --poses (or --bag), or --world (and --agent), not both");
+    const ReplaySource source = recorded_source(o.recording.open_any(o.scans, o.poses), o.preprocess.get());
     return {std::make_shared<RandomWalkSpec>(), source,
-            "recording " + o.scans + " (" + std::to_string(source.path->steps().size()) + " scans)"};
+            "recording " + (o.scans.empty() ? o.recording.bag : o.scans) + " (" +
+                std::to_string(source.path->steps().size()) + " scans)"};
 }
 
 void choose(const ChooseOptions& o) {

@@ -18,6 +18,8 @@
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 #include "bvc3d/experiment/replay.hpp"
+#include "bvc3d/recording/bag.hpp"
+#include "bvc3d/recording/bag_writer.hpp"
 #include "bvc3d/recording/extrinsics.hpp"
 #include "bvc3d/recording/pcd.hpp"
 #include "bvc3d/recording/ply.hpp"
@@ -78,14 +80,15 @@ struct SourceOptions {
         preprocess.add_to(cmd);
     }
     ReplaySource get() const {
-        const bool recorded = !scans.empty() || !poses.empty();
+        const bool recorded = !scans.empty() || !poses.empty() || recording.has_bag();
         const bool simulated = !world.empty() || !trajectory.empty() || !sensor.empty();
         if (recorded == simulated)
             throw InputError(
-                "give either a recording (--scans and --poses) or a simulation (--world, --trajectory, --sensor)");
+                "give either a recording (--scans and --poses, or --bag) or a simulation (--world, --trajectory, "
+                "--sensor)");
         if (recorded) {
-            if (scans.empty()) throw InputError("--poses needs --scans");
-            return recorded_source(recording.open(scans, poses), preprocess.get());
+            if (scans.empty() && !recording.has_bag()) throw InputError("--poses needs --scans");
+            return recorded_source(recording.open_any(scans, poses), preprocess.get());
         }
         if (world.empty() || trajectory.empty() || sensor.empty())
             throw InputError("a simulated replay needs --world, --trajectory and --sensor");
@@ -288,9 +291,10 @@ void add_localize(CLI::App& app) {
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--templates", o->templates,
-                    "Templates: a trial file ({model} stands for each model's name) or a scan folder/list");
+                    "Templates: a trial file ({model} stands for each model's name), a scan folder/list or a bag");
     cmd->add_option("--template-poses", o->template_poses, "Pose file of the template scans");
-    cmd->add_option("--queries", o->queries, "Queries: a trial file (may contain {model}) or a scan folder/list");
+    cmd->add_option("--queries", o->queries,
+                    "Queries: a trial file (may contain {model}), a scan folder/list or a bag (same topics)");
     cmd->add_option("--query-poses", o->query_poses, "Pose file of the query scans");
     cmd->add_option("--scans", o->scans, "One recording for both, split by --split (instead of --templates/--queries)");
     cmd->add_option("--poses", o->poses, "Pose file of --scans");
@@ -319,11 +323,11 @@ void add_localize(CLI::App& app) {
         const RecordedReturnParams pre = o->preprocess.get();
 
         Side templates, queries;
-        if (!o->scans.empty()) {
+        if (!o->scans.empty() || o->recording.has_bag()) {
             if (!o->templates.empty() || !o->queries.empty())
-                throw InputError("give either --scans with --split, or --templates and --queries");
+                throw InputError("give either --scans (or --bag) with --split, or --templates and --queries");
             if (o->split < 2) throw InputError("--scans needs --split N (N >= 2): scan i is a query when i mod N = 1");
-            const auto rec = o->recording.open(o->scans, o->poses);
+            const auto rec = o->recording.open_any(o->scans, o->poses);
             templates.recording = queries.recording = rec;
             for (std::size_t i = 0; i < rec->size(); ++i)
                 (i % static_cast<std::size_t>(o->split) == 1 ? queries : templates).keep.push_back(i);
@@ -335,6 +339,10 @@ void add_localize(CLI::App& app) {
                 if (fs::path(what).extension() == ".h5") {
                     if (!poses.empty()) throw InputError("'" + what + "' is a trial file: it needs no pose file");
                     s.file = what;
+                } else if (RecordingOptions::is_bag(what)) {
+                    if (!poses.empty())
+                        throw InputError("'" + what + "' is a bag: its poses come from --pose-topic or --tf-frames");
+                    s.recording = o->recording.open_bag(what);
                 } else {
                     s.recording = o->recording.open(what, poses);
                 }
@@ -418,8 +426,8 @@ void add_map(CLI::App& app) {
     };
     auto o = std::make_shared<Options>();
     o->params.min_range = 0.3;
-    cmd->add_option("--scans", o->scans, "Scan folder, scan list file or one scan")->required();
-    cmd->add_option("--poses", o->poses, "Pose file of the scans")->required();
+    cmd->add_option("--scans", o->scans, "Scan folder, scan list file or one scan");
+    cmd->add_option("--poses", o->poses, "Pose file of the scans");
     o->recording.add_to(*cmd);
     cmd->add_option("--voxel", o->params.voxel, "m, voxel edge: one point (the mean) per occupied voxel")
         ->capture_default_str();
@@ -436,7 +444,8 @@ void add_map(CLI::App& app) {
     cmd->callback([o] {
         const auto ext = fs::path(o->out).extension().string();
         if (ext != ".ply" && ext != ".pcd") throw InputError("--out must end in .ply or .pcd");
-        const auto rec = o->recording.open(o->scans, o->poses);
+        if (o->scans.empty() && !o->recording.has_bag()) throw InputError("give --scans and --poses, or --bag");
+        const auto rec = o->recording.open_any(o->scans, o->poses);
         recording::VoxelMap map(o->params);
         ProgressLine line;
         const auto start = std::chrono::steady_clock::now();
@@ -463,6 +472,7 @@ void add_export_scans(CLI::App& app) {
         std::string world = "cross", trajectory, sensor = "spherical", format = "pcd-f8", out;
         std::optional<double> tilt, hours;
         std::uint64_t seed = 0;
+        double start_time = recording::BagWriteOptions{}.start;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--world", o->world, "Preset or world YAML")->capture_default_str();
@@ -475,15 +485,26 @@ void add_export_scans(CLI::App& app) {
         ->check(seed_check);
     cmd->add_option("--sensor", o->sensor, "horizontal, spherical (upper half) or a sensor YAML")
         ->capture_default_str();
-    cmd->add_option("--format", o->format, "pcd (float32), pcd-f8 (float64), ply or kitti (.bin)")
+    cmd->add_option("--format", o->format,
+                    "pcd (float32), pcd-f8 (float64), ply, kitti (.bin); or a bag: ros1 (.bag) or mcap (ROS 2, .mcap)")
         ->capture_default_str();
-    cmd->add_option("--out", o->out, "Folder to write: 000000.<ext> ..., poses.txt, scans.txt")->required();
+    cmd->add_option("--out", o->out,
+                    "Folder to write: 000000.<ext> ..., poses.txt, scans.txt; with ros1 or mcap, the bag file")
+        ->required();
+    cmd->add_option("--start-time", o->start_time,
+                    "ros1, mcap: seconds added to every stamp (ROS takes a zero stamp for 'no time')")
+        ->capture_default_str();
     cmd->footer(
         "Each scan holds the hits in the sensor's own frame (x forward, z up; tilted with the pose's pitch and\n"
         "roll); poses.txt holds each sensor's world-from-sensor pose (4x4 rows with the time). Replaying the\n"
-        "folder gives the simulation's returns back (docs/recordings.md#export-scans).");
+        "folder gives the simulation's returns back (docs/recordings.md#export-scans). A bag holds /points\n"
+        "(sensor_msgs/PointCloud2, float64 x y z in frame 'sensor'), /odom (nav_msgs/Odometry, map <- sensor)\n"
+        "and /tf (the same transform): replay it with --bag OUT --cloud-topic /points --pose-topic /odom\n"
+        "(docs/ros.md#export).");
     cmd->callback([o] {
-        const auto format = recording::parse_scan_write_format(o->format);
+        const bool bag = o->format == "ros1" || o->format == "mcap";
+        const auto format = bag ? recording::ScanWriteFormat::pcd_f8 : recording::parse_scan_write_format(o->format);
+        if (bag && !(o->start_time >= 0)) throw InputError("--start-time must be >= 0");
         if (o->trajectory.empty() == !o->hours.has_value()) throw InputError("give --trajectory or --hours, not both");
         if (o->hours && !(*o->hours > 0)) throw InputError("--hours must be positive");
         const World world(config::resolve_world(o->world, o->tilt, "+x+y"));
@@ -510,8 +531,65 @@ void add_export_scans(CLI::App& app) {
             poses.push_back(pose);
         }
         line.done();
-        recording::write_recording(o->out, clouds, poses, format);
+        if (bag) {
+            recording::BagWriteOptions b;
+            b.format = o->format == "ros1" ? recording::BagFormat::ros1 : recording::BagFormat::mcap;
+            b.start = o->start_time;
+            recording::write_bag(o->out, clouds, poses, b);
+        } else {
+            recording::write_recording(o->out, clouds, poses, format);
+        }
         std::printf("wrote %zu scans and their poses to %s\n", clouds.size(), o->out.c_str());
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// bag-info
+
+void add_bag_info(CLI::App& app) {
+    auto* cmd = app.add_subcommand("bag-info", "List a ROS bag's topics: types, encodings, counts and time spans");
+    auto path = std::make_shared<std::string>();
+    cmd->add_option("bag", *path, "A ROS 1 .bag, an .mcap file or a ROS 2 bag folder (metadata.yaml)")->required();
+    cmd->footer(
+        "Times are the messages' log (receive) times in seconds. For a PointCloud2 topic, the frame and size of\n"
+        "its first cloud; for /tf and /tf_static, the links parent -> child. Then read the bag as a recording\n"
+        "with --bag, --cloud-topic and --pose-topic (or --tf-frames FIXED,SENSOR) (docs/ros.md).");
+    cmd->callback([path] {
+        const auto bag = recording::open_bag(*path);
+        std::size_t total = 0;
+        double first = 0, last = 0;
+        for (const auto& t : bag->topics()) {
+            if (t.count == 0) continue;
+            first = total == 0 ? t.first : std::min(first, t.first);
+            last = total == 0 ? t.last : std::max(last, t.last);
+            total += t.count;
+        }
+        std::printf("%s: %s, %zu topics, %zu messages, %.3f to %.3f s (%.3f s)\n", path->c_str(), bag->format().c_str(),
+                    bag->topics().size(), total, first, last, last - first);
+        std::printf("%-28s %-32s %-8s %9s %18s %18s %10s\n", "topic", "type", "encoding", "messages", "first_s",
+                    "last_s", "span_s");
+        for (std::size_t i = 0; i < bag->topics().size(); ++i) {
+            const auto& t = bag->topics()[i];
+            std::printf("%-28s %-32s %-8s %9zu %18.6f %18.6f %10.3f\n", t.name.c_str(), t.type.c_str(),
+                        t.encoding_name.c_str(), t.count, t.first, t.last, t.last - t.first);
+            if (t.count == 0) continue;
+            const auto kind = recording::message_kind(t.type);
+            if (kind == recording::MessageKind::point_cloud2) {
+                const auto c = bag->cloud(i, 0);
+                std::string fields;
+                for (const auto& f : c.fields) fields += (fields.empty() ? "" : ",") + f.name;
+                std::printf("    frame '%s', %u x %u points, fields %s%s\n", c.frame_id.c_str(), c.height, c.width,
+                            fields.c_str(), c.is_bigendian ? ", big-endian" : "");
+            } else if (kind == recording::MessageKind::tf) {
+                std::map<std::string, std::string> links;
+                for (std::size_t k = 0; k < t.count; ++k)
+                    for (const auto& x : bag->transforms(i, k)) links[x.child] = x.parent;
+                for (const auto& [child, parent] : links) std::printf("    %s -> %s\n", parent.c_str(), child.c_str());
+            } else if (kind == recording::MessageKind::odometry || kind == recording::MessageKind::pose_stamped) {
+                const auto p = bag->pose(i, 0);
+                std::printf("    frame '%s'%s%s\n", p.parent.c_str(), p.child.empty() ? "" : " <- ", p.child.c_str());
+            }
+        }
     });
 }
 
@@ -522,6 +600,7 @@ void add_recording_commands(CLI::App& app) {
     add_localize(app);
     add_map(app);
     add_export_scans(app);
+    add_bag_info(app);
 }
 
 }  // namespace bvc3d::cli

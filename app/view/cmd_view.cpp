@@ -10,6 +10,7 @@
 #include "bvc3d/world/gazebo_world.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "recording_options.hpp"
 #include "view/export.hpp"
 #include "view/safe_path.hpp"
 #include "view/server.hpp"
@@ -60,15 +61,14 @@ fs::path common_folder(const fs::path& a, const fs::path& b) {
 
 // What the arguments ask to show (see the command's help).
 view::ViewTarget make_target(const std::vector<std::string>& args, const std::string& scans, const std::string& poses,
-                             const std::string& model) {
+                             const RecordingOptions& recording, const std::string& model) {
     view::ViewTarget t;
     t.model = model;
     if (scans.empty() != poses.empty()) throw InputError("--scans and --poses go together");
-    if (!scans.empty()) {
+    if (!scans.empty() || recording.has_bag()) {
         for (const auto& p : {scans, poses})
-            if (!fs::exists(p)) throw InputError("'" + p + "' does not exist");
-        t.scans = fs::absolute(scans);
-        t.poses = fs::absolute(poses);
+            if (!p.empty() && !fs::exists(p)) throw InputError("'" + p + "' does not exist");
+        t.recording = recording.open_any(scans, poses);
     }
     if (args.size() > 2) throw InputError("bvc3d view takes at most two trial files (to compare them)");
     std::vector<fs::path> files;
@@ -117,7 +117,7 @@ view::ViewTarget make_target(const std::vector<std::string>& args, const std::st
             t.open.push_back(view::relative_name(t.root, f));
         }
     }
-    if (args.empty() && !t.scans) t.world = "cross";
+    if (args.empty() && !t.recording) t.world = "cross";
     t.worlds = list_worlds(t.root);
     return t;
 }
@@ -140,6 +140,7 @@ void add_view_command(CLI::App& app) {
         int port = 0;
         std::string export_dir, scans, poses, model = "3d-0.2";
         std::size_t export_steps = 40;
+        RecordingOptions recording;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("paths", o->paths,
@@ -148,6 +149,7 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--port", o->port, "Port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
     cmd->add_option("--scans", o->scans, "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");
+    o->recording.add_to(*cmd);
     cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")
         ->capture_default_str();
     cmd->add_option("--export", o->export_dir,
@@ -160,7 +162,7 @@ void add_view_command(CLI::App& app) {
         "Serves the page on http://127.0.0.1:PORT/ only (never on other interfaces), read-only, until Ctrl-C.\n"
         "Everything the page uses is installed with bvc3d; it fetches nothing from elsewhere.");
     cmd->callback([o] {
-        view::ViewData data(make_target(o->paths, o->scans, o->poses, o->model));
+        view::ViewData data(make_target(o->paths, o->scans, o->poses, o->recording, o->model));
         const fs::path web = web_dir();
         if (!o->export_dir.empty()) {
             const auto s = view::export_view(data, web, o->export_dir, o->export_steps);

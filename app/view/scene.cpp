@@ -311,12 +311,10 @@ std::string TrialScene::step_blob(std::size_t i) const {
 
 // ---- recordings ----
 
-RecordingScene::RecordingScene(const fs::path& scans, const fs::path& poses, ModelSpec model)
-    : model_(std::move(model)) {
-    scans_ = recording::list_scans(scans);
-    const auto all_poses = recording::read_poses(poses);
-    const auto pairing = recording::pair_scans_with_poses(recording::scan_times(scans_), all_poses);
-    for (auto k : pairing.pose_of_scan) poses_.push_back(all_poses[k]);
+RecordingScene::RecordingScene(std::shared_ptr<const recording::Recording> recording, ModelSpec model)
+    : recording_(std::move(recording)), model_(std::move(model)) {
+    const auto& scans_ = recording_->scans;
+    const auto& poses_ = recording_->poses;
     std::vector<float> position, rotation;
     json names = json::array(), times = json::array();
     for (std::size_t i = 0; i < scans_.size(); ++i) {
@@ -324,24 +322,27 @@ RecordingScene::RecordingScene(const fs::path& scans, const fs::path& poses, Mod
         for (int k = 0; k < 3; ++k) position.push_back(static_cast<float>(T.translation()[k]));
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) rotation.push_back(static_cast<float>(T.linear()(r, c)));
-        names.push_back(scans_[i].path.filename().string());
+        names.push_back(recording_->store->scan_name(i));
         times.push_back(poses_[i].time ? json(*poses_[i].time) : json(nullptr));
     }
-    json header = {{"kind", "recording"}, {"scans", scans_.size()},      {"names", names},
-                   {"times", times},      {"model", model_json(model_)}, {"paired_by_time", pairing.by_time}};
+    json header = {
+        {"kind", "recording"}, {"scans", scans_.size()},      {"names", names},
+        {"times", times},      {"model", model_json(model_)}, {"paired_by_time", recording_->paired_by_time}};
     blob_ =
         encode_blob(std::move(header), {f32_array("position", std::span<const float>(position), {scans_.size(), 3}),
                                         f32_array("rotation", std::span<const float>(rotation), {scans_.size(), 9})});
 }
 
 std::string RecordingScene::map_blob() const {
+    const auto& scans_ = recording_->scans;
+    const auto& poses_ = recording_->poses;
     // At most 60 scans and 250 000 points: enough to see the place, quick to read and draw.
     const std::size_t every = std::max<std::size_t>(1, (scans_.size() + 59) / 60);
     const std::size_t used = (scans_.size() + every - 1) / every;
     const std::size_t per_scan = 250000 / std::max<std::size_t>(used, 1);
     std::vector<float> points;
     for (std::size_t i = 0; i < scans_.size(); i += every) {
-        const auto cloud = recording::read_scan(scans_[i].path);
+        const auto cloud = recording_->load(i);
         const std::size_t stride = std::max<std::size_t>(1, (cloud.size() + per_scan - 1) / per_scan);
         const auto& T = poses_[i].world_from_sensor;
         for (std::size_t p = 0; p < cloud.size(); p += stride) {
@@ -355,9 +356,11 @@ std::string RecordingScene::map_blob() const {
 }
 
 std::string RecordingScene::scan_blob(std::size_t i) const {
-    if (i >= scans_.size())
-        throw InputError("scan " + std::to_string(i) + " is past the recording's " + std::to_string(scans_.size()));
-    const auto cloud = recording::read_scan(scans_[i].path);
+    const auto& poses_ = recording_->poses;
+    if (i >= recording_->size())
+        throw InputError("scan " + std::to_string(i) + " is past the recording's " +
+                         std::to_string(recording_->size()));
+    const auto cloud = recording_->load(i);
     const auto& T = poses_[i].world_from_sensor;
     std::vector<float> xyz, range;
     std::vector<std::uint8_t> kept;
@@ -386,7 +389,7 @@ std::string RecordingScene::scan_blob(std::size_t i) const {
     const Vec3 origin = T.translation();
     json header = {{"kind", "scan"},
                    {"scan", i},
-                   {"name", scans_[i].path.filename().string()},
+                   {"name", recording_->store->scan_name(i)},
                    {"returns", returns.size()},
                    {"sensor_origin", {origin.x(), origin.y(), origin.z()}},
                    {"dropped_nonfinite", cloud.dropped_nonfinite}};

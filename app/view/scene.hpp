@@ -12,6 +12,7 @@
 #include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/recorder/trial_file.hpp"
 #include "bvc3d/recording/pose_file.hpp"
+#include "bvc3d/recording/recording.hpp"
 #include "bvc3d/recording/scan_list.hpp"
 #include "bvc3d/world/world.hpp"
 #include "view/blob.hpp"
@@ -66,16 +67,15 @@ private:
 // A recording: scans paired with sensor poses, and the model whose BVCs the page shows.
 class RecordingScene {
 public:
-    RecordingScene(const std::filesystem::path& scans, const std::filesystem::path& poses, ModelSpec model);
-    std::size_t size() const { return scans_.size(); }
+    RecordingScene(std::shared_ptr<const recording::Recording> recording, ModelSpec model);
+    std::size_t size() const { return recording_->size(); }
     const std::string& blob() const { return blob_; }  // poses and scan names
     // The points of a map: every few scans, thinned, in the world frame (for the world view).
     std::string map_blob() const;
     std::string scan_blob(std::size_t index) const;
 
 private:
-    std::vector<recording::ScanEntry> scans_;
-    std::vector<recording::PoseRecord> poses_;  // one per scan, paired
+    std::shared_ptr<const recording::Recording> recording_;  // scans (files or a bag) paired with poses
     ModelSpec model_;
     std::string blob_;
 };

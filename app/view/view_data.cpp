@@ -49,9 +49,8 @@ Reply blob_reply(std::string body) { return Reply{200, "application/octet-stream
 }  // namespace
 
 ViewData::ViewData(ViewTarget target) : target_(std::move(target)) {
-    if (target_.scans && target_.poses)  // read the lists now: a bad recording fails before serving
-        recording_ =
-            std::make_unique<RecordingScene>(*target_.scans, *target_.poses, config::resolve_model(target_.model));
+    if (target_.recording)  // opened already: a bad recording fails before serving
+        recording_ = std::make_unique<RecordingScene>(target_.recording, config::resolve_model(target_.model));
 }
 
 Reply ViewData::get(const std::string& endpoint, const Query& query) {
@@ -71,7 +70,7 @@ Reply ViewData::route(const std::string& endpoint, const Query& query) {
                       {"open", target_.open},
                       {"world", target_.world},
                       {"worlds", target_.worlds},
-                      {"recording", target_.scans.has_value()},
+                      {"recording", target_.recording != nullptr},
                       {"model", target_.model}};
         return Reply{200, "application/json", index.dump()};
     }
@@ -161,7 +160,8 @@ std::shared_ptr<const World> ViewData::world_by_source(const std::string& source
 }
 
 const RecordingScene& ViewData::recording() {
-    if (!recording_) throw RequestError(404, "no recording is being shown (bvc3d view --scans ... --poses ...)");
+    if (!recording_)
+        throw RequestError(404, "no recording is being shown (bvc3d view --scans ... --poses ..., or --bag ...)");
     return *recording_;
 }
 

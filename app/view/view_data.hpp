@@ -22,8 +22,8 @@ struct ViewTarget {
     std::vector<std::string> open;    // the trials opened first (a second one is shown beside)
     std::string world;                // a world opened first: a preset or a YAML file relative to root
     std::vector<std::string> worlds;  // the worlds offered: presets and YAML files under root
-    std::optional<std::filesystem::path> scans, poses;  // a recording
-    std::string model = "3d-0.2";                       // the model whose BVCs a recording's page shows
+    std::shared_ptr<const bvc3d::recording::Recording> recording;  // a recording (scan files or a bag), opened
+    std::string model = "3d-0.2";                                  // the model whose BVCs a recording's page shows
 };
 
 struct Reply {

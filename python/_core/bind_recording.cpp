@@ -7,6 +7,7 @@
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/experiment/replay.hpp"
 #include "bvc3d/recorder/trial_file.hpp"
+#include "bvc3d/recording/bag_recording.hpp"
 #include "bvc3d/recording/extrinsics.hpp"
 #include "bvc3d/recording/recording.hpp"
 
@@ -64,6 +65,17 @@ pyb::dict run(const ReplaySource& source, const std::string& model, bool learn, 
     return samples_to_dict(r, true);  // a replay records the BVC rates
 }
 
+// Extrinsics from Python: a file, or 12/16 numbers.
+Eigen::Isometry3d extrinsics_of(const pyb::object& extrinsics) {
+    if (pyb::isinstance<pyb::str>(extrinsics) || pyb::hasattr(extrinsics, "__fspath__"))
+        return recording::read_extrinsics(pyb::str(extrinsics).cast<std::string>());
+    // Python's repr of each float is its shortest exact text: the parser reads what numpy holds.
+    const auto a = extrinsics.cast<ArrayD>();
+    std::string text;
+    for (pyb::ssize_t i = 0; i < a.size(); ++i) text += pyb::repr(pyb::float_(a.data()[i])).cast<std::string>() + " ";
+    return recording::parse_extrinsics(text, "extrinsics");
+}
+
 const char* preprocess_doc = "Preprocessing keywords (docs/recordings.md):\n";
 
 void bind_recording_class(pyb::module_& m) {
@@ -79,24 +91,42 @@ array and the scan's (N, 3) points in the sensor frame (docs/recordings.md).)doc
                 recording::RecordingOptions o;
                 o.pose_format = recording::parse_pose_format(pose_format);
                 o.time_tolerance = time_tolerance;
-                if (!extrinsics.is_none()) {
-                    if (pyb::isinstance<pyb::str>(extrinsics) || pyb::hasattr(extrinsics, "__fspath__")) {
-                        o.base_from_sensor = recording::read_extrinsics(pyb::str(extrinsics).cast<std::string>());
-                    } else {
-                        // Python's repr of each float is its shortest exact text: the parser reads what numpy holds.
-                        const auto a = extrinsics.cast<ArrayD>();
-                        std::string text;
-                        for (pyb::ssize_t i = 0; i < a.size(); ++i)
-                            text += pyb::repr(pyb::float_(a.data()[i])).cast<std::string>() + " ";
-                        o.base_from_sensor = recording::parse_extrinsics(text, "extrinsics");
-                    }
-                }
+                if (!extrinsics.is_none()) o.base_from_sensor = extrinsics_of(extrinsics);
                 return std::make_shared<recording::Recording>(recording::open_recording(scans, poses, o));
             },
             pyb::arg("scans"), pyb::arg("poses"), pyb::arg("pose_format") = "auto",
             pyb::arg("extrinsics") = pyb::none(),
             pyb::arg("time_tolerance") = recording::RecordingOptions{}.time_tolerance,
             "extrinsics: base_from_sensor as a file or 12/16 numbers; the poses are then the base's")
+        .def_static(
+            "open_bag",
+            [](const std::filesystem::path& bag, const std::string& cloud_topic, const std::string& pose_topic,
+               const std::string& tf_frames, double tf_tolerance, const pyb::object& extrinsics,
+               double time_tolerance) {
+                recording::RecordingOptions o;
+                o.time_tolerance = time_tolerance;
+                if (!extrinsics.is_none()) o.base_from_sensor = extrinsics_of(extrinsics);
+                recording::BagSource s;
+                s.bag = bag;
+                s.cloud_topic = cloud_topic;
+                s.pose_topic = pose_topic;
+                if (!tf_frames.empty()) recording::parse_tf_frames(tf_frames, s);
+                s.tf_tolerance = tf_tolerance;
+                std::shared_ptr<recording::Recording> r;
+                {
+                    pyb::gil_scoped_release release;
+                    r = std::make_shared<recording::Recording>(recording::open_bag_recording(s, o));
+                }
+                return r;
+            },
+            pyb::arg("bag"), pyb::arg("cloud_topic"), pyb::arg("pose_topic") = "", pyb::arg("tf_frames") = "",
+            pyb::arg("tf_tolerance") = recording::BagSource{}.tf_tolerance, pyb::arg("extrinsics") = pyb::none(),
+            pyb::arg("time_tolerance") = recording::RecordingOptions{}.time_tolerance,
+            R"doc(A ROS bag as a recording (docs/ros.md): bag is a ROS 1 .bag, an .mcap file or a ROS 2 bag folder;
+cloud_topic a sensor_msgs/PointCloud2 topic; the poses from pose_topic (nav_msgs/Odometry or
+geometry_msgs/PoseStamped, each cloud paired with the pose nearest its stamp within time_tolerance)
+or from tf, tf_frames="FIXED,SENSOR" (the chain interpolated at each cloud's stamp; tf_tolerance
+bounds a link's gap, s). extrinsics as for open.)doc")
         .def_property_readonly("name", [](const recording::Recording& r) { return r.name; })
         .def("__len__", &recording::Recording::size)
         .def_property_readonly(

@@ -114,9 +114,69 @@ SEEDS = {
 }
 
 
+def bag_seeds():
+    """MCAP files and CDR messages from the tests' independent writers; ROS 1 bags and messages from
+    Debian's python3-rosbag (left out when it is not installed)."""
+    import sys
+    import tempfile
+    sys.path.insert(0, str(SOURCE / "test" / "python"))
+    import bag_writers as bw
+    xyz = [("x", 0, 7, 1), ("y", 4, 7, 1), ("z", 8, 7, 1)]
+    data = b"".join(struct.pack("<fff", *p[:3]) for p in POINTS)
+    cloud = bw.cdr_cloud(1.5, "lidar", 1, 3, xyz, 12, data)
+    cloud_be = bw.cdr_cloud(1.5, "lidar", 1, 3, xyz, 12, b"".join(struct.pack(">fff", *p[:3]) for p in POINTS),
+                            big=True)
+    odom = bw.cdr_odometry(1.5, "map", "lidar", (1, 2, 3), (0, 0, 0.6, 0.8))
+    tf = bw.cdr_tf([(1.5, "map", "lidar", (1, 2, 3), (0, 0, 0.6, 0.8))])
+    channels = [(0, "/points", "sensor_msgs/msg/PointCloud2"), (1, "/odom", "nav_msgs/msg/Odometry"),
+                (2, "/tf", "tf2_msgs/msg/TFMessage")]
+    msgs = [(0, 1500000000, cloud), (1, 1500000000, odom), (2, 1500000000, tf)]
+    mcaps = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name, kw in {"zstd.mcap": {}, "lz4.mcap": {"compression": "lz4"}, "plain.mcap": {"chunked": False}}.items():
+            path = pathlib.Path(folder) / name
+            bw.mcap(path, channels, msgs, **kw)
+            mcaps[name] = path.read_bytes()
+    seeds = {"fuzz_mcap": mcaps,
+             "fuzz_cdr": {"cloud": b"\x00" + cloud, "cloud-be": b"\x00" + cloud_be, "odom": b"\x01" + odom,
+                          "pose": b"\x02" + odom[:4 + 4 + 4 + 8 + 56], "tf": b"\x03" + tf}}
+    try:
+        import io
+        import rosbag
+        import rospy
+        from nav_msgs.msg import Odometry
+        from sensor_msgs.msg import PointCloud2, PointField
+    except ImportError:
+        print("make_corpus: no python3-rosbag: the ROS 1 seeds are left out")
+        return seeds
+    c = PointCloud2(height=1, width=3, point_step=12, row_step=36, data=data,
+                    fields=[PointField(name=n, offset=o, datatype=d, count=k) for n, o, d, k in xyz])
+    c.header.stamp, c.header.frame_id = rospy.Time(1, 5), "lidar"
+    o = Odometry()
+    o.header.stamp, o.header.frame_id, o.child_frame_id = rospy.Time(1, 5), "map", "lidar"
+    o.pose.pose.orientation.w = 1.0
+    def serialized(m):
+        b = io.BytesIO()
+        m.serialize(b)
+        return b.getvalue()
+    with tempfile.TemporaryDirectory() as folder:
+        path = pathlib.Path(folder) / "x.bag"
+        with rosbag.Bag(str(path), "w") as bag:
+            bag.write("/points", c, rospy.Time(1, 5))
+            bag.write("/odom", o, rospy.Time(1, 5))
+        plain = path.read_bytes()
+        with rosbag.Bag(str(path), "w", compression="lz4") as bag:
+            bag.write("/points", c, rospy.Time(1, 5))
+        packed = path.read_bytes()
+    seeds["fuzz_bag"] = {"plain.bag": b"\x00" + plain, "lz4.bag": b"\x00" + packed,
+                         "cloud": b"\x01" + serialized(c), "odom": b"\x02" + serialized(o)}
+    return seeds
+
+
 def main():
     if CORPUS.exists():
         shutil.rmtree(CORPUS)
+    SEEDS.update(bag_seeds())
     for target, files in SEEDS.items():
         (CORPUS / target).mkdir(parents=True)
         for name, data in files.items():

@@ -85,6 +85,16 @@ ScanPosePairing pair_scans_with_poses(const std::vector<std::optional<double>>& 
     if (!all_timed(scan_times) || !all_timed(poses))
         throw InputError("cannot pair scans with poses: the counts differ (" + counts +
                          ") and no times are available to pair them (" + missing_times(scan_times, poses) + ")");
+    return pair_scans_with_poses_by_time(scan_times, poses, tolerance);
+}
+
+ScanPosePairing pair_scans_with_poses_by_time(const std::vector<std::optional<double>>& scan_times,
+                                              const std::vector<PoseRecord>& poses, double tolerance) {
+    if (!(tolerance >= 0)) throw InputError("pairing scans with poses: the time tolerance must be >= 0");
+    if (poses.empty()) throw InputError("cannot pair scans with poses: there are no poses");
+    if (!all_timed(scan_times) || !all_timed(poses))
+        throw InputError("cannot pair scans with poses by time: " + missing_times(scan_times, poses));
+    ScanPosePairing pairing;
     check_finite_times(scan_times, poses);
     pairing.by_time = true;
     const std::vector<std::size_t> by_time = poses_by_time(poses);

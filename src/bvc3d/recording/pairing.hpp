@@ -22,4 +22,9 @@ struct ScanPosePairing {
 ScanPosePairing pair_scans_with_poses(const std::vector<std::optional<double>>& scan_times,
                                       const std::vector<PoseRecord>& poses, double tolerance = 0.05);
 
+// Each scan with the pose nearest in time, whatever the counts (a bag's scans and poses always have
+// times); every scan and pose needs one. Errors as above.
+ScanPosePairing pair_scans_with_poses_by_time(const std::vector<std::optional<double>>& scan_times,
+                                              const std::vector<PoseRecord>& poses, double tolerance = 0.05);
+
 }  // namespace bvc3d::recording

@@ -38,6 +38,29 @@ std::string recording_name(const fs::path& scans) {
     return p.parent_path().filename().string();
 }
 
+// Scan files, one per scan.
+class ScanFiles : public ScanStore {
+public:
+    ScanFiles(std::vector<ScanEntry> scans, fs::path poses) : scans_(std::move(scans)), poses_(std::move(poses)) {}
+    PointCloud load(std::size_t i) const override { return read_scan(scans_.at(i).path); }
+    std::string scan_name(std::size_t i) const override { return scans_.at(i).path.filename().string(); }
+    std::string fingerprint() const override {
+        std::uint64_t h = fnv1a(detail::read_file(poses_));
+        for (const auto& s : scans_) {
+            std::error_code ec;
+            const auto size = fs::file_size(s.path, ec);
+            h = fnv1a(s.path.filename().string() + ":" + std::to_string(ec ? 0 : size) + ";", h);
+        }
+        char text[17];
+        std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+        return text;
+    }
+
+private:
+    std::vector<ScanEntry> scans_;
+    fs::path poses_;
+};
+
 }  // namespace
 
 Recording open_recording(const fs::path& scans, const fs::path& poses, const RecordingOptions& options) {
@@ -46,6 +69,7 @@ Recording open_recording(const fs::path& scans, const fs::path& poses, const Rec
     r.scans_source = scans;
     r.poses_source = poses;
     r.scans = list_scans(scans);
+    r.store = std::make_shared<ScanFiles>(r.scans, poses);
     std::vector<PoseRecord> all = read_poses(poses, options.pose_format);
     if (options.base_from_sensor) apply_extrinsics(all, *options.base_from_sensor);
     const ScanPosePairing pairing = pair_scans_with_poses(scan_times(r.scans), all, options.time_tolerance);
@@ -59,7 +83,7 @@ PointCloud Recording::load(std::size_t i) const {
         throw InputError("recording '" + name + "': scan " + std::to_string(i) + " does not exist (" +
                          std::to_string(scans.size()) + " scans)");
     try {
-        return read_scan(scans[i].path);
+        return store->load(i);
     } catch (const InputError& e) {
         throw InputError("recording '" + name + "', scan " + std::to_string(i) + ": " + e.what());
     }
@@ -70,17 +94,7 @@ std::optional<double> Recording::time(std::size_t i) const {
     return poses.at(i).time;
 }
 
-std::string Recording::fingerprint() const {
-    std::uint64_t h = fnv1a(detail::read_file(poses_source));
-    for (const auto& s : scans) {
-        std::error_code ec;
-        const auto size = fs::file_size(s.path, ec);
-        h = fnv1a(s.path.filename().string() + ":" + std::to_string(ec ? 0 : size) + ";", h);
-    }
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
-    return text;
-}
+std::string Recording::fingerprint() const { return store->fingerprint(); }
 
 ScanWriteFormat parse_scan_write_format(const std::string& name) {
     if (name == "pcd") return ScanWriteFormat::pcd_f4;

@@ -1,9 +1,11 @@
 #pragma once
 // A recording: scans in order, each with its pose and time (docs/recordings.md). Takes: a scan
-// folder or list, a pose file, and how to read and pair them. Gives: the paired recording, each
-// scan's points on demand, and writing a recording (scans and poses) into a folder.
+// folder or list, a pose file, and how to read and pair them (or a bag: bag_recording.hpp). Gives:
+// the paired recording, each scan's points on demand from its store (scan files, a bag's clouds),
+// and writing a recording (scans and poses) into a folder.
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,10 +22,23 @@ struct RecordingOptions {
     std::optional<Eigen::Isometry3d> base_from_sensor;  // extrinsics: poses are the base's when given
 };
 
+// Where a recording's points come from: scan files, or the cloud messages of a bag.
+class ScanStore {
+public:
+    virtual ~ScanStore() = default;
+    // Scan i's points in its sensor frame; errors name the file (and topic, message). Thread-safe.
+    virtual PointCloud load(std::size_t i) const = 0;
+    // Text that changes when the data does (see Recording::fingerprint).
+    virtual std::string fingerprint() const = 0;
+    // A short name of scan i for people: its file's name, or its topic and message index.
+    virtual std::string scan_name(std::size_t i) const = 0;
+};
+
 struct Recording {
     std::string name;  // the scan folder's name (a list file's: the folder holding it; one scan's: its stem)
-    std::filesystem::path scans_source, poses_source;
-    std::vector<ScanEntry> scans;   // in recording order
+    std::filesystem::path scans_source, poses_source;  // a bag's: "<bag>:<topic>" (or ":tf FIXED SENSOR")
+    std::shared_ptr<const ScanStore> store;
+    std::vector<ScanEntry> scans;   // in recording order (a bag's: the bag's path and the cloud's stamp)
     std::vector<PoseRecord> poses;  // world_from_sensor of each scan (paired, extrinsics applied)
     bool paired_by_time = false;
 
@@ -33,7 +48,8 @@ struct Recording {
     // Scan i's time: the list's, else its pose's, else none.
     std::optional<double> time(std::size_t i) const;
     // Text that changes when the recording does: the pose file's bytes and each scan file's name
-    // and size (scan contents are not read: an edit that keeps a scan's size goes unnoticed).
+    // and size (scan contents are not read: an edit that keeps a scan's size goes unnoticed); a bag's
+    // files' names and sizes, its topics and the pose source.
     std::string fingerprint() const;
 };
 
