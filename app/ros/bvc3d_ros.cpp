@@ -173,17 +173,7 @@ private:
 };
 
 bvc3d::recording::CloudMessage cloud_message(const sensor_msgs::PointCloud2& m) {
-    bvc3d::recording::CloudMessage c;
-    c.stamp = seconds(m.header.stamp);
-    c.frame_id = m.header.frame_id;
-    c.height = m.height;
-    c.width = m.width;
-    for (const auto& f : m.fields) c.fields.push_back({f.name, f.offset, f.datatype, f.count});
-    c.is_bigendian = m.is_bigendian;
-    c.point_step = m.point_step;
-    c.row_step = m.row_step;
-    c.data = m.data;
-    return c;
+    return bvc3d::recording::cloud_message_of(m, seconds(m.header.stamp));
 }
 
 template <class T>

@@ -7,6 +7,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recording/cdr.hpp"
 #include "bvc3d/recording/extrinsics.hpp"
+#include "bvc3d/recording/file_io.hpp"
 #include "bvc3d/recording/pairing.hpp"
 #include "bvc3d/recording/tf_tree.hpp"
 
@@ -15,11 +16,6 @@ namespace bvc3d::recording {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 0xcbf29ce484222325ull) {
-    for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ull;
-    return h;
-}
 
 std::string secs(double t) {
     char s[40];
@@ -45,7 +41,7 @@ public:
     }
     std::string fingerprint() const override {
         // The files' names and sizes (their contents are not read again), and what is read from them.
-        std::uint64_t h = fnv1a(key_);
+        std::uint64_t h = detail::fnv1a(key_);
         std::error_code ec;
         const fs::path& p = bag_->path();
         std::vector<fs::path> files;
@@ -55,7 +51,7 @@ public:
         std::sort(files.begin(), files.end());
         for (const auto& f : files) {
             const auto size = fs::file_size(f, ec);
-            h = fnv1a(f.filename().string() + ":" + std::to_string(ec ? 0 : size) + ";", h);
+            h = detail::fnv1a(f.filename().string() + ":" + std::to_string(ec ? 0 : size) + ";", h);
         }
         char text[17];
         std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));

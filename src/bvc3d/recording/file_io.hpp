@@ -1,7 +1,9 @@
 #pragma once
 // Internal to the recording stage: whole-file reads and the one shape of error every reader
 // throws. Takes: paths. Gives: file contents, and InputErrors worded "<file>: <where>: <reason>"
-// (where = "line 12", "point 7", ... or nothing). Writers use core/atomic_file.hpp.
+// (where = "line 12", "point 7", ... or nothing); a stable hash for fingerprints. Writers use
+// core/atomic_file.hpp.
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -21,5 +23,11 @@ std::string point_ref(std::size_t point);
 // The whole file in memory. Throws InputError for a missing file, a directory, an unreadable
 // file or an empty one, naming the file and the reason.
 std::string read_file(const std::filesystem::path& file);
+
+// FNV-1a, 64 bits: a stable hash for recordings' fingerprints (their files' names, sizes and poses).
+inline std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 0xcbf29ce484222325ull) {
+    for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ull;
+    return h;
+}
 
 }  // namespace bvc3d::recording::detail

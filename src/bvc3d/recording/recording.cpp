@@ -23,12 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// FNV-1a, 64 bits: a stable hash for fingerprints.
-std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 0xcbf29ce484222325ull) {
-    for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ull;
-    return h;
-}
-
 // A folder's name; for a list file, the name of the folder holding it (the recording's folder);
 // for a single scan, its stem.
 std::string recording_name(const fs::path& scans) {
@@ -45,11 +39,11 @@ public:
     PointCloud load(std::size_t i) const override { return read_scan(scans_.at(i).path); }
     std::string scan_name(std::size_t i) const override { return scans_.at(i).path.filename().string(); }
     std::string fingerprint() const override {
-        std::uint64_t h = fnv1a(detail::read_file(poses_));
+        std::uint64_t h = detail::fnv1a(detail::read_file(poses_));
         for (const auto& s : scans_) {
             std::error_code ec;
             const auto size = fs::file_size(s.path, ec);
-            h = fnv1a(s.path.filename().string() + ":" + std::to_string(ec ? 0 : size) + ";", h);
+            h = detail::fnv1a(s.path.filename().string() + ":" + std::to_string(ec ? 0 : size) + ";", h);
         }
         char text[17];
         std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));

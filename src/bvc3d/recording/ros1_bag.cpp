@@ -108,17 +108,8 @@ void copy_pose(const geometry_msgs::Point& p, const geometry_msgs::Quaternion& q
 
 CloudMessage decode_cloud(const std::vector<std::uint8_t>& bytes) {
     auto m = deserialize<sensor_msgs::PointCloud2>(bytes);
-    CloudMessage c;
-    c.stamp = seconds(m.header.stamp);
-    c.frame_id = m.header.frame_id;
-    c.height = m.height;
-    c.width = m.width;
-    for (const auto& f : m.fields) c.fields.push_back({f.name, f.offset, f.datatype, f.count});
-    c.is_bigendian = m.is_bigendian;
-    c.point_step = m.point_step;
-    c.row_step = m.row_step;
-    c.data = std::move(m.data);
-    return c;
+    const double stamp = seconds(m.header.stamp);
+    return cloud_message_of(std::move(m), stamp);
 }
 
 StampedTransform decode_odometry(const std::vector<std::uint8_t>& bytes) {

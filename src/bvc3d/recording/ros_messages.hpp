@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "bvc3d/recording/point_cloud.hpp"
@@ -43,6 +44,23 @@ struct CloudMessage {
     std::uint32_t point_step = 0, row_step = 0;
     std::vector<std::uint8_t> data;
 };
+
+// A ROS 1 sensor_msgs/PointCloud2 (the library's bag reader's and the node's: any type with its members) as a
+// CloudMessage, its header's stamp given in seconds; the data moved when `m` is an rvalue.
+template <class PointCloud2>
+CloudMessage cloud_message_of(PointCloud2&& m, double stamp) {
+    CloudMessage c;
+    c.stamp = stamp;
+    c.frame_id = m.header.frame_id;
+    c.height = m.height;
+    c.width = m.width;
+    for (const auto& f : m.fields) c.fields.push_back({f.name, f.offset, f.datatype, f.count});
+    c.is_bigendian = m.is_bigendian;
+    c.point_step = m.point_step;
+    c.row_step = m.row_step;
+    c.data = std::forward<PointCloud2>(m).data;
+    return c;
+}
 
 // A rigid transform at a time: parent_from_child (the pose of `child` in `parent`), as nav_msgs/Odometry
 // (header.frame_id ← child_frame_id), geometry_msgs/PoseStamped (header.frame_id ← the pose's own
