@@ -132,7 +132,8 @@ void PrunedSums::for_each_return(std::span<const LidarReturn> returns, Visit&& v
     }
 }
 
-std::size_t PrunedSums::record_of(std::size_t q, bool use_memo, double* sums) {
+// record_of and add_job run once per return (and layer): inlined into the two passes, as the lambdas they were.
+[[gnu::always_inline]] inline std::size_t PrunedSums::record_of(std::size_t q, bool use_memo, double* sums) {
     const std::size_t record = static_cast<std::size_t>(reach_) + 1;
     const double azimuth = in_.azimuth[q];
     const std::size_t slot = use_memo ? static_cast<std::size_t>(in_.slot[q]) : 0;
@@ -155,6 +156,12 @@ std::size_t PrunedSums::record_of(std::size_t q, bool use_memo, double* sums) {
     at = (memo_slots_ + n_direct_++) * record;
     memo_dir_[at] = static_cast<std::uint16_t>(angular_weights(azimuth, &memo_dir_[at + 1], &memo_weight_[at + 1]));
     return at;
+}
+
+[[gnu::always_inline]] inline void PrunedSums::add_job(const kernels::ProfileJob& job, double* sums) {
+    if (!recurrence_) return add_profile_directly(job, sums);
+    jobs_[n_jobs_++] = job;
+    if (n_jobs_ == jobs_.size()) flush_jobs(sums);
 }
 
 std::size_t PrunedSums::sum_unplanned(std::span<const LidarReturn> returns) {
@@ -248,12 +255,6 @@ void PrunedSums::sum_planned(std::span<const LidarReturn> returns, const ScanPla
     end_row();
     if (n_jobs_ > 0) flush_jobs(sums);
     end_run();
-}
-
-void PrunedSums::add_job(const kernels::ProfileJob& job, double* sums) {
-    if (!recurrence_) return add_profile_directly(job, sums);
-    jobs_[n_jobs_++] = job;
-    if (n_jobs_ == jobs_.size()) flush_jobs(sums);
 }
 
 void PrunedSums::add_profile_directly(const kernels::ProfileJob& job, double* sums) const {
