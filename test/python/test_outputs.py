@@ -114,3 +114,26 @@ def test_a_repeated_trajectory_column_is_named(tmp_path):
     assert proc.returncode == 2
     assert "line 1: the header names the column 'y' twice" in proc.stderr
     assert os.listdir(tmp_path) == ["track.csv"]
+
+
+def test_docs_robot_keys_are_the_defaults(source_dir):
+    """docs/python.md names the robot's keys with values it calls the defaults: they are (bvc3d config)."""
+    import re
+    text = (source_dir / "docs" / "python.md").read_text()
+    m = re.search(r"`radius=([\d.]+), turn_rate=([\d.]+)`, the defaults", text)
+    assert m, "docs/python.md no longer names the robot's default keys"
+    config = run_cli("config", check=True).stdout
+    defaults = {k: float(v) for k, v in re.findall(r"^\s+(radius|turn_rate): ([\d.]+)", config, re.M)}
+    assert defaults == {"radius": float(m.group(1)), "turn_rate": float(m.group(2))}
+
+
+def test_analyze_out_and_a_narrow_table(tmp_path):
+    out = tmp_path / "t.h5"
+    run_cli("run", "--hours", "0.02", "--seed", "1", "--out", out, "--checkpoint-minutes", "0", check=True)
+    proc = run_cli("analyze", out, "--min-samples", "10", "--out", tmp_path / "sub" / "m.csv/", check=True)
+    assert max(len(line) for line in proc.stdout.splitlines()) <= 100
+    import csv
+    (row,) = list(csv.DictReader(open(tmp_path / "sub" / "m.csv")))
+    assert row["min_samples"] == "10" and row["trial"] in proc.stdout and float(row["n_bins"]) > 0
+    bad = run_cli("analyze", tmp_path / "none.h5", "--out", tmp_path / "new" / "m.csv")
+    assert bad.returncode == 2 and not (tmp_path / "new").exists()
