@@ -137,3 +137,17 @@ def test_analyze_out_and_a_narrow_table(tmp_path):
     assert row["min_samples"] == "10" and row["trial"] in proc.stdout and float(row["n_bins"]) > 0
     bad = run_cli("analyze", tmp_path / "none.h5", "--out", tmp_path / "new" / "m.csv")
     assert bad.returncode == 2 and not (tmp_path / "new").exists()
+
+
+def test_readme_states_the_decoding_coverage_of_its_trials(source_dir):
+    """README's figure of the decoding error says how many samples were undecoded: the range it gives
+    is the range of frac_undecoded over docs/reproduction/spec-trials.csv, rounded outwards."""
+    import csv
+    import math
+    import re
+    text = (source_dir / "README.md").read_text()
+    m = re.search(r"(\d+)–(\d+) % of each trial's samples are undecoded", text)
+    assert m, "README.md no longer states the decoding coverage"
+    values = [float(r["frac_undecoded"]) for r in csv.DictReader(open(source_dir / "docs/reproduction/spec-trials.csv"))]
+    assert (int(m.group(1)), int(m.group(2))) == (math.floor(100 * min(values)), math.ceil(100 * max(values)))
+    assert "decoding_coverage.png" in text and (source_dir / "docs/figures/decoding_coverage.png").exists()
