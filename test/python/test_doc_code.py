@@ -9,7 +9,6 @@ data folder beside the repository); without them it is skipped, with the reason.
 """
 import os
 import pathlib
-import re
 import subprocess
 import sys
 
@@ -80,8 +79,8 @@ def test_python_block_runs(page, line, code, tmp_path):
         proc = subprocess.run([CLI, *argv], cwd=tmp_path, capture_output=True, text=True)
         assert proc.returncode == 0, proc.stderr
     env = dict(os.environ, MPLBACKEND="Agg")
-    env["PYTHONPATH"] = os.pathsep.join(str(pathlib.Path(p).resolve()) for p in env.get("PYTHONPATH", "").split(os.pathsep)
-                                        if p)
+    paths = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env["PYTHONPATH"] = os.pathsep.join(str(pathlib.Path(p).resolve()) for p in paths)  # the block runs elsewhere
     proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, env=env,
                           timeout=900)
     assert proc.returncode == 0, f"{page.name}:{line} fails:\n{proc.stderr[-3000:]}"

@@ -148,6 +148,7 @@ def test_readme_states_the_decoding_coverage_of_its_trials(source_dir):
     text = (source_dir / "README.md").read_text()
     m = re.search(r"(\d+)–(\d+) % of each trial's samples are undecoded", text)
     assert m, "README.md no longer states the decoding coverage"
-    values = [float(r["frac_undecoded"]) for r in csv.DictReader(open(source_dir / "docs/reproduction/spec-trials.csv"))]
+    trials = source_dir / "docs" / "reproduction" / "spec-trials.csv"
+    values = [float(r["frac_undecoded"]) for r in csv.DictReader(open(trials))]
     assert (int(m.group(1)), int(m.group(2))) == (math.floor(100 * min(values)), math.ceil(100 * max(values)))
     assert "decoding_coverage.png" in text and (source_dir / "docs/figures/decoding_coverage.png").exists()
