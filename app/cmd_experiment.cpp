@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/agent_kinds.hpp"
@@ -38,6 +39,26 @@ struct TrialOptions {
     RunOptions run;  // --out: the trial file; --checkpoint-minutes; --no-memory-check
 };
 
+// A trajectory steps the model once per row, and the place cells' time constant and Oja's rate are
+// per step: rows much closer (or farther) than the robot's model step change the dynamics per second.
+// Until trajectories are resampled to the model step (issue 32), say so.
+void warn_if_off_the_model_step(const TrajectorySpec& path) {
+    const auto& steps = path.steps();
+    if (steps.size() < 3) return;
+    std::vector<double> dt;
+    for (std::size_t i = 1; i < steps.size(); ++i) dt.push_back(steps[i].t - steps[i - 1].t);
+    std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+    const double median = dt[dt.size() / 2], model = RobotParams{}.model_dt;
+    if (std::abs(median / model - 1) <= 0.1) return;
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "has a row every %.3g s (median), the model one step per row: the place cells' time constant and "
+                  "Oja's rate are per step, so the dynamics run %.3g times as fast per second as at the robot's model "
+                  "step of %g s; resample the rows to %g s for the paper's dynamics",
+                  median, model / median, model, model);
+    std::cerr << "bvc3d: warning: trajectory '" << path.source() << "' " << text << "\n";
+}
+
 // The trial `bvc3d run` runs: the YAML file's, with the flags on top.
 TrialConfig run_config(const TrialOptions& o) {
     TrialConfig t = o.config.empty() ? TrialConfig{} : config::load_trial_file(o.config);
@@ -49,7 +70,11 @@ TrialConfig run_config(const TrialOptions& o) {
         t.set_agent(agent_by_name(o.agent));
         if (!o.trajectory.empty()) throw InputError("give --agent or --trajectory, not both");
     }
-    if (!o.trajectory.empty()) t.set_agent(std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory)));
+    if (!o.trajectory.empty()) {
+        auto path = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory));
+        warn_if_off_the_model_step(*path);
+        t.set_agent(path);
+    }
     if (o.seed) t.seed = *o.seed;
     if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
     const auto hours = [](const char* flag, double h) {
@@ -303,8 +328,14 @@ void add_analyze(CLI::App& app) {
         const auto columns = analysis::metric_names(dims);
         const auto& table = analysis::AnalysisParams::table();
         std::string csv = "file,trial";
-        for (const auto& c : columns) csv += "," + c;
-        for (const auto& f : table.fields()) csv += "," + f.key;
+        for (const auto& c : columns) {
+            csv += ',';
+            csv += c;
+        }
+        for (const auto& f : table.fields()) {
+            csv += ',';
+            csv += f.key;
+        }
         csv += "\n";
         for (std::size_t i = 0; i < trials.size(); ++i) {
             const auto& d = trials[i];
@@ -320,7 +351,9 @@ void add_analyze(CLI::App& app) {
             // A block per trial, two metrics a line: it fits a terminal of 80 columns (--out has them all).
             std::printf("%s (%s)\n", printable(d.name).c_str(), printable(o->files[i]).c_str());
             const auto values = analysis::scalar_metrics(m);
-            csv += csv_field(o->files[i]) + "," + csv_field(d.name);
+            csv += csv_field(o->files[i]);
+            csv += ',';
+            csv += csv_field(d.name);
             for (std::size_t c = 0; c < columns.size(); ++c) {
                 const auto it =
                     std::find_if(values.begin(), values.end(), [&](const auto& v) { return v.first == columns[c]; });
@@ -328,9 +361,13 @@ void add_analyze(CLI::App& app) {
                 if (has) std::printf("  %-22s %12.6g", columns[c].c_str(), it->second);
                 else std::printf("  %-22s %12s", columns[c].c_str(), "-");
                 std::printf("%s", c % 2 == 1 || c + 1 == columns.size() ? "\n" : "  ");
-                csv += "," + (has ? num(it->second) : std::string());
+                csv += ',';
+                if (has) csv += num(it->second);
             }
-            for (const auto& f : table.fields()) csv += "," + csv_field(params::to_text(f.get(params[i])));
+            for (const auto& f : table.fields()) {
+                csv += ',';
+                csv += csv_field(params::to_text(f.get(params[i])));
+            }
             csv += "\n";
             if (i == 0 && !o->cells.empty()) {
                 AtomicFile f(o->cells);

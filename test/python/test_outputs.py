@@ -152,3 +152,17 @@ def test_readme_states_the_decoding_coverage_of_its_trials(source_dir):
     values = [float(r["frac_undecoded"]) for r in csv.DictReader(open(trials))]
     assert (int(m.group(1)), int(m.group(2))) == (math.floor(100 * min(values)), math.ceil(100 * max(values)))
     assert "decoding_coverage.png" in text and (source_dir / "docs/figures/decoding_coverage.png").exists()
+
+
+def test_a_trajectory_off_the_model_step_is_warned_about(tmp_path):
+    """Rows every 0.05 s step the model 5.76 times as often per second as the robot's 0.288 s step."""
+    fast, model = tmp_path / "fast.csv", tmp_path / "model.csv"
+    t = np.arange(200) * 0.05
+    fast.write_text("t,x,y,heading\n" + "".join(f"{a},{-4 + 0.02 * i},-4,0\n" for i, a in enumerate(t)))
+    t = np.arange(200) * 0.288
+    model.write_text("t,x,y,heading\n" + "".join(f"{a},{-4 + 0.02 * i},-4,0\n" for i, a in enumerate(t)))
+    for path, warned in ((fast, True), (model, False)):
+        proc = run_cli("run", "--trajectory", path, "--protocol", "online", "--sample-hours", "0.001",
+                       "--out", tmp_path / f"{path.stem}.h5", "--checkpoint-minutes", "0")
+        assert proc.returncode == 0, proc.stderr
+        assert ("every 0.05 s" in proc.stderr and "5.76 times as fast" in proc.stderr) == warned, proc.stderr
