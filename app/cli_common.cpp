@@ -12,6 +12,7 @@
 
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -81,6 +82,13 @@ const CLI::Validator non_negative_check(
                    : "must be a number >= 0";
     },
     "NUMBER>=0");
+
+const CLI::Validator output_path(
+    [](std::string& s) -> std::string {
+        s = without_trailing_slash(s).string();
+        return "";
+    },
+    "", "output path");
 
 void warn_if_blocked(const World& world, const Pose& pose) {
     const BodyCollider body(world.description(), RobotParams{}.radius, RobotParams{}.height);

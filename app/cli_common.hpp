@@ -41,6 +41,8 @@ std::string printable(std::string_view text);
 // Option checks with short messages: seeds are whole numbers 0 .. 2^64 - 1, durations numbers >= 0.
 extern const CLI::Validator seed_check;
 extern const CLI::Validator non_negative_check;
+// Output paths (files and folders): trailing slashes dropped, "walk/" is the folder "walk".
+extern const CLI::Validator output_path;
 
 // `--extent`, the same flag with the same values in run, paper and analyze: `data` (the
 // trajectory's own bounds), `arena` (the walkable region's) or XMIN,XMAX,YMIN,YMAX.

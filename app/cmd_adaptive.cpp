@@ -115,8 +115,8 @@ void choose(const ChooseOptions& o) {
     p.validate(base.bvc.n_dir);
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
     // Fail before minutes of work, not after.
-    if (const auto folder = std::filesystem::path(o.out).parent_path(); !folder.empty())
-        ensure_writable_directory(folder);
+    const auto folder = std::filesystem::path(o.out).parent_path();
+    const EmptyFolderCleanup cleanup{folder, folder.empty() ? folder : ensure_writable_directory(folder)};
     const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
     const auto sets = o.sets.empty() ? std::vector<std::vector<double>>{} : parse_sets(o.sets);
     InterruptGuard guard;
@@ -193,7 +193,7 @@ void add_adaptive_command(CLI::App& app) {
     cmd->add_option("--seed", o->params.seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
     cmd->add_option("--sets", o->sets, "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
     o->run.add_jobs(*cmd, "Threads sharing the candidates; 0 (the default): one per core");
-    cmd->add_option("--out", o->out, "Model YAML file to write")->required();
+    cmd->add_option("--out", o->out, "Model YAML file to write")->required()->transform(output_path);
     cmd->callback([o] { choose(*o); });
 }
 

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 
+#include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/agent_kinds.hpp"
@@ -38,6 +39,26 @@ struct TrialOptions {
     RunOptions run;  // --out: the trial file; --checkpoint-minutes; --no-memory-check
 };
 
+// A trajectory steps the model once per row, and the place cells' time constant and Oja's rate are
+// per step: rows much closer (or farther) than the robot's model step change the dynamics per second.
+// Until trajectories are resampled to the model step (issue 32), say so.
+void warn_if_off_the_model_step(const TrajectorySpec& path) {
+    const auto& steps = path.steps();
+    if (steps.size() < 3) return;
+    std::vector<double> dt;
+    for (std::size_t i = 1; i < steps.size(); ++i) dt.push_back(steps[i].t - steps[i - 1].t);
+    std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+    const double median = dt[dt.size() / 2], model = RobotParams{}.model_dt;
+    if (std::abs(median / model - 1) <= 0.1) return;
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "has a row every %.3g s (median), the model one step per row: the place cells' time constant and "
+                  "Oja's rate are per step, so the dynamics run %.3g times as fast per second as at the robot's model "
+                  "step of %g s; resample the rows to %g s for the paper's dynamics",
+                  median, model / median, model, model);
+    std::cerr << "bvc3d: warning: trajectory '" << path.source() << "' " << text << "\n";
+}
+
 // The trial `bvc3d run` runs: the YAML file's, with the flags on top.
 TrialConfig run_config(const TrialOptions& o) {
     TrialConfig t = o.config.empty() ? TrialConfig{} : config::load_trial_file(o.config);
@@ -49,7 +70,11 @@ TrialConfig run_config(const TrialOptions& o) {
         t.set_agent(agent_by_name(o.agent));
         if (!o.trajectory.empty()) throw InputError("give --agent or --trajectory, not both");
     }
-    if (!o.trajectory.empty()) t.set_agent(std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory)));
+    if (!o.trajectory.empty()) {
+        auto path = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory));
+        warn_if_off_the_model_step(*path);
+        t.set_agent(path);
+    }
     if (o.seed) t.seed = *o.seed;
     if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
     const auto hours = [](const char* flag, double h) {
@@ -220,16 +245,28 @@ void add_paper(CLI::App& app) {
     });
 }
 
+// A CSV field: quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+    if (text.find_first_of(",\"\n") == std::string::npos) return text;
+    std::string out = "\"";
+    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+
 void add_analyze(CLI::App& app) {
     auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files, optionally with other parameters");
     struct Options {
         std::vector<std::string> files;
         std::optional<int> gridsize, min_samples, skip_samples, msai_bins;
         std::optional<double> quantile, eps, d_th, mi_quantile;
-        std::string extent, cells, templates;
+        std::string extent, cells, templates, out;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("files", o->files, "Trial files (.h5)")->required();
+    cmd->add_option("--out", o->out,
+                    "Write the recomputed metrics to this CSV: one row per file (file, trial, every metric, the "
+                    "analysis parameters used)")
+        ->transform(output_path);
     cmd->add_option("--gridsize", o->gridsize, "Hexagons across x");
     cmd->add_option("--quantile", o->quantile, "Rate-map threshold quantile");
     cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
@@ -244,7 +281,8 @@ void add_analyze(CLI::App& app) {
     cmd->add_option(
         "--decoding-templates", o->templates,
         "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
-    cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV");
+    cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV")
+        ->transform(output_path);
     cmd->footer(
         "Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
         "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20 (10 for flying agents'\n"
@@ -254,6 +292,7 @@ void add_analyze(CLI::App& app) {
         const bool new_extent = !o->extent.empty();
         const ExtentOption extent = parse_extent(new_extent ? o->extent : "data");
         if (!o->cells.empty()) require_not_directory(o->cells, "--cells");
+        if (!o->out.empty()) require_not_directory(o->out, "--out");
         std::vector<TrialFileData> trials;
         std::vector<analysis::AnalysisParams> params;
         for (const auto& f : o->files) {  // all readable and their parameters valid before any output
@@ -287,9 +326,17 @@ void add_analyze(CLI::App& app) {
         int dims = 2;  // columns for the metrics of the files' largest dimension
         for (const auto& d : trials) dims = std::max(dims, d.dims);
         const auto columns = analysis::metric_names(dims);
-        std::printf("%-40s", "trial");
-        for (const auto& n : columns) std::printf(" %15s", n.c_str());
-        std::printf("\n");
+        const auto& table = analysis::AnalysisParams::table();
+        std::string csv = "file,trial";
+        for (const auto& c : columns) {
+            csv += ',';
+            csv += c;
+        }
+        for (const auto& f : table.fields()) {
+            csv += ',';
+            csv += f.key;
+        }
+        csv += "\n";
         for (std::size_t i = 0; i < trials.size(); ++i) {
             const auto& d = trials[i];
             const Eigen::Map<const analysis::RowMatrixXf> rates(d.rates.data(), static_cast<Eigen::Index>(d.x.size()),
@@ -301,14 +348,27 @@ void add_analyze(CLI::App& app) {
                 if (d.dims == 3) positions(static_cast<Eigen::Index>(k), 2) = d.z[k];
             }
             const auto m = analysis::analyze_trial<float>(positions, rates, params[i]);
-            std::printf("%-40s", d.name.c_str());
+            // A block per trial, two metrics a line: it fits a terminal of 80 columns (--out has them all).
+            std::printf("%s (%s)\n", printable(d.name).c_str(), printable(o->files[i]).c_str());
             const auto values = analysis::scalar_metrics(m);
-            for (const auto& c : columns) {
-                const auto it = std::find_if(values.begin(), values.end(), [&](const auto& v) { return v.first == c; });
-                if (it == values.end()) std::printf(" %15s", "-");
-                else std::printf(" %15.6g", it->second);
+            csv += csv_field(o->files[i]);
+            csv += ',';
+            csv += csv_field(d.name);
+            for (std::size_t c = 0; c < columns.size(); ++c) {
+                const auto it =
+                    std::find_if(values.begin(), values.end(), [&](const auto& v) { return v.first == columns[c]; });
+                const bool has = it != values.end();
+                if (has) std::printf("  %-22s %12.6g", columns[c].c_str(), it->second);
+                else std::printf("  %-22s %12s", columns[c].c_str(), "-");
+                std::printf("%s", c % 2 == 1 || c + 1 == columns.size() ? "\n" : "  ");
+                csv += ',';
+                if (has) csv += num(it->second);
             }
-            std::printf("\n");
+            for (const auto& f : table.fields()) {
+                csv += ',';
+                csv += csv_field(params::to_text(f.get(params[i])));
+            }
+            csv += "\n";
             if (i == 0 && !o->cells.empty()) {
                 AtomicFile f(o->cells);
                 // field_area is m² of hexagons in 2-D, m³ of voxels in 3-D; isotropy only for 3-D files.
@@ -324,6 +384,10 @@ void add_analyze(CLI::App& app) {
                 }
                 f.commit();
             }
+        }
+        if (!o->out.empty()) {
+            write_file_atomically(o->out, csv);
+            std::printf("wrote %s\n", o->out.c_str());
         }
     });
 }

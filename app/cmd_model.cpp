@@ -46,7 +46,8 @@ void add_bvc(CLI::App& app) {
     cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's central walls in degrees");
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
     cmd->add_option("--pose", o->pose, "Robot pose X,Y,HEADING (m, m, rad; or e.g. 90deg)")->required();
-    cmd->add_option("--csv", o->csv, "Also write every cell: index, elevation, azimuth, distance, rate");
+    cmd->add_option("--csv", o->csv, "Also write every cell: index, elevation, azimuth, distance, rate")
+        ->transform(output_path);
     cmd->footer(
         "One line per (layer, direction): the largest rate, the preferred distance where it peaks, and the\n"
         "rates over preferred distance 0..max_dist as a bar (a full block is the step's maximum, 0.5).");

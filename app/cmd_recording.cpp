@@ -130,7 +130,8 @@ void add_replay(CLI::App& app) {
     cmd->add_option("--seed", o->seed, "Seed of the initial weights when no --weights is given")
         ->capture_default_str()
         ->check(seed_check);
-    cmd->add_option("--out", o->out, "Trial file to write (default results/<recording>_<model>.h5)");
+    cmd->add_option("--out", o->out, "Trial file to write (default results/<recording>_<model>.h5)")
+        ->transform(output_path);
     cmd->footer(
         "Each scan is one model step at its pose: its points are rotated into the world frame (gravity-aligned),\n"
         "kept within the range limits, and each model reads the upper half (3-D presets) or the horizontal slice\n"
@@ -307,7 +308,8 @@ void add_localize(CLI::App& app) {
     o->recording.add_to(*cmd);
     o->preprocess.add_to(*cmd);
     cmd->add_option("--out", o->out, "Folder for localization.csv/.md, queries.csv, templates.csv, localization.png")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->transform(output_path);
     cmd->add_flag("--no-figure", o->no_figure, "Skip the figure");
     cmd->footer(
         "Each query is decoded to the template whose population vector is most cosine-similar; the error is the\n"
@@ -351,7 +353,6 @@ void add_localize(CLI::App& app) {
             templates = side(o->templates, o->template_poses);
             queries = side(o->queries, o->query_poses);
         }
-        const OutputLock lock = lock_output_folder(o->out);
 
         // Every model on each recording at once: one replay per recording, its scans read once.
         std::vector<ModelSpec> specs;
@@ -391,6 +392,7 @@ void add_localize(CLI::App& app) {
             row.result = analysis::localize(row.templates.rates, row.templates.xyz, row.queries.rates, row.queries.xyz);
             rows.push_back(std::move(row));
         }
+        const OutputLock lock = lock_output_folder(o->out);  // made only now: an error above leaves nothing
         write_localization(o->out, rows, bvc);
         std::printf("%-12s %7s %9s %8s %8s %6s %6s | %14s %12s | %14s %13s\n", "model", "queries", "templates",
                     "median_m", "mean_m", "<=1m", "<=2m", "chance_median", "chance_<=2m", "nearest_median",
@@ -437,7 +439,9 @@ void add_map(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--min-points", o->params.min_points, "Voxels with fewer points are left out")
         ->capture_default_str();
-    cmd->add_option("--out", o->out, "Map to write: .ply (binary, float) or .pcd (binary, float)")->required();
+    cmd->add_option("--out", o->out, "Map to write: .ply (binary, float) or .pcd (binary, float)")
+        ->required()
+        ->transform(output_path);
     cmd->footer(
         "The map is a point cloud in the recording's world frame; a world YAML draws it as spheres with a\n"
         "point_cloud object (docs/worlds.md#point-clouds), so that a simulated robot or sensor can use it.");
@@ -451,7 +455,14 @@ void add_map(CLI::App& app) {
         const auto start = std::chrono::steady_clock::now();
         for (std::size_t i = 0; i < rec->size(); ++i) {
             line.show(rec->name + " scan", i + 1, rec->size());
-            map.add(rec->load(i), rec->poses[i].world_from_sensor);
+            try {
+                map.add(rec->load(i), rec->poses[i].world_from_sensor);
+            } catch (const InputError& e) {  // a point out of reach: name the recording and the scan
+                const std::string text = e.what();
+                if (text.rfind("recording '", 0) == 0) throw;
+                throw InputError("recording '" + rec->name + "', scan " + std::to_string(i) + " (" +
+                                 rec->store->scan_name(i) + ")" + rec->pose_origin(i) + ": " + text);
+            }
         }
         line.done();
         const recording::PointCloud cloud = map.cloud();
@@ -490,7 +501,8 @@ void add_export_scans(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--out", o->out,
                     "Folder to write: 000000.<ext> ..., poses.txt, scans.txt; with ros1 or mcap, the bag file")
-        ->required();
+        ->required()
+        ->transform(output_path);
     cmd->add_option("--start-time", o->start_time,
                     "ros1, mcap: seconds added to every stamp (ROS takes a zero stamp for 'no time')")
         ->capture_default_str();
@@ -509,8 +521,14 @@ void add_export_scans(CLI::App& app) {
         if (o->hours && !(*o->hours > 0)) throw InputError("--hours must be positive");
         const World world(config::resolve_world(o->world, o->tilt, "+x+y"));
         const Lidar lidar(config::resolve_sensor(o->sensor));
-        const std::vector<ModelStep> steps =
-            o->hours ? random_walk(world, *o->hours, o->seed) : TrajectorySpec::from_file(o->trajectory).steps();
+        std::vector<ModelStep> steps;
+        if (o->hours) {
+            steps = random_walk(world, *o->hours, o->seed);
+        } else {
+            const TrajectorySpec path = TrajectorySpec::from_file(o->trajectory);
+            path.check_world(world.description());  // a row outside the world, named as `run` names it
+            steps = path.steps();
+        }
         const std::uint64_t noise_seed = hash_u64(o->seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
         std::vector<recording::PointCloud> clouds;
         std::vector<recording::PoseRecord> poses;

@@ -44,7 +44,9 @@ void add_route_command(CLI::App& app) {
     cmd->add_option("--speed", o->route.speed, "Cruising speed, m/s")->capture_default_str();
     cmd->add_option("--lateral-acceleration", o->route.lateral_acceleration, "At most this in turns, m/s^2")
         ->capture_default_str();
-    cmd->add_option("--out", o->out, "Trajectory file to write (t,x,y,z,heading rows)")->required();
+    cmd->add_option("--out", o->out, "Trajectory file to write (t,x,y,z,heading rows)")
+        ->required()
+        ->transform(output_path);
     cmd->footer(
         "The path joins the waypoints with circular arcs (speed^2/radius never above the lateral acceleration;\n"
         "tight corners are stops and turns in place), heading along the motion, one row per model step (0.288 s)\n"

@@ -59,7 +59,7 @@ void add_scan(CLI::App& app) {
     world->add_to(*cmd);
     cmd->add_option("--sensor", *sensor, "horizontal, spherical, or a sensor YAML file")->capture_default_str();
     cmd->add_option("--pose", *pose, "Robot pose X,Y,HEADING (m, m, rad; or e.g. 90deg)")->required();
-    cmd->add_option("--out", *out, "CSV file to write (default: standard output)");
+    cmd->add_option("--out", *out, "CSV file to write (default: standard output)")->transform(output_path);
     cmd->footer(
         "Ranges in meters from the sensor; azimuth is allocentric (0 = +x, counter-clockwise) and elevation\n"
         "positive up, both in radians. Beams with no hit within max_range are left out.");
@@ -87,7 +87,7 @@ void add_walk(CLI::App& app) {
     world->add_to(*cmd);
     cmd->add_option("--hours", *hours, "Simulated hours to walk")->capture_default_str()->check(non_negative_check);
     cmd->add_option("--seed", *seed, "Random seed, 0 .. 2^64 - 1")->capture_default_str()->check(seed_check);
-    cmd->add_option("--out", *out, "CSV file to write (default: standard output)");
+    cmd->add_option("--out", *out, "CSV file to write (default: standard output)")->transform(output_path);
     cmd->add_flag("--no-memory-check", *no_memory_check, no_memory_check_help);
     cmd->footer(
         "One row per model step: t in simulated seconds, position in meters, heading in radians,\n"

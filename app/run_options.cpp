@@ -15,7 +15,7 @@ const char* const jobs_help = "Trials in parallel; 0 (the default): one per core
 const char* const no_memory_check_help = "Run even when the estimated memory exceeds what the machine has available";
 
 CLI::Option* RunOptions::add_out(CLI::App& cmd, const std::string& help) {
-    auto* option = cmd.add_option("--out", out, help);
+    auto* option = cmd.add_option("--out", out, help)->transform(output_path);
     return out.empty() ? option : option->capture_default_str();
 }
 
@@ -66,15 +66,28 @@ std::string output_folder_text(const std::filesystem::path& folder) {
     return "output folder '" + folder.string() + "'";
 }
 
-OutputLock lock_output_folder(const std::filesystem::path& folder) {
-    ensure_writable_directory(folder);
-    return OutputLock(folder_lock_path(folder), output_folder_text(folder));
+OutputLock lock_output_folder(const std::filesystem::path& path) {
+    const auto folder = without_trailing_slash(path);
+    const auto created = ensure_writable_directory(folder);
+    try {
+        return OutputLock(folder_lock_path(folder), output_folder_text(folder), folder, created);
+    } catch (...) {
+        remove_empty_folders(folder, created);
+        throw;
+    }
 }
 
-OutputLock lock_output_file(const std::filesystem::path& file) {
+OutputLock lock_output_file(const std::filesystem::path& path) {
+    const auto file = without_trailing_slash(path);
     require_not_directory(file, "--out");
-    ensure_writable_directory(file.has_parent_path() ? file.parent_path() : ".");
-    return OutputLock(file_lock_path(file), "trial file '" + file.string() + "'");
+    const auto parent = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+    const auto created = ensure_writable_directory(parent);
+    try {
+        return OutputLock(file_lock_path(file), "trial file '" + file.string() + "'", parent, created);
+    } catch (...) {
+        remove_empty_folders(parent, created);
+        throw;
+    }
 }
 
 void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const ExperimentOutcome& outcome) {

@@ -153,7 +153,8 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")
         ->capture_default_str();
     cmd->add_option("--export", o->export_dir,
-                    "Write the page as static files into this (new) folder instead of serving it");
+                    "Write the page as static files into this (new) folder instead of serving it")
+        ->transform(output_path);
     cmd->add_option("--export-steps", o->export_steps,
                     "Samples per trial (or scans) whose returns and rates are exported")
         ->capture_default_str()

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d::view {
@@ -80,13 +81,15 @@ private:
 
 }  // namespace
 
-ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::path& out, std::size_t steps) {
+ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::path& target, std::size_t steps) {
+    const fs::path out = without_trailing_slash(target);
     std::error_code ec;
-    if (fs::exists(out, ec) && !fs::is_empty(out, ec))
-        throw InputError("export folder '" + out.string() + "' exists and is not empty");
-    const fs::path temp = out.string() + ".partial";
-    fs::remove_all(temp, ec);
-    fs::create_directories(temp / "data");
+    if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
+        throw InputError("export folder '" + out.string() + "' exists and is not an empty folder");
+    AtomicFolder folder(out);  // a new folder beside `out`, removed on an error
+    const fs::path& temp = folder.temp_path();
+    fs::create_directory(temp / "data", ec);
+    if (ec) throw InputError("cannot create '" + (temp / "data").string() + "': " + ec.message());
 
     ViewTarget shown = data.target();
     // A folder of trials exports the trials opened first, or all of them.
@@ -153,8 +156,7 @@ ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::pat
     if (at == std::string::npos) throw InputError("'" + (web_dir / "index.html").string() + "' lacks " + marker);
     html.replace(at, marker.size(), "<script src=\"data/index.js\"></script>");
     write_text(temp / "index.html", html);
-    fs::remove(out, ec);
-    fs::rename(temp, out);
+    folder.commit();
     return w.summary;
 }
 

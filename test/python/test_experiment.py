@@ -102,16 +102,26 @@ def test_report_module_works_on_its_own(paper_dir, tmp_path):
 def test_analyze_recomputes_the_stored_metrics(paper_dir, tmp_path):
     path = paper_dir / "cross-45_3d-0.2_seed0.h5"
     cells = tmp_path / "cells.csv"
-    proc = run_cli("analyze", path, "--cells", cells, check=True)
-    header, row = proc.stdout.splitlines()[:2]
-    names, values = header.split()[1:], [float(v) for v in row.split()[1:]]
+    table = tmp_path / "metrics.csv"
+    proc = run_cli("analyze", path, "--cells", cells, "--out", table, check=True)
+    assert max(len(line) for line in proc.stdout.splitlines()) <= 100  # a terminal can show it
+    (row,) = list(csv.DictReader(open(table)))
+    assert row["file"] == str(path) and row["min_samples"] == "20"
     with h5py.File(path) as f:
-        for n, v in zip(names, values):
-            assert v == pytest.approx(f["metrics"].attrs[n], rel=1e-5, nan_ok=True), n
+        names = [n for n in row if n in f["metrics"].attrs]
+        assert len(names) >= 10
+        for n in names:
+            if isinstance(f["metrics"].attrs[n], (str, bytes)):
+                assert row[n] == f["metrics"].attrs[n], n
+                continue
+            assert float(row[n]) == pytest.approx(f["metrics"].attrs[n], rel=1e-5, nan_ok=True), n
+            if list(row).index(n) < list(row).index("gridsize"):  # a metric (then the parameters used)
+                assert f" {n} " in proc.stdout
         mi = f["metrics/modality"][:]
     np.testing.assert_array_equal(np.genfromtxt(cells, delimiter=",", names=True)["modality"], mi)
-    other = run_cli("analyze", path, "--min-samples", 5, check=True).stdout.splitlines()[1]
-    assert other != row
+    run_cli("analyze", path, "--min-samples", 5, "--out", f"{table}/", check=True)  # recomputed, written
+    (other,) = list(csv.DictReader(open(table)))
+    assert other["min_samples"] == "5" and other != row
 
 
 def test_rerun_skips_complete_trials(paper_dir):
@@ -252,13 +262,16 @@ def test_python_run_trial_matches_the_cli(tmp_path):
 def test_analyze_starts_from_the_files_own_parameters(tmp_path):
     out = tmp_path / "arena.h5"
     run_cli("run", "--tilt", 45, "--hours", HOURS, "--extent", "arena", "--out", out, check=True)
-    row = run_cli("analyze", out, check=True).stdout.splitlines()[1].split()
+    table = tmp_path / "m.csv"
+    run_cli("analyze", out, "--out", table, check=True)
+    (row,) = list(csv.DictReader(open(table)))
     with h5py.File(out) as f:
-        assert float(row[1]) == pytest.approx(f["metrics"].attrs["frac_active"])
-        assert float(row[7]) == f["metrics"].attrs["n_bins"]
+        assert float(row["frac_active"]) == pytest.approx(f["metrics"].attrs["frac_active"])
+        assert float(row["n_bins"]) == f["metrics"].attrs["n_bins"]
         np.testing.assert_array_equal(f["metrics/extent"][:], [-5, 5, -5, 5])
-    data = run_cli("analyze", out, "--extent", "data", check=True).stdout.splitlines()[1].split()
-    assert data[7] != row[7]  # binned over the trajectory instead: another grid
+    run_cli("analyze", out, "--extent", "data", "--out", table, check=True)
+    (data,) = list(csv.DictReader(open(table)))
+    assert data["n_bins"] != row["n_bins"]  # binned over the trajectory instead: another grid
 
 
 def test_sigterm_checkpoints_like_ctrl_c(tmp_path):

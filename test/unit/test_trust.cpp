@@ -221,3 +221,47 @@ TEST(MeshChecks, ValidFilesPassAndTheHeaderMustMatchTheData) {
     EXPECT_NO_THROW(check_mesh_file("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n"));
     EXPECT_THROW(check_mesh_file("a.stl", std::string(84, '\0') + "x"), InputError);
 }
+
+// Issue 32: output paths with a trailing slash, and nothing left behind by an output not written.
+TEST(Outputs, TrailingSlashesNameTheFolderOrFile) {
+    EXPECT_EQ(without_trailing_slash("walk/"), fs::path("walk"));
+    EXPECT_EQ(without_trailing_slash("a/walk//"), fs::path("a/walk"));
+    EXPECT_EQ(without_trailing_slash("/"), fs::path("/"));
+    EXPECT_EQ(without_trailing_slash("walk.csv"), fs::path("walk.csv"));
+}
+
+TEST(Outputs, AnAtomicFolderLeavesNothingUnlessCommittedAndReplacesOnCommit) {
+    const fs::path dir = fresh_dir("atomic-folder");
+    {
+        AtomicFolder out(dir / "new" / "deeper" / "walk/");
+        std::ofstream(out.temp_path() / "a.txt") << "a";
+        EXPECT_TRUE(fs::exists(dir / "new" / "deeper"));
+    }  // an error before commit: the temporary and the folders made for it are gone
+    EXPECT_TRUE(fs::is_empty(dir));
+    fs::create_directories(dir / "walk");
+    std::ofstream(dir / "walk" / "old.txt") << "old";
+    {
+        AtomicFolder out(dir / "walk/");
+        std::ofstream(out.temp_path() / "new.txt") << "new";
+        out.commit();
+    }
+    EXPECT_TRUE(fs::exists(dir / "walk" / "new.txt"));
+    EXPECT_FALSE(fs::exists(dir / "walk" / "old.txt"));
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);
+    std::ofstream(dir / "file") << "x";
+    EXPECT_THROW(AtomicFolder(dir / "file" / "walk"), InputError);  // below a file: a clear error
+    fs::remove_all(dir);
+}
+
+TEST(Outputs, AFailedAtomicFileRemovesTheFoldersMadeForIt) {
+    const fs::path dir = fresh_dir("atomic-file");
+    { AtomicFile f(dir / "a" / "b" / "out.csv/"); }
+    EXPECT_TRUE(fs::is_empty(dir));
+    {
+        AtomicFile f(dir / "a" / "out.csv/");
+        f.write("x");
+        f.commit();
+    }
+    EXPECT_TRUE(fs::is_regular_file(dir / "a" / "out.csv"));
+    fs::remove_all(dir);
+}

@@ -176,8 +176,11 @@ void FlightSpec::check_world(const WorldDescription& world) const {
         const SphereCollider fits(world, flight_.radius);  // throws for a volume that cannot hold the body
         (void)fits;
     } catch (const InputError& e) {
-        if (world.file.empty() || dynamic_cast<const ConfigError*>(&e)) throw;
-        throw ConfigError(world.file, "flight_volume", e.what());
+        // The body is the trial's (flight.radius), the volume the world's: name both, the radius first.
+        if (dynamic_cast<const ConfigError*>(&e)) throw;
+        throw InputError("flight.radius " + format_number(flight_.radius) + " m: " + e.what() +
+                         "; give a smaller flight.radius or a larger flight_volume" +
+                         (world.file.empty() ? std::string() : " (world file '" + world.file + "')"));
     }
 }
 

@@ -112,12 +112,17 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             degrees = has("heading_deg");
             if (has("heading") == degrees)
                 throw InputError(at + "the header needs exactly one of 'heading' and 'heading_deg'");
-            for (const auto& c : columns)
+            for (std::size_t i = 0; i < columns.size(); ++i) {
+                const auto& c = columns[i];
                 if (c != "t" && c != "x" && c != "y" && c != "z" && c != "heading" && c != "heading_deg" &&
-                    c != "pitch" && c != "roll" && c != "pitch_deg" && c != "roll_deg")
-                    throw InputError(
-                        at + "unknown column '" + c +
-                        "' (known: t, x, y, z, heading or heading_deg, pitch or pitch_deg, roll or roll_deg)");
+                    c != "pitch" && c != "roll" && c != "pitch_deg" && c != "roll_deg" && c != "bumped")
+                    throw InputError(at + "unknown column '" + c +
+                                     "' (known: t, x, y, z, heading or heading_deg, pitch or pitch_deg, roll or "
+                                     "roll_deg; bumped, as bvc3d walk writes it, is read and left out)");
+                if (std::find(columns.begin(), columns.begin() + static_cast<std::ptrdiff_t>(i), c) !=
+                    columns.begin() + static_cast<std::ptrdiff_t>(i))
+                    throw InputError(at + "the header names the column '" + c + "' twice");
+            }
             if ((has("pitch") && has("pitch_deg")) || (has("roll") && has("roll_deg")))
                 throw InputError(at + "give each angle in radians or in degrees, not both");
             continue;

@@ -39,8 +39,8 @@ std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std:
 
 // A text file, comma- or whitespace-separated, `#` comments: columns t, x, y, heading or
 // t, x, y, z, heading; an optional header line names them (then in any order, `heading_deg` may
-// replace `heading`, and `pitch`/`roll` or `pitch_deg`/`roll_deg` may be added). Errors name the
-// file, the line and the reason.
+// replace `heading`, and `pitch`/`roll` or `pitch_deg`/`roll_deg` may be added; `bumped`, a column of
+// `bvc3d walk`'s output, is read and left out). Errors name the file, the line and the reason.
 std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path);
 
 // Writes steps as read_trajectory_file() reads them back, bit for bit: a header `t,x,y,z,heading`

@@ -82,10 +82,15 @@ std::vector<ModelStep> recording_steps(const recording::Recording& rec) {
         const auto& m = rec.poses[i].world_from_sensor;
         const Pose p = Pose::from_rotation(m.translation(), m.linear());
         t[i] = timed ? *rec.time(i) : static_cast<double>(i);
+        const auto where = [&] {
+            return "recording '" + rec.name + "', scan " + std::to_string(i) + rec.pose_origin(i);
+        };
         if (i > 0 && !(t[i] > t[i - 1]))
-            throw InputError("recording '" + rec.name + "', scan " + std::to_string(i) + ": its time " +
-                             format_number(t[i]) + " s does not follow the previous scan's " + format_number(t[i - 1]) +
-                             " s (scans must be in time order)");
+            throw InputError(where() + ": its time " + format_number(t[i]) + " s does not follow the previous scan's " +
+                             format_number(t[i - 1]) + " s (scans must be in time order)");
+        if (!(std::abs(p.x) <= 1e6 && std::abs(p.y) <= 1e6 && std::abs(p.z) <= 1e6))
+            throw InputError(where() + ": its position (" + format_number(p.x) + ", " + format_number(p.y) + ", " +
+                             format_number(p.z) + ") lies beyond ±1e6 m");
         x[i] = p.x;
         y[i] = p.y;
         z[i] = p.z;

@@ -41,12 +41,17 @@ private:
     char block_[1 << 16];
 };
 
-AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+namespace {
+std::filesystem::path parent_of(const std::filesystem::path& p) {
+    return p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+}
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(without_trailing_slash(target)) {
     require_not_directory(target_, "output file");
     temp_ = target_;
     temp_ += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    const auto dir = target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
-    ensure_writable_directory(dir);
+    created_ = ensure_writable_directory(parent_of(target_));
 }
 
 AtomicFile::~AtomicFile() {
@@ -56,6 +61,7 @@ AtomicFile::~AtomicFile() {
     if (committed_) return;
     std::error_code ec;
     std::filesystem::remove(temp_, ec);
+    remove_empty_folders(parent_of(target_), created_);
 }
 
 void AtomicFile::fail(int error) const {
@@ -124,7 +130,9 @@ void write_file_atomically(const std::filesystem::path& target, std::string_view
     file.commit();
 }
 
-void ensure_writable_directory(const std::filesystem::path& dir) {
+std::filesystem::path ensure_writable_directory(const std::filesystem::path& path) {
+    const std::filesystem::path dir = without_trailing_slash(path);
+    std::filesystem::path created;
     std::error_code ec;
     if (std::filesystem::exists(dir, ec)) {
         if (!std::filesystem::is_directory(dir, ec))
@@ -138,11 +146,70 @@ void ensure_writable_directory(const std::filesystem::path& dir) {
                                      "' is not a folder");
                 break;
             }
+        created = dir;
+        while (created.has_parent_path() && created.parent_path() != created &&
+               !std::filesystem::exists(created.parent_path(), ec))
+            created = created.parent_path();
         std::filesystem::create_directories(dir, ec);
         if (ec) throw InputError("cannot create output folder '" + dir.string() + "': " + ec.message());
     }
     if (::access(dir.c_str(), W_OK) != 0)
         throw InputError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+    return created;
+}
+
+void remove_empty_folders(const std::filesystem::path& dir, const std::filesystem::path& top) {
+    if (top.empty()) return;
+    std::error_code ec;
+    for (auto p = without_trailing_slash(dir); !p.empty(); p = p.parent_path()) {
+        if (!std::filesystem::remove(p, ec)) return;  // not empty (or gone): stop, as remove() only takes empty ones
+        if (p == top || !p.has_parent_path() || p.parent_path() == p) return;
+    }
+}
+
+std::filesystem::path without_trailing_slash(const std::filesystem::path& path) {
+    std::string s = path.string();
+    while (s.size() > 1 && s.back() == '/') s.pop_back();
+    return s;
+}
+
+AtomicFolder::AtomicFolder(const std::filesystem::path& target) : target_(without_trailing_slash(target)) {
+    std::error_code ec;
+    if (std::filesystem::exists(target_, ec) && !std::filesystem::is_directory(target_, ec))
+        throw InputError("output folder '" + target_.string() + "' exists and is not a folder");
+    created_ = ensure_writable_directory(parent_of(target_));
+    temp_ = target_;
+    temp_ += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    std::filesystem::remove_all(temp_, ec);
+    if (!std::filesystem::create_directory(temp_, ec))
+        throw InputError("cannot create '" + temp_.string() + "' for output folder '" + target_.string() +
+                         "': " + (ec ? ec.message() : std::string("it exists")));
+}
+
+AtomicFolder::~AtomicFolder() {
+    if (committed_) return;
+    std::error_code ec;
+    std::filesystem::remove_all(temp_, ec);
+    remove_empty_folders(parent_of(target_), created_);
+}
+
+void AtomicFolder::commit() {
+    std::error_code ec;
+    std::filesystem::path old;
+    if (std::filesystem::exists(target_, ec)) {
+        old = target_;
+        old += ".old" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+        std::filesystem::rename(target_, old, ec);
+        if (ec) throw InputError("cannot replace output folder '" + target_.string() + "': " + ec.message());
+    }
+    std::filesystem::rename(temp_, target_, ec);
+    if (ec) {
+        std::error_code back;
+        if (!old.empty()) std::filesystem::rename(old, target_, back);
+        throw InputError("cannot write output folder '" + target_.string() + "': " + ec.message());
+    }
+    committed_ = true;
+    if (!old.empty()) std::filesystem::remove_all(old, ec);
 }
 
 void require_not_directory(const std::filesystem::path& path, const std::string& what) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 
 namespace bvc3d {
@@ -31,7 +32,9 @@ std::string host_name() {
 
 }  // namespace
 
-OutputLock::OutputLock(std::filesystem::path lock_file, const std::string& what) : path_(std::move(lock_file)) {
+OutputLock::OutputLock(std::filesystem::path lock_file, const std::string& what, std::filesystem::path empty_dir,
+                       std::filesystem::path empty_top)
+    : path_(std::move(lock_file)), empty_dir_(std::move(empty_dir)), empty_top_(std::move(empty_top)) {
     // A holder that releases between our open and our flock removes the file it locked: then we
     // hold a lock on a name that is gone, and try again on the new file.
     for (int attempt = 0; attempt < 100; ++attempt) {
@@ -68,6 +71,7 @@ OutputLock::~OutputLock() {
     if (fd_ < 0) return;
     ::unlink(path_.c_str());  // while still holding it: a waiting process then retries on a new file
     ::close(fd_);
+    remove_empty_folders(empty_dir_, empty_top_);
 }
 
 std::filesystem::path folder_lock_path(const std::filesystem::path& folder) { return folder / ".bvc3d.lock"; }

@@ -12,7 +12,11 @@ class OutputLock {
 public:
     // Takes the lock file `lock_file` for `what` (e.g. "output folder 'results/paper'"); throws
     // InputError if another process holds it, naming `what`, the lock file and the holder.
-    OutputLock(std::filesystem::path lock_file, const std::string& what);
+    // On release, it also removes `empty_dir` and its parents up to `empty_top` if they are empty
+    // then: the folders made for an output that an error kept from being written
+    // (ensure_writable_directory's return; nothing when empty).
+    OutputLock(std::filesystem::path lock_file, const std::string& what, std::filesystem::path empty_dir = {},
+               std::filesystem::path empty_top = {});
     ~OutputLock();
     OutputLock(const OutputLock&) = delete;
     OutputLock& operator=(const OutputLock&) = delete;
@@ -20,7 +24,7 @@ public:
     const std::filesystem::path& path() const { return path_; }
 
 private:
-    std::filesystem::path path_;
+    std::filesystem::path path_, empty_dir_, empty_top_;
     int fd_ = -1;
 };
 

@@ -75,8 +75,9 @@ void write_mcap(const fs::path& file, const std::vector<PointCloud>& clouds, con
 
 }  // namespace
 
-void write_bag(const fs::path& file, const std::vector<PointCloud>& clouds, const std::vector<PoseRecord>& poses,
+void write_bag(const fs::path& target, const std::vector<PointCloud>& clouds, const std::vector<PoseRecord>& poses,
                const BagWriteOptions& o) {
+    const fs::path file = without_trailing_slash(target);
     if (clouds.size() != poses.size()) throw std::logic_error("write_bag: one pose per scan");
     if (clouds.empty()) throw InputError(quoted_path(file) + ": a bag needs at least one scan");
     for (std::size_t i = 0; i < poses.size(); ++i)
@@ -84,16 +85,20 @@ void write_bag(const fs::path& file, const std::vector<PointCloud>& clouds, cons
             throw InputError(quoted_path(file) + ": scan " + std::to_string(i) + " has no time after the previous");
     if (!(o.start + *poses.front().time > 0)) throw InputError("a bag's stamps must be positive: raise the start time");
     require_not_directory(file, "bag");
-    ensure_writable_directory(file.has_parent_path() ? file.parent_path() : fs::path("."));
     if (o.format == BagFormat::mcap) return write_mcap(file, clouds, poses, o);
+    const fs::path parent = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const fs::path created = ensure_writable_directory(parent);
     // rosbag writes its own file: into a temporary beside the target, renamed when complete.
     const fs::path temp = file.string() + ".tmp" + std::to_string(::getpid());
     try {
         write_ros1(temp, clouds, poses, o);
-        fs::rename(temp, file);
+        std::error_code ec;
+        fs::rename(temp, file, ec);
+        if (ec) throw InputError("cannot write " + quoted_path(file) + ": " + ec.message());
     } catch (...) {
         std::error_code ec;
         fs::remove(temp, ec);
+        remove_empty_folders(parent, created);
         throw;
     }
 }

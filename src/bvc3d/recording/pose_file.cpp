@@ -58,7 +58,7 @@ std::vector<PoseRecord> parse_kitti(const fs::path& file, const std::vector<Numb
     for (const NumberLine& line : lines) {
         check_value_count(file, line, 12, "a KITTI pose: the row-major 3x4 [R|t]");
         const double* v = line.values.data();
-        poses.push_back({from_rows(file, pose_ref(line, poses.size()), {v, v + 4, v + 8}), std::nullopt});
+        poses.push_back({from_rows(file, pose_ref(line, poses.size()), {v, v + 4, v + 8}), std::nullopt, line.line});
     }
     return poses;
 }
@@ -76,7 +76,7 @@ std::vector<PoseRecord> parse_tum(const fs::path& file, const std::vector<Number
             throw input_error(file, where,
                               "quaternion norm " + std::to_string(norm) + " is not 1 (within 1e-3): not a rotation");
         q.normalize();
-        poses.push_back({rigid(file, where, q.toRotationMatrix(), {v[1], v[2], v[3]}), v[0]});
+        poses.push_back({rigid(file, where, q.toRotationMatrix(), {v[1], v[2], v[3]}), v[0], line.line});
     }
     return poses;
 }
@@ -100,7 +100,7 @@ std::vector<PoseRecord> parse_matrix(const fs::path& file, const std::vector<Num
                               "the 4th row of a pose matrix must be 0 0 0 T (T the pose's time)");
         const std::array<const double*, 3> rows = {lines[first].values.data(), lines[first + 1].values.data(),
                                                    lines[first + 2].values.data()};
-        poses.push_back({from_rows(file, pose_ref(lines[first], poses.size()), rows), bottom[3]});
+        poses.push_back({from_rows(file, pose_ref(lines[first], poses.size()), rows), bottom[3], lines[first].line});
         all_times_one = all_times_one && bottom[3] == 1;
     }
     if (all_times_one)  // plain homogeneous matrices: no times

@@ -26,6 +26,7 @@ namespace bvc3d::recording {
 struct PoseRecord {
     Eigen::Isometry3d world_from_sensor = Eigen::Isometry3d::Identity();
     std::optional<double> time;  // seconds
+    std::size_t line = 0;        // its (first) line in the pose file it was read from; 0: not from a file
 };
 
 enum class PoseFormat { kitti, tum, matrix, detect };

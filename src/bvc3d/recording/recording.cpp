@@ -66,7 +66,12 @@ Recording open_recording(const fs::path& scans, const fs::path& poses, const Rec
     r.store = std::make_shared<ScanFiles>(r.scans, poses);
     std::vector<PoseRecord> all = read_poses(poses, options.pose_format);
     if (options.base_from_sensor) apply_extrinsics(all, *options.base_from_sensor);
-    const ScanPosePairing pairing = pair_scans_with_poses(scan_times(r.scans), all, options.time_tolerance);
+    ScanPosePairing pairing;
+    try {
+        pairing = pair_scans_with_poses(scan_times(r.scans), all, options.time_tolerance);
+    } catch (const InputError& e) {  // name the files paired
+        throw InputError("scans '" + scans.string() + "' with pose file '" + poses.string() + "': " + e.what());
+    }
     r.paired_by_time = pairing.by_time;
     for (const std::size_t i : pairing.pose_of_scan) r.poses.push_back(all[i]);
     return r;
@@ -81,6 +86,11 @@ PointCloud Recording::load(std::size_t i) const {
     } catch (const InputError& e) {
         throw InputError("recording '" + name + "', scan " + std::to_string(i) + ": " + e.what());
     }
+}
+
+std::string Recording::pose_origin(std::size_t i) const {
+    if (i >= poses.size() || poses[i].line == 0 || poses_source.empty()) return "";
+    return " (pose file '" + poses_source.string() + "', line " + std::to_string(poses[i].line) + ")";
 }
 
 std::optional<double> Recording::time(std::size_t i) const {
@@ -141,20 +151,9 @@ void write_recording(const fs::path& folder, const std::vector<PointCloud>& clou
                      const std::vector<PoseRecord>& poses, ScanWriteFormat format) {
     if (clouds.size() != poses.size()) throw std::logic_error("write_recording: one pose per scan");
     if (clouds.empty()) throw InputError("'" + folder.string() + "': a recording needs at least one scan");
-    check_replaceable(folder);
-    const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
-    ensure_writable_directory(parent);
-    const fs::path temp = folder.string() + ".tmp" + std::to_string(::getpid());
-    std::error_code ec;
-    fs::remove_all(temp, ec);
-    fs::create_directories(temp);
-    struct Cleanup {
-        fs::path dir;
-        ~Cleanup() {
-            std::error_code e;
-            if (!dir.empty()) fs::remove_all(dir, e);
-        }
-    } cleanup{temp};
+    check_replaceable(without_trailing_slash(folder));
+    AtomicFolder out(folder);
+    const fs::path& temp = out.temp_path();
 
     const bool timed = std::all_of(poses.begin(), poses.end(), [](const PoseRecord& p) { return p.time.has_value(); });
     std::string list;
@@ -186,12 +185,7 @@ void write_recording(const fs::path& folder, const std::vector<PointCloud>& clou
     if (timed) write_matrix_poses(temp / "poses.txt", poses);
     else write_kitti_poses(temp / "poses.txt", poses);
 
-    // Swap the new folder in; the old one (an earlier recording) goes only once the new one is there.
-    const fs::path old = folder.string() + ".old" + std::to_string(::getpid());
-    const bool had_old = fs::exists(folder, ec);
-    if (had_old) fs::rename(folder, old);
-    fs::rename(temp, folder);
-    cleanup.dir = had_old ? old : fs::path();
+    out.commit();  // an earlier recording goes only once the new one is there
 }
 
 }  // namespace bvc3d::recording

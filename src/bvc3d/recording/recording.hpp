@@ -45,6 +45,8 @@ struct Recording {
     std::size_t size() const { return scans.size(); }
     // Scan i's points in its sensor frame. Errors name the scan's index and file.
     PointCloud load(std::size_t i) const;
+    // Where scan i's pose was read, for messages: " (pose file 'P', line L)", or "" (a bag's).
+    std::string pose_origin(std::size_t i) const;
     // Scan i's time: the list's, else its pose's, else none.
     std::optional<double> time(std::size_t i) const;
     // Text that changes when the recording does: the pose file's bytes and each scan file's name
