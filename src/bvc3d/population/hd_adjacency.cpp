@@ -47,7 +47,6 @@ void HdAdjacency::learn(std::span<const double> place, std::span<const double> h
     const double gx = p_.eta / p_.tau_x, gu = p_.eta / p_.tau_hd;
     for (std::size_t i = 0; i < x_.size(); ++i) x_[i] += gx * (place[i] - x_[i]);
     for (std::size_t k = 0; k < u_.size(); ++k) u_[k] += gu * (hd[k] - u_[k]);
-    scale_ *= 1.0 - p_.decay;
     if (!bumped) {
         active_.clear();
         for (int i = 0; i < n_; ++i)
@@ -67,6 +66,7 @@ void HdAdjacency::learn(std::span<const double> place, std::span<const double> h
             }
         }
     }
+    scale_ *= 1.0 - p_.decay;
     if (scale_ < 1e-6) {
         for (float& w : m_) w = static_cast<float>(w * scale_);
         scale_ = 1.0;

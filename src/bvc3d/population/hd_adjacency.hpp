@@ -8,7 +8,7 @@
 //   x   += (η/τ_x)(v − x)                  trace of the place cells
 //   Υ   += (η/τ_hd)(v_hd − Υ)              trace of the HD cells
 //   W_rec[k] += a·Υ_k·(v xᵀ − x vᵀ)        for each HD cell k, skipped on a step that bumps
-//   W_rec[k] *= (1 − δ)                    every learning step (bumps too)
+//   W_rec[k] *= (1 − δ)                    every learning step (bumps too), after the update
 // so W_rec[k][i][j] > 0 says "i follows j when heading along k": antisymmetric, as each update is. The
 // traces are updated first and the update reads the new ones (SPEC's order). HD rates are SPEC §16's
 // cells, v_k = cos(h − 2πk/n_hd) (hd_rates below), unless a model gives an HD population.
