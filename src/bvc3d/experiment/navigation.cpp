@@ -37,7 +37,8 @@ const params::Table<NavigationParams>& NavigationParams::table() {
          real("clearance", &P::clearance, closed(0, 100), "m of free travel a direction needs"),
          integer("settle_steps", &P::settle_steps, closed(0, 1000), "place-cell steps at a start before moving"),
          real("path_cell", &P::path_cell, closed(0.01, 10), "m, the shortest path's grid"),
-         real("path_inflate", &P::path_inflate, closed(0, 100), "m, obstacles inflated for the shortest path")});
+         real("path_inflate", &P::path_inflate, closed(0, 100), "m, obstacles inflated for the shortest path"),
+         real("reward_map_cell", &P::reward_map_cell, closed(0, 100), "m between reward-map points; 0: no map")});
     return t;
 }
 
@@ -199,6 +200,19 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
         run.rewards.push_back(run.goal_cells[g] >= 0 ? replay(adj, run.goal_cells[g], s.reward)
                                                      : std::vector<double>(std::size_t(adj.n_place()), 0.0));
         const auto& w = run.rewards.back();
+        run.reward_maps.emplace_back();
+        if (nav.reward_map_cell > 0)
+            for (double y = bounds.min().y() + nav.reward_map_cell / 2; y < bounds.max().y(); y += nav.reward_map_cell)
+                for (double x = bounds.min().x() + nav.reward_map_cell / 2; x < bounds.max().x();
+                     x += nav.reward_map_cell) {
+                    const Vec2 q(x, y);
+                    if (!body->walkable().contains(q) || body->clearance(q) < 0) continue;
+                    senses.net.reset();
+                    std::vector<double> v;
+                    for (int k = 0; k < std::max(1, nav.settle_steps); ++k)
+                        v = senses.step(Pose::on_floor(x, y, 0.0), false);
+                    run.reward_maps.back().push_back({q, reward(w, v)});
+                }
         const int goal_part = parts[path_grid.index(*nearest_usable_cell(path_grid, goal, s.robot.radius))];
         Rng rng(hash_u64(seed, 0x6e617669676174ULL, g), Stream::walk);
         for (int i = 0; i < nav.starts; ++i) {

@@ -47,8 +47,9 @@ struct NavigationParams {
     double clearance = 1.0;           // m a direction needs
     int settle_steps = 5;             // place-cell steps at a start before the first decision
     // the yardstick (SPEC §17): A* on this grid, obstacles inflated by this
-    double path_cell = 0.1;     // m
-    double path_inflate = 0.5;  // m
+    double path_cell = 0.1;        // m
+    double path_inflate = 0.5;     // m
+    double reward_map_cell = 0.5;  // m between the points of the reward maps; 0: none
     static const params::Table<NavigationParams>& table();
     void validate() const { table().check(*this); }
 };
@@ -69,6 +70,12 @@ struct NavigationRun {
     std::vector<std::vector<double>> rewards;  // per goal, the reward cell's weights after replay
     std::vector<NavigationStart> starts;
     std::vector<Vec2> learn_path;  // positions of the learning walk (every 8th step)
+    // Per goal, the reward read-out r at points of a grid over the free floor, the place cells settled there.
+    struct MapPoint {
+        Vec2 p;
+        double reward;
+    };
+    std::vector<std::vector<MapPoint>> reward_maps;
 };
 
 struct NavigationSetup {
