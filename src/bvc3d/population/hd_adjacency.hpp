@@ -16,7 +16,8 @@
 // Memory: n_hd dense float32 matrices, n_hd·n²·4 bytes (8 HD cells: 2 MB for the paper's 250 place cells,
 // 128 MB for 2 000, 392 MB for 3 500): checked against the free memory before it is taken. The decay is a
 // common scale factor (W = scale·M, folded back into M when it falls below 10⁻⁶), and the update touches
-// only the rows and columns of the active cells: a step costs O(n_hd · active · n), not O(n_hd · n²).
+// only the rows and columns of the active cells: a step costs O(n_hd · active · n), not O(n_hd · n²). Products
+// W·x with few active cells read only their rows (W is antisymmetric), which makes a rollout cheap.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -70,6 +71,7 @@ private:
     AdjacencyParams p_;
     std::vector<float> m_;  // W_rec = scale_ · m_
     double scale_ = 1.0;
+    bool antisymmetric_ = true;  // as learned; a hand-made W need not be
     std::vector<double> x_, u_;
     std::vector<int> active_;
 };
