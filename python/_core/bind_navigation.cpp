@@ -139,8 +139,8 @@ HdAdjacency(n_place, **params); params and their defaults:
             if (g.ndim() != 2 || g.shape(1) != 2) throw InputError("goals must be an (N, 2) array of x, y");
             for (pyb::ssize_t i = 0; i < g.shape(0); ++i) s.goals.emplace_back(g.at(i, 0), g.at(i, 1));
             apply_navigation(s, kwargs);
-            const auto run =
-                interruptible([&](const std::atomic<bool>&) { return navigate(w, s, seed_of(seed, "seed")); });
+            const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
+            const auto run = interruptible([&](const std::atomic<bool>&) { return navigate(w, s, seed_value); });
             pyb::dict d;
             const auto n = pyb::ssize_t(run.starts.size());
             std::vector<double> gx, gy, sx, sy, path, shortest, time;

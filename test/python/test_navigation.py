@@ -146,3 +146,21 @@ def test_navigate_refuses_bad_goals(tmp_path, goals, named):
     assert r.returncode == 2, r.stderr
     assert named in r.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path():
+    world = bvc3d.World.cross()
+    kw = dict(max_learn_hours=0.2, starts=2, min_start_distance=3.0, goal_visits=1, reward_map_cell=0)
+    a = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, **kw)
+    b = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, **kw)
+    assert len(a["start_x"]) == 2
+    for key in ("start_x", "start_y", "path_m", "shortest_m", "time_s", "success"):
+        np.testing.assert_array_equal(a[key], b[key])
+    for i, path in enumerate(a["paths"]):
+        start = [a["start_x"][i], a["start_y"][i]]
+        assert np.hypot(start[0] - 3.5, start[1] - 3.5) >= 3.0
+        assert a["shortest_m"][i] == pytest.approx(bvc3d.shortest_path(world, start, [3.5, 3.5])["length"])
+        steps = np.hypot(*np.diff(path, axis=0).T)
+        assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
+    with pytest.raises(ValueError, match="goal 1"):
+        bvc3d.navigate(world, [[30.0, 0.0]])
