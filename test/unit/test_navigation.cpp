@@ -13,6 +13,7 @@
 #include "../support/temp_dir.hpp"
 
 #include "bvc3d/agent/shortest_path.hpp"
+#include "bvc3d/agent/voxel_path.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/navigation.hpp"
@@ -245,4 +246,55 @@ TEST(Navigation, RefusesGoalsOutsideInWallsOrNone) {
     EXPECT_THROW(check_goals(world, setup), InputError);
     setup.goals = {};
     EXPECT_THROW(check_goals(world, setup), InputError);
+}
+
+TEST(VoxelPath, MatchesBruteForceAndGoesRoundASlab) {
+    // 3-D relaxation (Bellman-Ford) with the same move rule: the box of a move must be free.
+    std::mt19937 gen(3);
+    for (int trial = 0; trial < 6; ++trial) {
+        VoxelGrid3 g{6, 5, 4, 0.5, {}};
+        g.free.resize(6 * 5 * 4);
+        for (auto& c : g.free) c = gen() % 100 >= 25;
+        g.free[0] = 1;
+        std::vector<double> d(g.free.size(), std::numeric_limits<double>::infinity());
+        d[0] = 0;
+        for (bool changed = true; changed;) {
+            changed = false;
+            for (int z = 0; z < g.nz; ++z)
+                for (int y = 0; y < g.ny; ++y)
+                    for (int x = 0; x < g.nx; ++x)
+                        for (int dz = -1; dz <= 1; ++dz)
+                            for (int dy = -1; dy <= 1; ++dy)
+                                for (int dx = -1; dx <= 1; ++dx) {
+                                    if ((dx | dy | dz) == 0 || !g.usable(x, y, z)) continue;
+                                    bool ok = true;
+                                    for (int ez = std::min(0, dz); ez <= std::max(0, dz); ++ez)
+                                        for (int ey = std::min(0, dy); ey <= std::max(0, dy); ++ey)
+                                            for (int ex = std::min(0, dx); ex <= std::max(0, dx); ++ex)
+                                                ok = ok && g.usable(x + ex, y + ey, z + ez);
+                                    if (!ok) continue;
+                                    const double via = d[g.index(x + dx, y + dy, z + dz)] +
+                                                       0.5 * std::sqrt(double(dx * dx + dy * dy + dz * dz));
+                                    if (via < d[g.index(x, y, z)] - 1e-12) d[g.index(x, y, z)] = via, changed = true;
+                                }
+        }
+        for (int z = 0; z < g.nz; ++z)
+            for (int y = 0; y < g.ny; ++y)
+                for (int x = 0; x < g.nx; ++x) {
+                    if (!g.usable(x, y, z)) continue;
+                    const auto p = voxel_shortest_path(g, {0, 0, 0}, {x, y, z});
+                    ASSERT_EQ(p.has_value(), std::isfinite(d[g.index(x, y, z)])) << trial;
+                    if (p) {
+                        EXPECT_NEAR(*p, d[g.index(x, y, z)], 1e-9) << trial;
+                    }
+                }
+    }
+    // A floor-to-ceiling slab at x = 2 with one hole at the top (z = 3): up, through, down.
+    VoxelGrid3 g{5, 1, 4, 1.0, std::vector<char>(20, 1)};
+    for (int z = 0; z < 3; ++z) g.free[g.index(2, 0, z)] = 0;
+    // (0,0,0) → (1,0,3)? The box rule forbids diagonals past the slab's edge: (0,0,0)→(1,0,1)→(1,0,2)→(1,0,3)
+    // →(2,0,3)→(3,0,3)→(3,0,2)→(3,0,1)→(4,0,0): √2 + 1 + 1 + 1 + 1 + 1 + 1 + √2 = 6 + 2√2.
+    EXPECT_NEAR(*voxel_shortest_path(g, {0, 0, 0}, {4, 0, 0}), 6 + 2 * std::sqrt(2.0), 1e-9);
+    g.free[g.index(2, 0, 3)] = 0;
+    EXPECT_FALSE(voxel_shortest_path(g, {0, 0, 0}, {4, 0, 0}).has_value());
 }
