@@ -36,6 +36,7 @@ def main():
     ap.add_argument("--learn-hours", type=float, default=15)
     ap.add_argument("--models", default="2d,3d-3l")
     ap.add_argument("--worlds", default="nav-open,nav-cross,nav-maze,nav-wall,cross-0,cross-60")
+    ap.add_argument("--prefix", default="", help="prefix of the files written (a partial run beside the main one)")
     a = ap.parse_args()
     rows, summary = [], []
     for world in a.worlds.split(","):
@@ -51,7 +52,7 @@ def main():
             with open(out / "summary.csv", newline="") as f:
                 summary += list(csv.DictReader(f))
     for name, table in (("starts.csv", rows), ("summary.csv", summary)):
-        with open(HERE / name, "w", newline="") as f:
+        with open(HERE / (a.prefix + name), "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(table[0].keys()))
             w.writeheader()
             w.writerows(table)
@@ -76,7 +77,7 @@ def main():
         ax.set_ylabel(label)
         ax.legend()
     fig.tight_layout()
-    fig.savefig(HERE / "results.png", dpi=110)
+    fig.savefig(HERE / (a.prefix + "results.png"), dpi=110)
 
 
 if __name__ == "__main__":
