@@ -13,5 +13,6 @@ void add_recording_commands(CLI::App& app);   // cmd_recording.cpp: replay, loca
 void add_view_command(CLI::App& app);         // view/cmd_view.cpp
 void add_adaptive_command(CLI::App& app);     // cmd_adaptive.cpp: choose-elevations
 void add_route_command(CLI::App& app);        // cmd_route.cpp: route, tour
+void add_navigate_command(CLI::App& app);     // cmd_navigate.cpp
 
 }  // namespace bvc3d::cli

@@ -17,3 +17,5 @@ __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording",
            "choose_elevations", "flying_walk", "localize", "metric_table", "model_presets", "model_sensor",
            "random_walk", "read_trajectory", "replay_simulated", "run_trial"]
 __all__ += ["lidar_models", "route", "tour", "write_trajectory"]
+from ._core import HdAdjacency, navigate, reward_readout, shortest_path
+__all__ += ["HdAdjacency", "navigate", "reward_readout", "shortest_path"]

@@ -1,6 +1,10 @@
 #include "bvc3d/agent/free_space_grid.hpp"
 
 #include <cmath>
+#include <string>
+#include <utility>
+
+#include "bvc3d/core/error.hpp"
 
 namespace bvc3d {
 
@@ -15,6 +19,13 @@ FreeSpaceGrid::FreeSpaceGrid(const BodyCollider& body, double cell, double max_c
         const Vec2 p = center(cell_at(i));
         if (body.walkable().contains(p)) room_[i] = static_cast<float>(std::max(0.0, body.room(p)));
     }
+}
+
+FreeSpaceGrid::FreeSpaceGrid(const Vec2& origin, double cell, int nx, int ny, std::vector<float> rooms)
+    : origin_(origin), cell_(cell), nx_(nx), ny_(ny), room_(std::move(rooms)) {
+    if (nx < 1 || ny < 1 || !(cell > 0) || room_.size() != static_cast<std::size_t>(nx) * ny)
+        throw InputError("free-space grid: " + std::to_string(nx) + " × " + std::to_string(ny) + " cells of " +
+                         std::to_string(cell) + " m do not fit " + std::to_string(room_.size()) + " rooms");
 }
 
 std::optional<GridCell> FreeSpaceGrid::cell_of(const Vec2& p) const {

@@ -21,6 +21,8 @@ public:
     // Cells of `cell` m over the walkable region's bounds (coarsened for very large floors: at most
     // `max_cells` cells).
     FreeSpaceGrid(const BodyCollider& body, double cell = 0.1, double max_cells = 4e7);
+    // A grid of nx × ny cells from `origin` with given rooms (row-major, y outer): hand-made grids for tests.
+    FreeSpaceGrid(const Vec2& origin, double cell, int nx, int ny, std::vector<float> rooms);
 
     double cell() const { return cell_; }
     int nx() const { return nx_; }

@@ -1,0 +1,84 @@
+"""Navigation results for docs/navigation.md: runs `bvc3d navigate` per world and model, gathers every start into
+docs/navigation/starts.csv and the per-goal summaries into docs/navigation/summary.csv, and draws
+docs/navigation/results.png (success rate and path ratio per world and model).
+
+Run from the repository root after building: /usr/bin/python3 docs/navigation/make.py [--seeds N] [--starts N]
+[--learn-hours H] [--models 2d,3d-3l] [--worlds nav-open,...]. Each run's own folder (paths, reward maps, figures)
+is kept in build/navigation/.
+"""
+import argparse
+import csv
+import pathlib
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HERE = ROOT / "docs" / "navigation"
+GOALS = {"nav-open": "7,7;-7,7;-7,-7;7,-7", "nav-cross": "7,7;-7,7;-7,-7;7,-7", "nav-maze": "7,7;-7,7;-7,-7;7,-7",
+         "nav-wall": "-2,2", "cross-0": "3.5,3.5;-3.5,-3.5", "cross-60": "3.5,3.5;-3.5,-3.5"}
+
+
+def world_arg(name):
+    file = ROOT / "configs" / "worlds" / f"{name}.yaml"
+    return str(file) if file.exists() else name
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--starts", type=int, default=20)
+    ap.add_argument("--learn-hours", type=float, default=15)
+    ap.add_argument("--models", default="2d,3d-3l")
+    ap.add_argument("--worlds", default="nav-open,nav-cross,nav-maze,nav-wall,cross-0,cross-60")
+    ap.add_argument("--prefix", default="", help="prefix of the files written (a partial run beside the main one)")
+    a = ap.parse_args()
+    rows, summary = [], []
+    for world in a.worlds.split(","):
+        for model in a.models.split(","):
+            out = ROOT / "build" / "navigation" / f"{world}-{model}"
+            cmd = [str(ROOT / "build" / "bvc3d"), "navigate", "--world", world_arg(world), "--goals", GOALS[world],
+                   "--model", model, "--seeds", str(a.seeds), "--starts", str(a.starts), "--max-learn-hours",
+                   str(a.learn_hours), "--out", str(out)]
+            print(" ".join(cmd), file=sys.stderr, flush=True)
+            subprocess.run(cmd, check=True)
+            with open(out / "starts.csv", newline="") as f:
+                rows += list(csv.DictReader(f))
+            with open(out / "summary.csv", newline="") as f:
+                summary += list(csv.DictReader(f))
+    for name, table in (("starts.csv", rows), ("summary.csv", summary)):
+        with open(HERE / (a.prefix + name), "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(table[0].keys()))
+            w.writeheader()
+            w.writerows(table)
+    # Per world and model over all goals and learning runs: success rate, path ratio of the reached starts.
+    worlds = list(dict.fromkeys(r["world"] for r in rows))
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
+    width = 0.8 / len(models)
+    for m, model in enumerate(models):
+        rate, med, lo, hi = [], [], [], []
+        for world in worlds:
+            mine = [r for r in rows if r["world"] == world and r["model"] == model]
+            ok = [float(r["path_ratio"]) for r in mine if r["success"] == "1"]
+            rate.append(100 * len(ok) / max(len(mine), 1))
+            q = np.percentile(ok, [25, 50, 75]) if ok else [np.nan] * 3
+            lo.append(q[1] - q[0]), med.append(q[1]), hi.append(q[2] - q[1])
+        x = np.arange(len(worlds)) + m * width
+        ax1.bar(x, rate, width, label=model)
+        ax2.bar(x, med, width, yerr=[lo, hi], label=model, capsize=3)
+    for ax, label in ((ax1, "success (%)"), (ax2, "path ratio of reached starts\n(median, quartiles)")):
+        ax.set_xticks(np.arange(len(worlds)) + 0.4 - width / 2, worlds, rotation=20)
+        ax.set_ylabel(label)
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(HERE / (a.prefix + "results.png"), dpi=110)
+
+
+if __name__ == "__main__":
+    main()

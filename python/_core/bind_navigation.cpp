@@ -1,0 +1,182 @@
+// Navigation to goals (docs/navigation.md): the HD-conditioned adjacency, replay and the choice of direction by
+// hand, the shortest path of SPEC §17, and a whole navigation run.
+#include "bindings.hpp"
+
+#include "bvc3d/agent/body_collider.hpp"
+#include "bvc3d/agent/shortest_path.hpp"
+#include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/experiment/navigation.hpp"
+
+namespace bvc3d::py {
+
+namespace {
+
+std::vector<double> vector_of(const pyb::handle& obj, const std::string& name, std::size_t n) {
+    const auto a = real_array(obj, name);
+    if (a.ndim() != 1 || std::size_t(a.shape(0)) != n)
+        throw InputError(name + " must be a 1-D array of " + std::to_string(n) + " values");
+    return {a.data(), a.data() + n};
+}
+
+Vec2 point_of(const pyb::handle& obj, const std::string& name) {
+    const auto v = vector_of(obj, name, 2);
+    return {v[0], v[1]};
+}
+
+RewardParams reward_of(const pyb::kwargs& kwargs) {
+    RewardParams p;
+    apply_kwargs(p, RewardParams::table(), kwargs);
+    return p;
+}
+
+// Keywords to whichever table names them: navigation, reward, adjacency.
+void apply_navigation(NavigationSetup& s, const pyb::kwargs& kwargs) {
+    pyb::kwargs a, b, c;
+    for (const auto& [k, v] : kwargs) {
+        const std::string key = pyb::str(k);
+        if (RewardParams::table().find(key)) b[k] = v;
+        else if (AdjacencyParams::table().find(key) && !NavigationParams::table().find(key)) c[k] = v;
+        else a[k] = v;
+    }
+    apply_kwargs(s.nav, NavigationParams::table(), a);
+    apply_kwargs(s.reward, RewardParams::table(), b);
+    apply_kwargs(s.adjacency, AdjacencyParams::table(), c);
+}
+
+}  // namespace
+
+void bind_navigation(pyb::module_& m) {
+    auto cls = pyb::class_<HdAdjacency>(m, "HdAdjacency",
+                                        (R"doc(
+The HD-conditioned adjacency of place cells (SPEC §16, docs/navigation.md): one transition matrix per HD cell.
+HdAdjacency(n_place, **params); params and their defaults:
+)doc" + describe(AdjacencyParams::table(), AdjacencyParams{}))
+                                            .c_str());
+    cls.def(pyb::init([](int n_place, const pyb::kwargs& kwargs) {
+                AdjacencyParams p;
+                apply_kwargs(p, AdjacencyParams::table(), kwargs);
+                return HdAdjacency(n_place, p);
+            }),
+            pyb::arg("n_place"))
+        .def(
+            "learn",
+            [](HdAdjacency& a, const pyb::object& place, const pyb::object& hd, bool bumped) {
+                a.learn(vector_of(place, "place", std::size_t(a.n_place())), vector_of(hd, "hd", std::size_t(a.n_hd())),
+                        bumped);
+            },
+            pyb::arg("place"), pyb::arg("hd"), pyb::arg("bumped") = false,
+            "One learning step: place-cell rates (n_place,), HD rates (n_hd,)")
+        .def_property(
+            "weights",
+            [](const HdAdjacency& a) {
+                const int n = a.n_place(), h = a.n_hd();
+                std::vector<double> w(std::size_t(h) * n * n);
+                for (int k = 0; k < h; ++k)
+                    for (int i = 0; i < n; ++i)
+                        for (int j = 0; j < n; ++j) w[(std::size_t(k) * n + i) * n + j] = a.weight(k, i, j);
+                return to_numpy(w.data(), {h, n, n});
+            },
+            [](HdAdjacency& a, const pyb::object& obj) {
+                const auto w = real_array_f32(obj, "weights");
+                a.set_weights({w.data(), std::size_t(w.size())});
+            },
+            "W_rec as an (n_hd, n_place, n_place) array; W_rec[k, i, j] > 0: i follows j heading along k")
+        .def_property_readonly("place_trace",
+                               [](const HdAdjacency& a) { return to_numpy(a.place_trace().data(), {a.n_place()}); })
+        .def_property_readonly("hd_trace",
+                               [](const HdAdjacency& a) { return to_numpy(a.hd_trace().data(), {a.n_hd()}); })
+        .def(
+            "replay",
+            [](const HdAdjacency& a, int goal_cell, const pyb::kwargs& kwargs) {
+                const auto w = replay(a, goal_cell, reward_of(kwargs));
+                return to_numpy(w.data(), {a.n_place()});
+            },
+            pyb::arg("goal_cell"),
+            ("The reward cell's weights after replay from place cell goal_cell (SPEC §17). Keywords:\n" +
+             describe(RewardParams::table(), RewardParams{}))
+                .c_str())
+        .def(
+            "direction_returns",
+            [](const HdAdjacency& a, const pyb::object& w, const pyb::object& v, const pyb::kwargs& kwargs) {
+                const auto n = std::size_t(a.n_place());
+                const auto r = direction_returns(a, vector_of(w, "w", n), vector_of(v, "v", n), reward_of(kwargs));
+                return to_numpy(r.data(), {a.n_hd()});
+            },
+            pyb::arg("w"), pyb::arg("v"), "Each HD direction's rollout return R_k from place-cell rates v (SPEC §17)");
+    m.def(
+        "reward_readout",
+        [](const pyb::object& w, const pyb::object& v) {
+            const auto wv = real_array(w, "w");
+            const auto n = std::size_t(wv.size());
+            return reward(vector_of(w, "w", n), vector_of(v, "v", n));
+        },
+        pyb::arg("w"), pyb::arg("v"), "r = w·v / max(|v|₁, 1e-4)");
+    m.def(
+        "shortest_path",
+        [](const World& w, const pyb::object& start, const pyb::object& goal, double cell, double inflate) {
+            const RobotParams robot;
+            const BodyCollider body(w.description(), robot.radius, robot.height);
+            const FreeSpaceGrid grid(body, cell);
+            const auto p = shortest_path(grid, point_of(start, "start"), point_of(goal, "goal"), inflate);
+            pyb::dict d;
+            d["found"] = p.found;
+            d["length"] = p.length;
+            std::vector<double> xy;
+            for (const Vec2& q : p.points) xy.push_back(q.x()), xy.push_back(q.y());
+            d["points"] = to_numpy(xy.data(), {pyb::ssize_t(p.points.size()), 2});
+            return d;
+        },
+        pyb::arg("world"), pyb::arg("start"), pyb::arg("goal"), pyb::arg("cell") = 0.1, pyb::arg("inflate") = 0.5,
+        "SPEC §17's shortest path (A* on a grid of `cell` m, obstacles inflated by `inflate` m): dict found, length "
+        "(m), points (N, 2)");
+    m.def(
+        "navigate",
+        [](const World& w, const pyb::object& goals, const std::string& model, const pyb::object& seed,
+           const pyb::kwargs& kwargs) {
+            NavigationSetup s;
+            s.model = config::resolve_model(model);
+            const auto g = real_array(goals, "goals");
+            if (g.ndim() != 2 || g.shape(1) != 2) throw InputError("goals must be an (N, 2) array of x, y");
+            for (pyb::ssize_t i = 0; i < g.shape(0); ++i) s.goals.emplace_back(g.at(i, 0), g.at(i, 1));
+            apply_navigation(s, kwargs);
+            const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
+            const auto run = interruptible([&](const std::atomic<bool>&) { return navigate(w, s, seed_value); });
+            pyb::dict d;
+            const auto n = pyb::ssize_t(run.starts.size());
+            std::vector<double> gx, gy, sx, sy, path, shortest, time;
+            std::vector<int> goal, success;
+            pyb::list paths;
+            for (const auto& st : run.starts) {
+                goal.push_back(st.goal), success.push_back(st.success);
+                gx.push_back(s.goals[std::size_t(st.goal)].x()), gy.push_back(s.goals[std::size_t(st.goal)].y());
+                sx.push_back(st.start.x()), sy.push_back(st.start.y());
+                path.push_back(st.path_m), shortest.push_back(st.shortest_m), time.push_back(st.time_s);
+                std::vector<double> xy;
+                for (const Vec2& q : st.path) xy.push_back(q.x()), xy.push_back(q.y());
+                paths.append(to_numpy(xy.data(), {pyb::ssize_t(st.path.size()), 2}));
+            }
+            d["goal"] = to_numpy(goal.data(), {n});
+            d["goal_x"] = to_numpy(gx.data(), {n});
+            d["goal_y"] = to_numpy(gy.data(), {n});
+            d["start_x"] = to_numpy(sx.data(), {n});
+            d["start_y"] = to_numpy(sy.data(), {n});
+            d["success"] = to_numpy(success.data(), {n}).attr("astype")("bool");
+            d["path_m"] = to_numpy(path.data(), {n});
+            d["shortest_m"] = to_numpy(shortest.data(), {n});
+            d["time_s"] = to_numpy(time.data(), {n});
+            d["paths"] = paths;
+            d["learn_s"] = run.learn_s;
+            d["coverage"] = run.coverage;
+            d["visits"] = run.visits;
+            d["goal_cells"] = run.goal_cells;
+            return d;
+        },
+        pyb::arg("world"), pyb::arg("goals"), pyb::arg("model") = "2d", pyb::arg("seed") = 0,
+        ("One navigation run (docs/navigation.md): learning, then starts per goal. dict of arrays, one entry per "
+         "start (goal, goal_x, goal_y, start_x, start_y, success, path_m, shortest_m, time_s, paths), and learn_s, "
+         "coverage, visits, goal_cells. Keywords (navigation, reward and adjacency parameters):\n" +
+         describe(NavigationParams::table(), NavigationParams{}) + describe(RewardParams::table(), RewardParams{}))
+            .c_str());
+}
+
+}  // namespace bvc3d::py

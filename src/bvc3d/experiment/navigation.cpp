@@ -1,0 +1,262 @@
+#include "bvc3d/experiment/navigation.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "bvc3d/agent/body_collider.hpp"
+#include "bvc3d/agent/free_space_grid.hpp"
+#include "bvc3d/agent/goal_seeking_walk.hpp"
+#include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/agent/shortest_path.hpp"
+#include "bvc3d/bvc/boundary_vector_layer.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/place/place_cell_network.hpp"
+#include "bvc3d/sensor/lidar.hpp"
+
+namespace bvc3d {
+
+const params::Table<NavigationParams>& NavigationParams::table() {
+    using namespace params;
+    using P = NavigationParams;
+    static const Table<P> t(
+        "navigation",
+        {real("coverage", &P::coverage, closed(0, 1), "learning ends once this fraction of free cells is visited"),
+         real("coverage_cell", &P::coverage_cell, closed(0.05, 100), "m, cells counted for coverage"),
+         integer("goal_visits", &P::goal_visits, closed(0, 1000000), "and each goal has been entered this often"),
+         real("goal_radius", &P::goal_radius, closed(0.01, 100), "m, a goal's radius while learning"),
+         real("max_learn_hours", &P::max_learn_hours, open_closed(0, max_agent_hours), "or after this much time"),
+         integer("starts", &P::starts, closed(1, 1000000), "starts per goal"),
+         real("min_start_distance", &P::min_start_distance, closed(0, 1e4), "m, a start's least distance to goal"),
+         real("success_radius", &P::success_radius, closed(0.01, 100), "m, reached when this close to the goal"),
+         real("max_path_ratio", &P::max_path_ratio, above(1), "fail when the path reaches this × the shortest"),
+         real("max_hours", &P::max_hours, open_closed(0, max_agent_hours), "fail after this much time per start"),
+         real("step", &P::step, closed(0.01, 10), "m per decision"),
+         real("clearance", &P::clearance, closed(0, 100), "m of free travel a direction needs"),
+         integer("settle_steps", &P::settle_steps, closed(0, 1000), "place-cell steps at a start before moving"),
+         real("path_cell", &P::path_cell, closed(0.01, 10), "m, the shortest path's grid"),
+         real("path_inflate", &P::path_inflate, closed(0, 100), "m, obstacles inflated for the shortest path"),
+         real("reward_map_cell", &P::reward_map_cell, closed(0, 100), "m between reward-map points; 0: no map")});
+    return t;
+}
+
+namespace {
+
+std::string goal_text(std::size_t i, const Vec2& g) {
+    return "goal " + std::to_string(i + 1) + " (" + format_number(g.x()) + ", " + format_number(g.y()) + ")";
+}
+
+// The label of the part of the floor p lies in (-1 if none), on cells where the body fits.
+int part_of(const FreeSpaceGrid& grid, const std::vector<int>& parts, const Vec2& p) {
+    const auto c = grid.cell_of(p);
+    return c ? parts[grid.index(*c)] : -1;
+}
+
+// The largest part: the one the walk roams.
+int largest_part(const std::vector<int>& parts, int count) {
+    std::vector<std::size_t> n(std::size_t(std::max(count, 1)), 0);
+    for (int l : parts)
+        if (l >= 0) ++n[std::size_t(l)];
+    return count > 0 ? static_cast<int>(std::max_element(n.begin(), n.end()) - n.begin()) : -1;
+}
+
+std::vector<double> to_double(std::span<const float> v) { return {v.begin(), v.end()}; }
+
+// The model's senses: the sensor's scan at a pose, the BVC rates, one place-cell step.
+struct Senses {
+    const World& world;
+    Lidar lidar;
+    BoundaryVectorLayer layer;
+    PlaceCellNetwork net;
+    Scan scan;
+    std::vector<double> bvc;
+    Senses(const World& w, const ModelSpec& m, std::uint64_t seed)
+        : world(w),
+          lidar(m.sensor),
+          layer(m.bvc),
+          net(static_cast<int>(layer.n_cells()), m.place, seed),
+          bvc(layer.n_cells()) {}
+    std::vector<double> step(const Pose& pose, bool learn) {
+        lidar.scan(world, pose, scan);
+        layer.rates(scan, bvc);
+        return to_double(net.step(bvc, learn));
+    }
+};
+
+// SPEC §17's choice: softmax(β·R) over the offered directions, sampled.
+class RewardPolicy : public DirectionPolicy {
+public:
+    RewardPolicy(const HdAdjacency& adj, const std::vector<double>& w, const std::vector<double>& v,
+                 const RewardParams& p, Rng& rng)
+        : adj_(adj), w_(w), v_(v), p_(p), rng_(rng) {}
+    int choose(const Pose&, std::span<const char> allowed) override {
+        const auto returns = direction_returns(adj_, w_, v_, p_);
+        const auto prob = softmax(returns, p_.beta, {allowed.begin(), allowed.end()});
+        const double u = rng_.uniform();
+        double sum = 0;
+        int last = -1;
+        for (std::size_t d = 0; d < prob.size(); ++d) {
+            if (!allowed[d]) continue;
+            last = static_cast<int>(d);
+            if (u < (sum += prob[d])) return last;
+        }
+        return last;
+    }
+
+private:
+    const HdAdjacency& adj_;
+    const std::vector<double>& w_;
+    const std::vector<double>& v_;
+    RewardParams p_;
+    Rng& rng_;
+};
+
+}  // namespace
+
+void check_goals(const World& world, const NavigationSetup& s) {
+    if (s.goals.empty()) throw InputError("navigation: no goals given");
+    const BodyCollider body(world.description(), s.robot.radius, s.robot.height);
+    const FreeSpaceGrid grid(body, s.nav.path_cell);
+    int count = 0;
+    const auto parts = grid.parts(s.robot.radius, count);
+    const int main = largest_part(parts, count);
+    for (std::size_t i = 0; i < s.goals.size(); ++i) {
+        const Vec2& g = s.goals[i];
+        if (!std::isfinite(g.x()) || !std::isfinite(g.y()) || !body.walkable().contains(g))
+            throw InputError("navigation: " + goal_text(i, g) + " lies outside the world's walkable floor");
+        if (body.clearance(g) < 0)
+            throw InputError("navigation: " + goal_text(i, g) +
+                             " lies in or against a wall (the robot's body, radius " + format_number(s.robot.radius) +
+                             " m, does not fit there)");
+        const auto c = nearest_usable_cell(grid, g, s.robot.radius);
+        if (!c || parts[grid.index(*c)] != main)
+            throw InputError("navigation: " + goal_text(i, g) +
+                             " cannot be reached from the floor the robot walks (a closed-off pocket)");
+    }
+}
+
+NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64_t seed,
+                       const std::function<void(const NavigationStart&)>& progress) {
+    s.nav.validate();
+    s.reward.validate();
+    s.model.validate();
+    check_goals(world, s);
+    const NavigationParams& nav = s.nav;
+    auto body = std::make_shared<const BodyCollider>(world.description(), s.robot.radius, s.robot.height);
+    const FreeSpaceGrid path_grid(*body, nav.path_cell);
+    const FreeSpaceGrid cover_grid(*body, nav.coverage_cell);
+    Senses senses(world, s.model, seed);
+    HdAdjacency adj(senses.net.n_place(), s.adjacency);
+    NavigationRun run;
+    const std::size_t n_goals = s.goals.size();
+    run.visits.assign(n_goals, 0);
+    run.goal_cells.assign(n_goals, -1);
+
+    // Learning.
+    int n_cover_parts = 0;
+    const auto cover_parts = cover_grid.parts(s.robot.radius, n_cover_parts);
+    const int cover_main = largest_part(cover_parts, n_cover_parts);
+    std::size_t free_cells = 0, covered = 0;
+    for (int l : cover_parts) free_cells += l == cover_main;
+    std::vector<char> visited(cover_grid.size(), 0);
+    std::vector<char> inside(n_goals, 0);
+    std::vector<double> best(n_goals, 0.0);
+    const auto walk = RandomWalkSpec(s.robot).make(&world, seed);
+    const double learn_end = nav.max_learn_hours * 3600;
+    for (std::int64_t k = 0;; ++k) {
+        const auto step = walk->next(learn_end);
+        if (!step) break;
+        const Vec2 p(step->pose.x, step->pose.y);
+        const auto v = senses.step(step->pose, true);
+        adj.learn(v, hd_rates(step->pose.heading, adj.n_hd()), step->bumped);
+        if (k % 8 == 0) run.learn_path.push_back(p);
+        if (const auto c = cover_grid.cell_of(p); c && !visited[cover_grid.index(*c)]) {
+            visited[cover_grid.index(*c)] = 1;
+            covered += cover_parts[cover_grid.index(*c)] == cover_main;
+        }
+        bool goals_done = true;
+        for (std::size_t g = 0; g < n_goals; ++g) {
+            const bool in = (p - s.goals[g]).norm() <= nav.goal_radius;
+            if (in && !inside[g]) ++run.visits[g];
+            inside[g] = in;
+            if (in)
+                for (std::size_t i = 0; i < v.size(); ++i)
+                    if (v[i] > best[g]) best[g] = v[i], run.goal_cells[g] = static_cast<int>(i);
+            goals_done = goals_done && run.visits[g] >= nav.goal_visits;
+        }
+        run.learn_s = step->t;
+        run.coverage = free_cells ? double(covered) / double(free_cells) : 1.0;
+        if (goals_done && run.coverage >= nav.coverage) break;
+    }
+
+    // Exploitation.
+    int n_parts = 0;
+    const auto parts = path_grid.parts(s.robot.radius, n_parts);
+    const auto bounds = body->walkable().bounds();
+    for (std::size_t g = 0; g < n_goals; ++g) {
+        const Vec2 goal = s.goals[g];
+        run.rewards.push_back(run.goal_cells[g] >= 0 ? replay(adj, run.goal_cells[g], s.reward)
+                                                     : std::vector<double>(std::size_t(adj.n_place()), 0.0));
+        const auto& w = run.rewards.back();
+        run.reward_maps.emplace_back();
+        if (nav.reward_map_cell > 0)
+            for (double y = bounds.min().y() + nav.reward_map_cell / 2; y < bounds.max().y(); y += nav.reward_map_cell)
+                for (double x = bounds.min().x() + nav.reward_map_cell / 2; x < bounds.max().x();
+                     x += nav.reward_map_cell) {
+                    const Vec2 q(x, y);
+                    if (!body->walkable().contains(q) || body->clearance(q) < 0) continue;
+                    senses.net.reset();
+                    std::vector<double> v;
+                    for (int k = 0; k < std::max(1, nav.settle_steps); ++k)
+                        v = senses.step(Pose::on_floor(x, y, 0.0), false);
+                    run.reward_maps.back().push_back({q, reward(w, v)});
+                }
+        const int goal_part = parts[path_grid.index(*nearest_usable_cell(path_grid, goal, s.robot.radius))];
+        Rng rng(hash_u64(seed, 0x6e617669676174ULL, g), Stream::walk);
+        for (int i = 0; i < nav.starts; ++i) {
+            NavigationStart out;
+            out.goal = static_cast<int>(g);
+            Vec2 p;
+            for (int tries = 0;; ++tries) {
+                if (tries > 100000)
+                    throw InputError("navigation: no start at least " + format_number(nav.min_start_distance) +
+                                     " m from " + goal_text(g, goal) + " on its floor");
+                p = Vec2(rng.uniform(bounds.min().x(), bounds.max().x()),
+                         rng.uniform(bounds.min().y(), bounds.max().y()));
+                if ((p - goal).norm() >= nav.min_start_distance && body->walkable().contains(p) &&
+                    body->clearance(p) >= 0.05 && part_of(path_grid, parts, p) == goal_part)
+                    break;
+            }
+            out.start = p;
+            out.shortest_m = shortest_path(path_grid, p, goal, nav.path_inflate).length;
+            senses.net.reset();
+            Pose pose = Pose::on_floor(p.x(), p.y(), rng.uniform(-pi, pi));
+            std::vector<double> v;
+            for (int k = 0; k < std::max(1, nav.settle_steps); ++k) v = senses.step(pose, false);
+            RewardPolicy policy(adj, w, v, s.reward, rng);
+            GoalSeekingWalk agent(body, s.robot, {adj.n_hd(), nav.step, nav.clearance}, policy, pose);
+            out.path.push_back(p);
+            while (true) {
+                const Vec2 here(agent.pose().x, agent.pose().y);
+                if ((here - goal).norm() <= nav.success_radius) {
+                    out.success = true;
+                    break;
+                }
+                if (agent.travelled() >= nav.max_path_ratio * out.shortest_m) break;
+                const auto step = agent.next(nav.max_hours * 3600);
+                if (!step) break;
+                v = senses.step(step->pose, false);
+                out.path.emplace_back(step->pose.x, step->pose.y);
+            }
+            out.path_m = agent.travelled();
+            out.time_s = agent.time();
+            if (progress) progress(out);
+            run.starts.push_back(std::move(out));
+        }
+    }
+    return run;
+}
+
+}  // namespace bvc3d

@@ -1,0 +1,98 @@
+#pragma once
+// Experiment stage: navigation to goals (SPEC §17, docs/navigation.md), the closed loop from place cells to
+// motion. Takes: a world, a model (its sensor, BVC layer and place cells), goals on the floor and a seed.
+// Gives: per goal, its reward cell; per start, whether and how the agent reached the goal, against the
+// shortest path (agent/shortest_path.hpp).
+//
+// Learning: the paper's random walk (agent/random_walk.hpp) while the place cells learn (Oja) and the
+// HD-conditioned adjacency learns (population/hd_adjacency.hpp), until `coverage` of the free cells of
+// `coverage_cell` m are visited and each goal has been entered `goal_visits` times (goal radius), or
+// `max_learn_hours`. The place cell most active inside a goal's radius during learning is its reward
+// cell. Exploitation, per goal: replay from the reward cell (population/reward_cells.hpp); from each of
+// `starts` random starts at least `min_start_distance` m from the goal (Euclidean, in the goal's part of
+// the floor), the agent (agent/goal_seeking_walk.hpp) chooses each 0.25 m move by softmax(β·R) over the
+// directions' rollout returns R, sampled from its seeded stream, until it is within `success_radius` of
+// the goal, or its path reaches `max_path_ratio` × the shortest path, or `max_hours` pass.
+//
+// The place cells here are one network (the paper's). A model with several scales plugs in by giving,
+// per scale, a place-cell population and its adjacency; the choice then combines the scales' returns
+// (SPEC §17: softmax(2·score)), see docs/navigation.md#multiscale.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/core/params.hpp"
+#include "bvc3d/population/hd_adjacency.hpp"
+#include "bvc3d/population/reward_cells.hpp"
+#include "bvc3d/world/world.hpp"
+
+namespace bvc3d {
+
+struct NavigationParams {
+    // learning
+    double coverage = 0.95;       // fraction of free cells visited
+    double coverage_cell = 0.5;   // m
+    int goal_visits = 10;         // entries into each goal's radius
+    double goal_radius = 0.7;     // m
+    double max_learn_hours = 15;  // simulated
+    // exploitation
+    int starts = 20;                  // per goal
+    double min_start_distance = 6.0;  // m from the goal
+    double success_radius = 1.0;      // m
+    double max_path_ratio = 10.0;     // fail when the path reaches this × the shortest
+    double max_hours = 5.0;           // simulated, per start
+    double step = 0.25;               // m per decision
+    double clearance = 1.0;           // m a direction needs
+    int settle_steps = 5;             // place-cell steps at a start before the first decision
+    // the yardstick (SPEC §17): A* on this grid, obstacles inflated by this
+    double path_cell = 0.1;        // m
+    double path_inflate = 0.5;     // m
+    double reward_map_cell = 0.5;  // m between the points of the reward maps; 0: none
+    static const params::Table<NavigationParams>& table();
+    void validate() const { table().check(*this); }
+};
+
+struct NavigationStart {
+    int goal = 0;  // index into the goals
+    Vec2 start{0, 0};
+    bool success = false;
+    double path_m = 0, shortest_m = 0, time_s = 0;
+    std::vector<Vec2> path;  // positions after each move, from the start
+};
+
+struct NavigationRun {
+    double learn_s = 0;                        // simulated learning time
+    double coverage = 0;                       // reached
+    std::vector<int> visits;                   // per goal
+    std::vector<int> goal_cells;               // per goal, -1 if never visited
+    std::vector<std::vector<double>> rewards;  // per goal, the reward cell's weights after replay
+    std::vector<NavigationStart> starts;
+    std::vector<Vec2> learn_path;  // positions of the learning walk (every 8th step)
+    // Per goal, the reward read-out r at points of a grid over the free floor, the place cells settled there.
+    struct MapPoint {
+        Vec2 p;
+        double reward;
+    };
+    std::vector<std::vector<MapPoint>> reward_maps;
+};
+
+struct NavigationSetup {
+    ModelSpec model;
+    std::vector<Vec2> goals;
+    NavigationParams nav;
+    AdjacencyParams adjacency;
+    RewardParams reward;
+    RobotParams robot;
+};
+
+// InputError naming each goal outside the walkable floor, where the body does not fit, or that cannot be
+// reached from the others' part of the floor; and for no goals.
+void check_goals(const World& world, const NavigationSetup& setup);
+
+// One learning run and its exploitation. `progress` (if set) is told of each finished start.
+NavigationRun navigate(const World& world, const NavigationSetup& setup, std::uint64_t seed,
+                       const std::function<void(const NavigationStart&)>& progress = {});
+
+}  // namespace bvc3d

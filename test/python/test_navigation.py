@@ -1,0 +1,166 @@
+"""Navigation to goals (docs/navigation.md) against a numpy transcription of SPEC §16-§17: the HD-conditioned
+adjacency's update on a hand-made sequence, replay and the reward read-out on a hand-made chain of cells, the
+direction choice, the shortest path against the arena's geometry, and `bvc3d navigate` on bad input."""
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import bvc3d
+
+from conftest import CLI
+
+
+def hd(heading, n=8):
+    return np.cos(heading - 2 * np.pi * np.arange(n) / n)
+
+
+def adjacency_numpy(sequence, n, eta=0.096, tau_x=3.0, tau_hd=0.1, rate=0.3, decay=1e-4):
+    """SPEC §16 written out: traces first, then the antisymmetric update (not on bumps), then the decay."""
+    W = np.zeros((8, n, n))
+    x = np.zeros(n)
+    u = np.zeros(8)
+    for v, heading, bumped in sequence:
+        x += eta / tau_x * (v - x)
+        u += eta / tau_hd * (hd(heading) - u)
+        if not bumped:
+            W += rate * u[:, None, None] * (np.outer(v, x) - np.outer(x, v))[None]
+        W *= 1 - decay
+    return W, x, u
+
+
+def test_adjacency_update_matches_numpy_on_a_hand_made_sequence():
+    rng = np.random.default_rng(4)
+    n = 6
+    sequence = []
+    for t in range(40):
+        v = np.zeros(n)
+        cells = rng.choice(n, size=2, replace=False)
+        v[cells] = rng.uniform(0.1, 1.0, size=2)
+        sequence.append((v, rng.uniform(-np.pi, np.pi), t % 7 == 3))
+    adj = bvc3d.HdAdjacency(n)
+    for v, heading, bumped in sequence:
+        adj.learn(v, hd(heading), bumped)
+    W, x, u = adjacency_numpy(sequence, n)
+    scale = np.abs(W).max()
+    assert scale > 0.01
+    np.testing.assert_allclose(adj.weights, W, atol=1e-6 * scale, rtol=1e-5)
+    np.testing.assert_allclose(adj.weights, -np.transpose(adj.weights, (0, 2, 1)), atol=1e-7 * scale)
+    np.testing.assert_allclose(adj.place_trace, x, rtol=1e-12)
+    np.testing.assert_allclose(adj.hd_trace, u, rtol=1e-12)
+
+
+def chain(n):
+    W = np.zeros((8, n, n), dtype=np.float32)
+    for i in range(n - 1):
+        W[0, i + 1, i], W[0, i, i + 1] = 1, -1
+        W[4, i, i + 1], W[4, i + 1, i] = 1, -1
+    return W
+
+
+# The C library's tanh, as the library calls it: numpy's own tanh may differ in the last bit, and replay's
+# hundreds of steps of tanh([·]+) amplify such differences (to 1e-6 relative at λ = 20, 1e-3 at 60).
+libm_tanh = np.vectorize(math.tanh)
+
+
+def replay_numpy(W, goal, lam=20.0):
+    n = W.shape[1]
+    amp = 5 / lam
+    w = np.zeros(n)
+    x = np.zeros(n)
+    x[goal] = 1
+    for t in range(math.ceil(8 * lam) + 1):
+        norm = np.linalg.norm(x)
+        if norm == 0:
+            break
+        w += amp * np.exp(-t / lam) * x / norm
+        x = libm_tanh(np.maximum((W.astype(float) @ x).max(axis=0) + x, 0))
+    return w
+
+
+def reward_numpy(w, v):
+    return w @ v / max(np.abs(v).sum(), 1e-4)
+
+
+def returns_numpy(W, w, v, steps=3, gamma=0.7):
+    out = np.zeros(8)
+    for k in range(8):
+        x = v.copy()
+        for t in range(steps):
+            x = libm_tanh(np.maximum(W[k].astype(float) @ x - x, 0))
+            out[k] += gamma**t * reward_numpy(w, x)
+    return out
+
+
+@pytest.mark.parametrize("lam", [20.0, 30.0, 60.0])
+def test_replay_and_reward_readout_match_numpy_on_a_chain(lam):
+    n = 30
+    adj = bvc3d.HdAdjacency(n)
+    adj.weights = chain(n)
+    w = adj.replay(n - 1, **{"lambda": lam})
+    expected = replay_numpy(chain(n), n - 1, lam)
+    np.testing.assert_allclose(w, expected, rtol=1e-10)
+    if lam == 20.0:  # the default: value falls with the distance from the goal (longer replays fill the chain)
+        assert np.all(np.diff(w[-12:]) > 0)
+    v = np.zeros(n)
+    v[[17, 18]] = [0.3, 0.6]
+    assert bvc3d.reward_readout(w, v) == pytest.approx(reward_numpy(w, v), rel=1e-12)
+    assert bvc3d.reward_readout(w, np.zeros(n)) == 0.0
+
+
+def test_direction_returns_match_numpy_and_point_to_the_goal():
+    n = 30
+    adj = bvc3d.HdAdjacency(n)
+    adj.weights = chain(n)
+    w = adj.replay(n - 1)
+    v = np.zeros(n)
+    v[20] = 1.0
+    r = adj.direction_returns(w, v)
+    np.testing.assert_allclose(r, returns_numpy(chain(n), w, v), rtol=1e-10)
+    assert np.argmax(r) == 0  # east, along the chain toward the goal
+
+
+def test_shortest_path_in_the_cross_arena_goes_round_the_wall():
+    world = bvc3d.World.cross()
+    # Straight across the open corner: the segment's own length, on the 0.1 m grid's octile moves (≤ 8 % longer).
+    p = bvc3d.shortest_path(world, [-4.0, 4.0], [-2.0, 4.0])
+    assert p["found"] and p["length"] == pytest.approx(2.0, abs=0.15)
+    # From one side of wall A to the other (x = -2, y = ±1.5): every path crosses y = 0 beyond the wall's end
+    # inflated by 0.5 m (x ≤ -4.0), so at least 2·hypot(2, 1.5) = 5 m. The polyline (-2, -1.5), (-4, -0.65),
+    # (-4, 0.65), (-2, 1.5) keeps 0.5 m from the wall (|y| ≤ 0.15) and is 5.646 m; 8-neighbour moves make a path up
+    # to 8.24 % longer than a straight one (octile metric), plus a cell at each end.
+    p = bvc3d.shortest_path(world, [-2.0, -1.5], [-2.0, 1.5])
+    polyline = 2 * math.hypot(2.0, 0.85) + 1.3
+    assert p["found"] and 5.0 <= p["length"] <= polyline * 1.0824 + 0.2
+
+
+def run(*args):
+    return subprocess.run([CLI, *args], capture_output=True, text=True)
+
+
+@pytest.mark.parametrize("goals, named", [("30,0", "goal 1 (30, 0)"), ("2,2;0,0.1", "goal 2 (0, 0.1)"),
+                                          ("", "no goals")])
+def test_navigate_refuses_bad_goals(tmp_path, goals, named):
+    r = run("navigate", "--world", "cross", "--goals", goals, "--out", str(tmp_path / "out"))
+    assert r.returncode == 2, r.stderr
+    assert named in r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path():
+    world = bvc3d.World.cross()
+    kw = dict(max_learn_hours=0.2, starts=2, min_start_distance=3.0, goal_visits=1, reward_map_cell=0)
+    a = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, **kw)
+    b = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, **kw)
+    assert len(a["start_x"]) == 2
+    for key in ("start_x", "start_y", "path_m", "shortest_m", "time_s", "success"):
+        np.testing.assert_array_equal(a[key], b[key])
+    for i, path in enumerate(a["paths"]):
+        start = [a["start_x"][i], a["start_y"][i]]
+        assert np.hypot(start[0] - 3.5, start[1] - 3.5) >= 3.0
+        assert a["shortest_m"][i] == pytest.approx(bvc3d.shortest_path(world, start, [3.5, 3.5])["length"])
+        steps = np.hypot(*np.diff(path, axis=0).T)
+        assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
+    with pytest.raises(ValueError, match="goal 1"):
+        bvc3d.navigate(world, [[30.0, 0.0]])

@@ -1,0 +1,91 @@
+// Navigation (docs/navigation.md#speed): one exploitation decision — the rollouts of every HD direction through a
+// learned adjacency — and a whole decision with the sensor, BVCs and place cells, for the paper's 250 place cells and
+// for adjacencies of the authors' multiscale sizes (2 000 / 1 000 / 500 cells per scale; learned here on a
+// synthetic walk of sparse place fields, the multiscale network itself not being in the library yet).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "bvc3d/bvc/boundary_vector_layer.hpp"
+#include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/place/place_cell_network.hpp"
+#include "bvc3d/population/reward_cells.hpp"
+#include "bvc3d/sensor/lidar.hpp"
+
+using namespace bvc3d;
+
+namespace {
+
+// n cells with fields on a 20 × 20 m floor; rates of a point: the cells within 1 m, Gaussian.
+struct Fields {
+    std::vector<double> cx, cy;
+    explicit Fields(int n) {
+        Rng rng(1, Stream::walk);
+        for (int i = 0; i < n; ++i) cx.push_back(rng.uniform(-10, 10)), cy.push_back(rng.uniform(-10, 10));
+    }
+    std::vector<double> rates(double x, double y, double width) const {
+        std::vector<double> v(cx.size(), 0.0);
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            const double d2 = (cx[i] - x) * (cx[i] - x) + (cy[i] - y) * (cy[i] - y);
+            if (d2 < 4 * width * width) v[i] = std::exp(-d2 / (2 * width * width));
+        }
+        return v;
+    }
+};
+
+struct Learned {
+    Fields fields;
+    HdAdjacency adj;
+    std::vector<double> w;
+    double width;
+    Learned(int n, double width_) : fields(n), adj(n), width(width_) {
+        Rng rng(2, Stream::walk);
+        double x = 0, y = 0, h = 0;
+        for (int t = 0; t < 20000; ++t) {
+            h += rng.normal(0, 0.3);
+            x = std::clamp(x + 0.144 * std::cos(h), -10.0, 10.0), y = std::clamp(y + 0.144 * std::sin(h), -10.0, 10.0);
+            adj.learn(fields.rates(x, y, width), hd_rates(h), false);
+        }
+        const auto v = fields.rates(7, 7, width);
+        w = replay(adj, static_cast<int>(std::max_element(v.begin(), v.end()) - v.begin()));
+    }
+};
+
+void BM_DirectionChoice(benchmark::State& state) {
+    const int n = static_cast<int>(state.range(0));
+    const double width = n >= 2000 ? 0.5 : n >= 1000 ? 1.0 : 1.5;
+    static std::map<int, std::unique_ptr<Learned>> cache;
+    auto& l = cache[n];
+    if (!l) l = std::make_unique<Learned>(n, width);
+    const auto v = l->fields.rates(-3, -2, width);
+    for (auto _ : state) benchmark::DoNotOptimize(direction_returns(l->adj, l->w, v));
+    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DirectionChoice)->Arg(250)->Arg(500)->Arg(1000)->Arg(2000)->Unit(benchmark::kMicrosecond);
+
+// A whole decision of the paper's 2d model: scan, BVCs, one place-cell step, the rollouts.
+void BM_DecisionWithModel(benchmark::State& state) {
+    const World world = World::cross();
+    const ModelSpec model = model_preset("2d");
+    const Lidar lidar(model.sensor);
+    const BoundaryVectorLayer layer(model.bvc);
+    PlaceCellNetwork net(static_cast<int>(layer.n_cells()), model.place, 0);
+    static Learned l(250, 1.5);
+    Scan scan;
+    std::vector<double> bvc(layer.n_cells());
+    for (auto _ : state) {
+        lidar.scan(world, Pose::on_floor(-3, -2, 0), scan);
+        layer.rates(scan, bvc);
+        const auto p = net.step(bvc, false);
+        const std::vector<double> v(p.begin(), p.end());
+        benchmark::DoNotOptimize(direction_returns(l.adj, l.w, v));
+    }
+    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DecisionWithModel)->Unit(benchmark::kMicrosecond);
+
+}  // namespace

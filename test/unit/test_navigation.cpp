@@ -1,0 +1,300 @@
+// Navigation to goals (SPEC §17, docs/navigation.md): the shortest path against hand-made grids and a brute-force
+// relaxation, the HD-conditioned adjacency's update, replay and the choice of direction on a hand-made chain of
+// cells, and a closed-loop run that reaches a goal in sight, the same for the same seed. (The update and replay
+// against numpy: test/python/test_navigation.py.)
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+
+#include "../support/temp_dir.hpp"
+
+#include "bvc3d/agent/shortest_path.hpp"
+#include "bvc3d/agent/voxel_path.hpp"
+#include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/experiment/navigation.hpp"
+#include "bvc3d/population/reward_cells.hpp"
+
+using namespace bvc3d;
+
+namespace {
+
+// Distances between usable cell centres by relaxing every edge until nothing changes (Bellman-Ford): shares
+// nothing with A* but the move rules (8 neighbours, a diagonal only when both cells beside it are usable).
+std::vector<double> brute_force(const std::vector<char>& ok, int nx, int ny, int from, double h) {
+    std::vector<double> d(ok.size(), std::numeric_limits<double>::infinity());
+    d[std::size_t(from)] = 0;
+    const auto usable = [&](int x, int y) {
+        return x >= 0 && y >= 0 && x < nx && y < ny && ok[std::size_t(y * nx + x)];
+    };
+    for (bool changed = true; changed;) {
+        changed = false;
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                if (!usable(x, y)) continue;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        if ((dx == 0 && dy == 0) || !usable(x + dx, y + dy)) continue;
+                        if (dx != 0 && dy != 0 && !(usable(x + dx, y) && usable(x, y + dy))) continue;
+                        const double via = d[std::size_t((y + dy) * nx + x + dx)] + h * std::hypot(dx, dy);
+                        if (via < d[std::size_t(y * nx + x)] - 1e-12) d[std::size_t(y * nx + x)] = via, changed = true;
+                    }
+            }
+    }
+    return d;
+}
+
+FreeSpaceGrid grid_of(const std::vector<char>& ok, int nx, int ny, double h) {
+    std::vector<float> rooms(ok.size());
+    for (std::size_t i = 0; i < ok.size(); ++i) rooms[i] = ok[i] ? 1.0f : 0.0f;
+    return FreeSpaceGrid(Vec2(0, 0), h, nx, ny, rooms);
+}
+
+}  // namespace
+
+TEST(ShortestPath, GoesAroundAHandMadeWall) {
+    // 12 × 7 cells of 1 m; a wall at column 5 from row 0 to row 4: from (0, 0) to (11, 0) the path climbs to row 5.
+    const int nx = 12, ny = 7;
+    std::vector<char> ok(nx * ny, 1);
+    for (int y = 0; y <= 4; ++y) ok[std::size_t(y * nx + 5)] = 0;
+    const auto grid = grid_of(ok, nx, ny, 1.0);
+    const auto path = shortest_path(grid, {0.5, 0.5}, {11.5, 0.5}, 0.5);
+    ASSERT_TRUE(path.found);
+    // By hand: (0,0) → (4,5) is 4 diagonals and 1 straight; (4,5) → (6,5) straight (the corner rule forbids cutting
+    // past the wall's top end); (6,5) → (11,0) 5 diagonals: 9√2 + 3.
+    const auto d = brute_force(ok, nx, ny, 0, 1.0);
+    EXPECT_NEAR(path.length, d[11], 1e-9);
+    EXPECT_NEAR(path.length, 9 * std::sqrt(2.0) + 3, 1e-9);
+    for (const Vec2& p : path.points) EXPECT_FALSE(p.x() > 5 && p.x() < 6 && p.y() < 5) << p.transpose();
+}
+
+TEST(ShortestPath, MatchesBruteForceOnRandomGrids) {
+    std::mt19937 gen(7);
+    for (int trial = 0; trial < 20; ++trial) {
+        const int nx = 9 + trial % 5, ny = 8 + trial % 3;
+        std::vector<char> ok(std::size_t(nx * ny));
+        for (auto& c : ok) c = gen() % 100 >= 30;
+        ok[0] = 1;
+        const auto grid = grid_of(ok, nx, ny, 0.1);
+        const auto d = brute_force(ok, nx, ny, 0, 0.1);
+        for (int to = 0; to < nx * ny; ++to) {
+            if (!ok[std::size_t(to)]) continue;
+            const Vec2 b = grid.center(grid.cell_at(std::size_t(to)));
+            const auto path = shortest_path(grid, grid.center({0, 0}), b, 0.5);
+            ASSERT_EQ(path.found, std::isfinite(d[std::size_t(to)])) << trial << " " << to;
+            if (path.found) {
+                EXPECT_NEAR(path.length, d[std::size_t(to)], 1e-9) << trial << " " << to;
+            }
+        }
+    }
+}
+
+TEST(ShortestPath, JoinsEndsOutsideUsableCellsAndRefusesUnreachable) {
+    const int nx = 10, ny = 3;
+    std::vector<char> ok(nx * ny, 1);
+    ok[std::size_t(1 * nx + 0)] = 0;  // (0, 1) unusable: a point there is joined to its nearest usable cell
+    const auto grid = grid_of(ok, nx, ny, 1.0);
+    const auto path = shortest_path(grid, {0.5, 1.4}, {9.5, 1.5}, 0.5);
+    ASSERT_TRUE(path.found);
+    // Nearest usable centre to (0.5, 1.4) is (0.5, 0.5) (0.9 away; (1.5, 1.5) is 1.005 away), then the grid.
+    const auto d = brute_force(ok, nx, ny, 0, 1.0);
+    EXPECT_NEAR(path.length, 0.9 + d[std::size_t(1 * nx + 9)], 1e-9);
+    for (int y = 0; y < ny; ++y) ok[std::size_t(y * nx + 5)] = 0;  // a wall across: no path
+    EXPECT_FALSE(shortest_path(grid_of(ok, nx, ny, 1.0), {0.5, 0.5}, {9.5, 0.5}, 0.5).found);
+    EXPECT_FALSE(shortest_path(grid, {-3, 0.5}, {9.5, 0.5}, 0.5).found);  // outside the grid
+}
+
+TEST(HdAdjacency, UpdateIsAntisymmetricSkipsBumpsAndDecays) {
+    AdjacencyParams p;
+    HdAdjacency adj(3, p);
+    // Cell 0 then cell 1 fire while heading east (HD cell 0 fully on).
+    const auto east = hd_rates(0.0);
+    adj.learn(std::vector<double>{1, 0, 0}, east, false);
+    adj.learn(std::vector<double>{0, 1, 0}, east, false);
+    EXPECT_GT(adj.weight(0, 1, 0), 0);  // 1 follows 0 heading east
+    for (int k = 0; k < 8; ++k)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) EXPECT_FLOAT_EQ(adj.weight(k, i, j), -adj.weight(k, j, i));
+    EXPECT_LT(adj.weight(4, 1, 0), 0);  // heading west the same sequence runs backwards
+    const double before = adj.weight(0, 1, 0);
+    adj.learn(std::vector<double>{0, 0, 1}, east, true);  // a bump: no update, only the decay
+    EXPECT_NEAR(adj.weight(0, 1, 0), before * (1 - p.decay), 1e-7 * before);
+    EXPECT_EQ(adj.weight(0, 2, 1), 0.0);
+}
+
+namespace {
+
+// A chain of n cells along x: heading east (HD 0) cell i+1 follows cell i, heading west (HD 4) the reverse.
+HdAdjacency chain(int n) {
+    HdAdjacency adj(n);
+    std::vector<float> w(std::size_t(8 * n * n), 0.0f);
+    const auto at = [&](int k, int i, int j) -> float& { return w[std::size_t((k * n + i) * n + j)]; };
+    for (int i = 0; i + 1 < n; ++i) {
+        at(0, i + 1, i) = 1, at(0, i, i + 1) = -1;
+        at(4, i, i + 1) = 1, at(4, i + 1, i) = -1;
+    }
+    adj.set_weights(w);
+    return adj;
+}
+
+}  // namespace
+
+TEST(RewardCells, ReplayValueFallsAlongTheChainAndTheChoiceHeadsToTheGoal) {
+    // Replay spreads from the goal's cell through every direction's links, so value falls with the distance from
+    // the goal (near the chain's far end it rises a little again: an end cell has no successor to inhibit it,
+    // as the formula says; the exact values are checked against numpy in test/python/test_navigation.py).
+    const int n = 30;
+    const auto adj = chain(n);
+    RewardParams p;
+    const auto w = replay(adj, n - 1, p);
+    for (int i = n - 12; i + 1 < n; ++i) EXPECT_LT(w[std::size_t(i)], w[std::size_t(i + 1)]) << i;
+    EXPECT_GT(w[0], 0.0);
+    std::vector<double> v(n, 0.0);
+    v[20] = 1.0;
+    const auto returns = direction_returns(adj, w, v, p);
+    for (int k = 1; k < 8; ++k) EXPECT_GT(returns[0], returns[std::size_t(k)]) << k;  // east, toward the goal
+    const auto prob = softmax(returns, p.beta, std::vector<char>(8, 1));
+    EXPECT_GT(prob[0], 0.99);
+    auto closed = std::vector<char>(8, 1);
+    closed[0] = 0;  // east blocked: never chosen
+    EXPECT_EQ(softmax(returns, p.beta, closed)[0], 0.0);
+    // The goal at the chain's start: west wins.
+    v.assign(n, 0.0);
+    v[9] = 1.0;
+    const auto back = direction_returns(adj, replay(adj, 0, p), v, p);
+    for (int k = 0; k < 8; ++k) {
+        if (k != 4) {
+            EXPECT_GT(back[4], back[std::size_t(k)]) << k;
+        }
+    }
+    EXPECT_DOUBLE_EQ(reward(w, v), w[9]);
+}
+
+namespace {
+
+World open_room(const std::filesystem::path& dir) {
+    const auto file = dir / "room.yaml";
+    std::ofstream(file) << "name: room\nobjects:\n"
+                           "  - box: {center: [0, 0, -0.05], size: [8, 8, 0.1]}\n"
+                           "  - box: {center: [0, 0, 2.55], size: [8, 8, 0.1]}\n"
+                           "  - box: {center: [-4.1, 0, 1.25], size: [0.2, 8.4, 2.5]}\n"
+                           "  - box: {center: [4.1, 0, 1.25], size: [0.2, 8.4, 2.5]}\n"
+                           "  - box: {center: [0, -4.1, 1.25], size: [8.4, 0.2, 2.5]}\n"
+                           "  - box: {center: [0, 4.1, 1.25], size: [8.4, 0.2, 2.5]}\n"
+                           "  - box: {center: [1, -1, 1.25], size: [0.6, 0.6, 2.5]}\n"
+                           "walkable: {rect: [-4, -4, 4, 4]}\nstart: {rect: [-3.5, -3.5, 3.5, 3.5]}\n";
+    return World(config::load_world_file(file.string()));
+}
+
+NavigationSetup room_setup() {
+    NavigationSetup s;
+    s.model = model_preset("2d");
+    s.goals = {{2.5, 2.5}};
+    s.nav.max_learn_hours = 0.5;
+    s.nav.goal_visits = 3;
+    s.nav.coverage = 0.9;
+    s.nav.starts = 4;
+    s.nav.min_start_distance = 4.0;
+    return s;
+}
+
+}  // namespace
+
+TEST(Navigation, ReachesAGoalInSightInAnOpenRoomTheSameForTheSameSeed) {
+    test::TempDir dir;
+    const World world = open_room(dir.path());
+    const auto setup = room_setup();
+    const auto run = navigate(world, setup, 3);
+    ASSERT_GE(run.goal_cells[0], 0);
+    EXPECT_GE(run.visits[0], 1);
+    int reached = 0;
+    for (const auto& s : run.starts) {
+        reached += s.success;
+        EXPECT_GT(s.shortest_m, 4.0 - 1e-9);
+        if (s.success) {
+            EXPECT_LE((s.path.back() - setup.goals[0]).norm(), setup.nav.success_radius + 1e-9);
+            EXPECT_LT(s.path_m / s.shortest_m, 2.5);  // a blind walk (β = 0) fails all four at 10×
+        }
+    }
+    EXPECT_GE(reached, 3) << "of " << run.starts.size();
+    const auto again = navigate(world, setup, 3);
+    ASSERT_EQ(again.starts.size(), run.starts.size());
+    for (std::size_t i = 0; i < run.starts.size(); ++i) {
+        EXPECT_EQ(again.starts[i].path_m, run.starts[i].path_m);
+        EXPECT_EQ(again.starts[i].path.size(), run.starts[i].path.size());
+        EXPECT_EQ(again.starts[i].start, run.starts[i].start);
+    }
+    EXPECT_EQ(again.rewards, run.rewards);
+}
+
+TEST(Navigation, RefusesGoalsOutsideInWallsOrNone) {
+    test::TempDir dir;
+    const World world = open_room(dir.path());
+    auto setup = room_setup();
+    setup.goals = {{2.5, 2.5}, {9, 0}};
+    try {
+        check_goals(world, setup);
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("goal 2 (9, 0)"), std::string::npos) << e.what();
+    }
+    setup.goals = {{1, -1}};
+    EXPECT_THROW(check_goals(world, setup), InputError);
+    setup.goals = {};
+    EXPECT_THROW(check_goals(world, setup), InputError);
+}
+
+TEST(VoxelPath, MatchesBruteForceAndGoesRoundASlab) {
+    // 3-D relaxation (Bellman-Ford) with the same move rule: the box of a move must be free.
+    std::mt19937 gen(3);
+    for (int trial = 0; trial < 6; ++trial) {
+        VoxelGrid3 g{6, 5, 4, 0.5, {}};
+        g.free.resize(6 * 5 * 4);
+        for (auto& c : g.free) c = gen() % 100 >= 25;
+        g.free[0] = 1;
+        std::vector<double> d(g.free.size(), std::numeric_limits<double>::infinity());
+        d[0] = 0;
+        for (bool changed = true; changed;) {
+            changed = false;
+            for (int z = 0; z < g.nz; ++z)
+                for (int y = 0; y < g.ny; ++y)
+                    for (int x = 0; x < g.nx; ++x)
+                        for (int dz = -1; dz <= 1; ++dz)
+                            for (int dy = -1; dy <= 1; ++dy)
+                                for (int dx = -1; dx <= 1; ++dx) {
+                                    if ((dx | dy | dz) == 0 || !g.usable(x, y, z)) continue;
+                                    bool ok = true;
+                                    for (int ez = std::min(0, dz); ez <= std::max(0, dz); ++ez)
+                                        for (int ey = std::min(0, dy); ey <= std::max(0, dy); ++ey)
+                                            for (int ex = std::min(0, dx); ex <= std::max(0, dx); ++ex)
+                                                ok = ok && g.usable(x + ex, y + ey, z + ez);
+                                    if (!ok) continue;
+                                    const double via = d[g.index(x + dx, y + dy, z + dz)] +
+                                                       0.5 * std::sqrt(double(dx * dx + dy * dy + dz * dz));
+                                    if (via < d[g.index(x, y, z)] - 1e-12) d[g.index(x, y, z)] = via, changed = true;
+                                }
+        }
+        for (int z = 0; z < g.nz; ++z)
+            for (int y = 0; y < g.ny; ++y)
+                for (int x = 0; x < g.nx; ++x) {
+                    if (!g.usable(x, y, z)) continue;
+                    const auto p = voxel_shortest_path(g, {0, 0, 0}, {x, y, z});
+                    ASSERT_EQ(p.has_value(), std::isfinite(d[g.index(x, y, z)])) << trial;
+                    if (p) {
+                        EXPECT_NEAR(*p, d[g.index(x, y, z)], 1e-9) << trial;
+                    }
+                }
+    }
+    // A floor-to-ceiling slab at x = 2 with one hole at the top (z = 3): up, through, down.
+    VoxelGrid3 g{5, 1, 4, 1.0, std::vector<char>(20, 1)};
+    for (int z = 0; z < 3; ++z) g.free[g.index(2, 0, z)] = 0;
+    // (0,0,0) → (1,0,3)? The box rule forbids diagonals past the slab's edge: (0,0,0)→(1,0,1)→(1,0,2)→(1,0,3)
+    // →(2,0,3)→(3,0,3)→(3,0,2)→(3,0,1)→(4,0,0): √2 + 1 + 1 + 1 + 1 + 1 + 1 + √2 = 6 + 2√2.
+    EXPECT_NEAR(*voxel_shortest_path(g, {0, 0, 0}, {4, 0, 0}), 6 + 2 * std::sqrt(2.0), 1e-9);
+    g.free[g.index(2, 0, 3)] = 0;
+    EXPECT_FALSE(voxel_shortest_path(g, {0, 0, 0}, {4, 0, 0}).has_value());
+}
