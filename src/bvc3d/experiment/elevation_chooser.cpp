@@ -195,7 +195,9 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
                          " directions");
     m.bvc.elevations = elevations;
     m.bvc.n_per_axis = per_axis;
-    m.name = "adaptive[" + elevations_text(elevations) + "]";
+    // A name that is also a file name a shell leaves alone (no brackets, spaces or commas): adaptive-0_0.35.
+    m.name = "adaptive";
+    for (std::size_t i = 0; i < elevations.size(); ++i) m.name += (i ? "_" : "-") + format_number(elevations[i]);
     m.validate();
     return m;
 }
