@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bvc3d/agent/random_walk.hpp"
+#include "bvc3d/config/sweep_yaml.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
@@ -116,6 +117,19 @@ Pose parse_pose(const std::string& text) {
 }
 
 std::string num(double v) { return format_number(v); }
+
+void check_seed_count(int seeds, const std::vector<std::pair<std::size_t, std::string>>& factors) {
+    if (seeds < 1) throw InputError("--seeds must be >= 1, got " + std::to_string(seeds));
+    double n_trials = seeds;
+    std::string product = "--seeds " + std::to_string(seeds);
+    for (const auto& [count, what] : factors) {
+        n_trials *= static_cast<double>(count);
+        product += " × " + std::to_string(count) + " " + what;
+    }
+    if (n_trials > config::max_trials)
+        throw InputError(product + " = " + num(n_trials) + " trials; the limit is " +
+                         std::to_string(static_cast<long long>(config::max_trials)));
+}
 
 const char* const extent_help =
     "Rate-map grid: 'data' (each trajectory's own bounds, the default), 'arena' (the walkable region's) or "

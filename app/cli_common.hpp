@@ -28,6 +28,10 @@ Pose parse_pose(const std::string& text);
 // Full-precision decimal text for numbers written to CSV.
 std::string num(double v);
 
+// Refuses --seeds below 1, and more trials than a sweep may hold (--seeds × each factor: a count and
+// what it counts, "models"), naming --seeds, the product and the limit.
+void check_seed_count(int seeds, const std::vector<std::pair<std::size_t, std::string>>& factors);
+
 // Prints a warning when a pose puts the robot's body inside or against geometry, or outside the
 // walkable region: scans from there are legal but rarely what was meant.
 void warn_if_blocked(const World& world, const Pose& pose);

@@ -184,13 +184,7 @@ std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
     std::vector<std::string> choices = paper_preset(o.preset).choices;
     for (const auto& c : split_commas(o.choices)) choices.push_back(c);
-    const double n_trials =
-        static_cast<double>(o.seeds) * static_cast<double>(models.size()) * static_cast<double>(tilts.size());
-    if (o.seeds < 1) throw InputError("--seeds must be >= 1, got " + std::to_string(o.seeds));
-    if (n_trials > config::max_trials)
-        throw InputError("--seeds " + std::to_string(o.seeds) + " × " + std::to_string(models.size()) + " models × " +
-                         std::to_string(tilts.size()) + " tilts = " + num(n_trials) + " trials; the limit is " +
-                         std::to_string(static_cast<long long>(config::max_trials)));
+    check_seed_count(o.seeds, {{models.size(), "models"}, {tilts.size(), "tilts"}});
     if (o.hours && (!(*o.hours > 0) || !std::isfinite(*o.hours)))
         throw InputError("--hours must be a positive number of hours");
     const ExtentOption extent = parse_extent(o.extent.empty() ? "data" : o.extent);

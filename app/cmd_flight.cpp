@@ -29,7 +29,6 @@ struct FlightOptions {
 
 // Models × worlds × seeds, seeds slowest; the flying agent's protocol (docs/flying.md) unless shortened.
 std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
-    if (o.seeds < 1) throw InputError("--seeds must be >= 1");
     for (const auto& [h, name] :
          {std::pair{o.hours, "--hours"}, {o.explore_hours, "--explore-hours"}, {o.sample_hours, "--sample-hours"}})
         if (h && !(*h > 0 || (*h == 0 && std::string(name) == "--explore-hours")))
@@ -39,6 +38,7 @@ std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
     if (models.empty()) throw InputError("--models lists no model");
     const auto worlds = split_commas(o.worlds);
     if (worlds.empty()) throw InputError("--worlds lists no world");
+    check_seed_count(o.seeds, {{models.size(), "models"}, {worlds.size(), "worlds"}});
     const auto agent = flying_kind().make_default();
     std::vector<TrialConfig> trials;
     for (int seed = 0; seed < o.seeds; ++seed)

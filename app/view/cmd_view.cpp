@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 
+#include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/world/gazebo_world.hpp"
@@ -31,7 +32,10 @@ bool is_world_name(const fs::path& p) {
 std::vector<std::string> list_trials(const fs::path& root, const fs::path& folder, bool recursive) {
     std::vector<std::string> out;
     auto take = [&](const fs::directory_entry& e) {
-        if (e.is_regular_file() && is_trial_name(e.path())) out.push_back(view::relative_name(root, e.path()));
+        if (!e.is_regular_file() || !is_trial_name(e.path())) return;
+        // Only files that resolve inside the served folder (a symbolic link out of it is neither listed nor opened).
+        const std::string name = view::relative_name(root, e.path());
+        if (view::path_inside(root, name)) out.push_back(name);
     };
     if (recursive)
         for (const auto& e : fs::recursive_directory_iterator(folder, fs::directory_options::skip_permission_denied))
@@ -47,7 +51,9 @@ std::vector<std::string> list_worlds(const fs::path& root) {
     if (root.empty()) return out;
     std::vector<std::string> files;
     for (const auto& e : fs::directory_iterator(root))
-        if (e.is_regular_file() && is_world_name(e.path())) files.push_back(view::relative_name(root, e.path()));
+        if (e.is_regular_file() && is_world_name(e.path()) &&
+            view::path_inside(root, view::relative_name(root, e.path())))
+            files.push_back(view::relative_name(root, e.path()));
     std::sort(files.begin(), files.end());
     out.insert(out.end(), files.begin(), files.end());
     return out;
@@ -63,6 +69,7 @@ fs::path common_folder(const fs::path& a, const fs::path& b) {
 view::ViewTarget make_target(const std::vector<std::string>& args, const std::string& scans, const std::string& poses,
                              const RecordingOptions& recording, const std::string& model) {
     view::ViewTarget t;
+    config::resolve_model(model);  // an unknown model is refused before anything is served
     t.model = model;
     if (scans.empty() != poses.empty()) throw InputError("--scans and --poses go together");
     if (!scans.empty() || recording.has_bag()) {
@@ -173,8 +180,12 @@ void add_view_command(CLI::App& app) {
         }
         InterruptGuard guard;
         view::serve(data, web, o->port, stop_flag(), [&](int port) {
-            std::printf("bvc3d view: serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n",
-                        data.target().root.empty() ? data.target().world.c_str() : data.target().root.c_str(), port);
+            const auto& target = data.target();
+            const std::string served = !target.root.empty()    ? target.root.string()
+                                       : !target.world.empty() ? target.world
+                                       : target.recording      ? "recording '" + target.recording->name + "'"
+                                                               : std::string("the page");
+            std::printf("bvc3d view: serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", served.c_str(), port);
             std::fflush(stdout);
         });
         std::printf("bvc3d view: stopped\n");

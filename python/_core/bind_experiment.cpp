@@ -37,11 +37,68 @@ std::shared_ptr<const AgentSpec> trajectory_of(const pyb::object& obj) {
         "arrays");
 }
 
-TrialConfig trial_of(const std::string& model, const std::string& world, std::optional<double> tilt_deg,
+// A keyword that must be a dict of a table's keys (flight=, analysis=, bvc=, place=).
+pyb::kwargs dict_argument(const pyb::object& obj, const std::string& key, const std::string& example) {
+    if (!pyb::isinstance<pyb::dict>(obj))
+        throw InputError("run_trial: " + key + "= must be a dict of keywords, e.g. " + key + "=dict(" + example + ")");
+    return obj.cast<pyb::kwargs>();
+}
+
+// A text argument (a name or a path): anything else is refused naming the argument.
+std::string text_argument(const pyb::object& obj, const std::string& key, const std::string& what) {
+    if (pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__")) return pyb::str(obj).cast<std::string>();
+    if (pyb::isinstance<World>(obj))
+        throw InputError("run_trial: " + key + "= takes " + what +
+                         ", not a World object (a trial file records where its world came from, so a trial "
+                         "rebuilds it: give the preset name or the YAML file the World was made from)");
+    throw InputError("run_trial: " + key + "= must be " + what + ", not " +
+                     pyb::str(pyb::type::of(obj).attr("__name__")).cast<std::string>());
+}
+
+// The keywords run_trial takes besides the protocol's, and their hint for keys of other places.
+const std::vector<std::string> trial_keywords = {"trajectory",      "protocol", "agent", "flight",
+                                                 "authors_choices", "analysis", "bvc",   "place"};
+
+void check_trial_keywords(const pyb::kwargs& kwargs) {
+    for (const auto& [k, v] : kwargs) {
+        const std::string key = pyb::str(k);
+        if (Protocol::table().find(key) ||
+            std::find(trial_keywords.begin(), trial_keywords.end(), key) != trial_keywords.end())
+            continue;
+        if (analysis::AnalysisParams::table().find(key))
+            throw InputError("run_trial: '" + key + "' is an analysis parameter: give analysis=dict(" + key + "=...)");
+        if (BvcParams::table().find(key) || PlaceParams::table().find(key))
+            throw InputError("run_trial: '" + key + "' is a model parameter: give bvc=dict(" + key +
+                             "=...) or place=dict(" + key + "=...) (see help(bvc3d.BoundaryVectorLayer), " +
+                             "help(bvc3d.PlaceCellNetwork))");
+        if (key == "sensor" || key == "robot")
+            throw InputError("run_trial: '" + key + "' is not a keyword of run_trial: a model's sensor is set in a " +
+                             "model YAML (model=FILE; `bvc3d config --model 3d-0.2` prints one to start from), the " +
+                             "robot's in a trial YAML (`bvc3d run --config FILE`)");
+        std::string accepted = "model, world, tilt_deg, seed";
+        for (const auto& t : trial_keywords) accepted += ", " + t;
+        for (const auto& f : Protocol::table().fields()) accepted += ", " + f.key;
+        throw InputError("run_trial: unknown argument '" + key + "' (accepted: " + accepted + ")");
+    }
+}
+
+TrialConfig trial_of(const pyb::object& model, const pyb::object& world, const pyb::object& tilt_deg,
                      const pyb::object& seed, const pyb::kwargs& kwargs) {
+    check_trial_keywords(kwargs);
     TrialConfig t;
-    t.model = config::resolve_model(model);
-    t.world = WorldSpec{world, tilt_deg, t.world.lean};
+    t.model = config::resolve_model(text_argument(model, "model", "a model preset name or a model YAML path"));
+    const bool model_changed = kwargs.contains("bvc") || kwargs.contains("place");
+    if (kwargs.contains("bvc"))
+        apply_kwargs(t.model.bvc, BvcParams::table(), dict_argument(kwargs["bvc"], "bvc", "n_per_axis=12"));
+    if (kwargs.contains("place"))
+        apply_kwargs(t.model.place, PlaceParams::table(), dict_argument(kwargs["place"], "place", "n_place=100"));
+    if (model_changed) {
+        t.model.name += "-custom";  // as an inline model YAML that changes its base is named
+        t.model.validate();
+    }
+    std::optional<double> tilt;
+    if (!tilt_deg.is_none()) tilt = std::get<double>(to_value(tilt_deg, params::Kind::real, "tilt_deg"));
+    t.world = WorldSpec{text_argument(world, "world", "a world preset name or a world YAML path"), tilt, t.world.lean};
     t.seed = seed_of(seed, "seed");
     const auto agent = kwargs.contains("agent") ? agent_by_name(pyb::str(kwargs["agent"])) : nullptr;
     const bool flight = agent && dynamic_cast<const FlightSpec*>(agent.get());
@@ -54,18 +111,29 @@ TrialConfig trial_of(const std::string& model, const std::string& world, std::op
     }
     if (flight && kwargs.contains("flight") && !kwargs["flight"].is_none()) {
         FlightParams params;
-        apply_kwargs(params, FlightParams::table(), kwargs["flight"].cast<pyb::kwargs>());
+        apply_kwargs(params, FlightParams::table(), dict_argument(kwargs["flight"], "flight", "speed=0.5"));
         t.set_agent(std::make_shared<FlightSpec>(params));
     }
     if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) {
         if (agent) throw InputError("give agent= or trajectory=, not both");
         t.set_agent(trajectory_of(kwargs["trajectory"]));
     }
-    if (kwargs.contains("authors_choices"))
-        apply_authors_choices(t, kwargs["authors_choices"].cast<std::vector<std::string>>());
-    apply_kwargs(t.protocol, Protocol::table(), kwargs,
-                 {"trajectory", "protocol", "agent", "flight", "authors_choices"});
+    if (kwargs.contains("authors_choices")) {
+        const auto choices = kwargs["authors_choices"];
+        if (pyb::isinstance<pyb::str>(choices) || !pyb::isinstance<pyb::sequence>(choices))
+            throw InputError("run_trial: authors_choices= must be a list of names, e.g. [\"all\"]");
+        std::vector<std::string> names;
+        for (const auto& c : choices)
+            names.push_back(
+                text_argument(pyb::reinterpret_borrow<pyb::object>(c), "authors_choices", "a list of names"));
+        apply_authors_choices(t, names);
+    }
+    apply_kwargs(t.protocol, Protocol::table(), kwargs, trial_keywords);
     if (kwargs.contains("protocol")) t.protocol.kind = parse_protocol(pyb::str(kwargs["protocol"]));  // = kind
+    // Analysis keywords last: they apply over the agent's defaults (min_samples 10 in 3-D) and the authors' choices.
+    if (kwargs.contains("analysis"))
+        apply_kwargs(t.analysis, analysis::AnalysisParams::table(),
+                     dict_argument(kwargs["analysis"], "analysis", "eps=0.1, d_th=0.2"));
     t.validate();
     t.agent->check_world(t.world.resolve());
     return t;
@@ -117,14 +185,18 @@ pyb::dict choice_to_dict(const ElevationChoice& c) {
 void bind_experiment(pyb::module_& m) {
     m.def(
         "run_trial",
-        [](const std::string& model, const std::string& world, std::optional<double> tilt_deg, const pyb::object& seed,
+        [](const pyb::object& model, const pyb::object& world, const pyb::object& tilt_deg, const pyb::object& seed,
            const pyb::kwargs& kwargs) {
             const TrialConfig t = trial_of(model, world, tilt_deg, seed, kwargs);
+            std::vector<std::string> warnings;  // collected on the worker, raised as Python warnings here
             const GroupOutcome done = interruptible([&](const std::atomic<bool>& stop) {
                 RunControl control;
                 control.stop = &stop;  // Ctrl-C: KeyboardInterrupt within a fraction of a second
+                control.warn = [&](const std::string& message) { warnings.push_back(message); };
                 return run_and_analyze({t}, control);
             });
+            for (const auto& w : warnings)
+                if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw pyb::error_already_set();
             return outcome_to_dict(t, done);
         },
         pyb::arg("model") = TrialConfig{}.model.name, pyb::arg("world") = WorldSpec{}.source,
@@ -138,7 +210,11 @@ follow instead of the random walk; agent: the agent by name, )doc" +
 a world with a flight volume, )doc" +
          protocol_hours_text(protocol_preset(agent_kind("flight").protocol)) +
          R"doc( h unless given, 3-D metrics), with flight=dict(...) for its parameters (see
-flying_walk); authors_choices: a list of the authors' choices to switch on (as `bvc3d paper
+flying_walk); analysis=dict(...): analysis parameters (the keys of a trial YAML's analysis:, see
+`bvc3d config`; eps and d_th are metres, for the paper's 10 m arena: in a much smaller one set them
+to its scale, a warning says when they cannot work); bvc=dict(...), place=dict(...): the model's
+BVC and place-cell parameters over its preset (help(bvc3d.BoundaryVectorLayer),
+help(bvc3d.PlaceCellNetwork)); authors_choices: a list of the authors' choices to switch on (as `bvc3d paper
 --authors-choices`; ["all"] for all of them; protocol keywords still apply after them).
 Protocol keywords and their defaults:
 )doc" + describe(Protocol::table(), Protocol{}))

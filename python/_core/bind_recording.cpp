@@ -1,6 +1,8 @@
 // Recordings: Recording (scans + poses), replays through models, localization.
 #include "bindings.hpp"
 
+#include <limits>
+
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/localization.hpp"
 #include "bvc3d/config/model_yaml.hpp"
@@ -77,6 +79,26 @@ Eigen::Isometry3d extrinsics_of(const pyb::object& extrinsics) {
 }
 
 const char* preprocess_doc = "Preprocessing keywords (docs/recordings.md):\n";
+
+// A scan index: a Python integer, negative from the end as in a list; past the end (or not an integer)
+// an InputError naming the recording and the index, as Recording::load words it.
+std::size_t scan_index(const recording::Recording& r, const pyb::handle& obj) {
+    if (pyb::isinstance<pyb::bool_>(obj) || !pyb::hasattr(obj, "__index__"))
+        throw InputError("recording '" + r.name + "': a scan index must be an integer, not " +
+                         pyb::str(pyb::type::of(obj).attr("__name__")).cast<std::string>());
+    const auto n = static_cast<long long>(r.size());
+    long long i = 0;
+    try {
+        i = obj.cast<long long>();
+    } catch (const pyb::cast_error&) {
+        i = std::numeric_limits<long long>::max();
+    }
+    if (i < 0 && i >= -n) i += n;
+    if (i < 0 || i >= n)
+        throw InputError("recording '" + r.name + "': scan " + pyb::str(obj).cast<std::string>() + " does not exist (" +
+                         std::to_string(n) + " scans)");
+    return static_cast<std::size_t>(i);
+}
 
 void bind_recording_class(pyb::module_& m) {
     pyb::class_<recording::Recording, RecordingPtr>(m, "Recording", R"doc(
@@ -158,7 +180,8 @@ bounds a link's gap, s). extrinsics as for open.)doc")
                                })
         .def(
             "points",
-            [](const recording::Recording& r, std::size_t i) {
+            [](const recording::Recording& r, const pyb::object& index) {
+                const std::size_t i = scan_index(r, index);
                 recording::PointCloud c;
                 {
                     pyb::gil_scoped_release release;
@@ -177,11 +200,13 @@ bounds a link's gap, s). extrinsics as for open.)doc")
              })
         .def(
             "returns",
-            [](const RecordingPtr& r, std::size_t i, const std::string& model, const pyb::kwargs& kwargs) {
+            [](const RecordingPtr& r, const pyb::object& index, const std::string& model, const pyb::kwargs& kwargs) {
+                const std::size_t i = scan_index(*r, index);
                 const ModelSpec spec = config::resolve_model(model);
                 const RecordedReturnParams p = preprocess_of(kwargs, {});
+                const recording::PointCloud cloud = r->load(i);
                 Scan s;
-                returns_from_points(r->load(i).xyz, r->poses.at(i).world_from_sensor.linear(), p,
+                returns_from_points(cloud.xyz, r->poses.at(i).world_from_sensor.linear(), p,
                                     selection_for(spec.sensor, spec.bvc.elevations.empty()), s);
                 static_assert(sizeof(LidarReturn) == 3 * sizeof(double));
                 return to_numpy(reinterpret_cast<const double*>(s.data()), {static_cast<pyb::ssize_t>(s.size()), 3});
@@ -224,11 +249,16 @@ void bind_recording(pyb::module_& m) {
                 path = std::make_shared<const TrajectorySpec>(
                     TrajectorySpec::from_file(pyb::str(trajectory).cast<std::string>()));
             } else {
+                if (!pyb::isinstance<pyb::dict>(trajectory))
+                    throw InputError(
+                        "trajectory must be a file path or a dict of arrays t, x, y, heading "
+                        "(and optionally z, pitch, roll)");
                 const auto d = trajectory.cast<pyb::dict>();
                 auto column = [&](const char* key) {
                     if (!d.contains(key)) return std::vector<double>{};
-                    return pyb::cast<std::vector<double>>(
-                        pyb::module_::import("numpy").attr("asarray")(d[key], "float64").attr("ravel")());
+                    const auto a = real_array(d[key], std::string("trajectory['") + key + "']");
+                    if (a.ndim() > 1) throw InputError(std::string("trajectory['") + key + "'] must be 1-D");
+                    return std::vector<double>(a.data(), a.data() + a.size());
                 };
                 for (const char* key : {"t", "x", "y", "heading"})
                     if (!d.contains(key)) throw InputError(std::string("trajectory: the dict lacks '") + key + "'");
@@ -250,7 +280,13 @@ file or a dict of arrays t, x, y, heading[, z, pitch, roll]; sensor: a name, a Y
 Sensor. Preprocessing keywords as Recording.replay.)doc");
     m.def(
         "localize",
-        [](const ArrayF& templates, const ArrayD& template_xyz, const ArrayF& queries, const ArrayD& query_xyz) {
+        [](const pyb::object& templates_in, const pyb::object& template_xyz_in, const pyb::object& queries_in,
+           const pyb::object& query_xyz_in) {
+            // Real numbers only (no booleans, complex or text cast into numbers), as every array argument.
+            const ArrayF templates = real_array_f32(templates_in, "templates");
+            const ArrayF queries = real_array_f32(queries_in, "queries");
+            const ArrayD template_xyz = real_array(template_xyz_in, "template_positions");
+            const ArrayD query_xyz = real_array(query_xyz_in, "query_positions");
             auto matrix = [](const auto& a, const char* name) {
                 if (a.ndim() != 2) throw InputError(std::string(name) + " must be a 2-D array");
                 return a;

@@ -311,7 +311,7 @@ def analyze(x, y, rates, gridsize=_D2["gridsize"], quantile=_D2["quantile"], eps
 
 
 def _positions3(positions):
-    p = np.ascontiguousarray(positions, dtype=np.float64)
+    p = np.ascontiguousarray(_real(positions, "positions"), dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"positions must be an (n, 3) array of x, y, z, got shape {p.shape}")
     return p
@@ -327,7 +327,7 @@ def _voxel(voxel):
 def _volume(volume):
     if volume is None:
         return None
-    v = np.asarray(volume, dtype=np.float64).ravel()
+    v = np.asarray(_real(volume, "volume"), dtype=np.float64).ravel()
     if v.shape != (6,):
         raise ValueError(f"volume must be (xmin, xmax, ymin, ymax, zmin, zmax), got {volume!r}")
     return tuple(float(x) for x in v)
@@ -353,7 +353,7 @@ def voxel_rate_maps(positions, rates, voxel=_D3["voxel"], volume=None, quantile=
 def dbscan_labels(points, eps=_D3["eps"], min_samples=_D3["min_samples"]):
     """``sklearn.cluster.DBSCAN(eps, min_samples).fit(points).labels_``, identical for (N, 2) or (N, 3)
     points: per point its cluster (numbered as scikit-learn numbers them) or -1 for noise."""
-    p = np.ascontiguousarray(points, dtype=np.float64)
+    p = np.ascontiguousarray(_real(points, "points"), dtype=np.float64)
     if p.ndim != 2 or p.shape[1] not in (2, 3):
         raise ValueError(f"points must be an (N, 2) or (N, 3) array, got shape {p.shape}")
     eps, min_samples = _dbscan_params(eps, min_samples)
@@ -366,7 +366,7 @@ def isotropy(centers, maps, modality, eps=_D3["eps"], min_samples=_D3["min_sampl
     by its map value; isotropy = the weighted sd of the field's z over the mean of its weighted sds
     of x and y (population sds). 1 is round, > 1 a vertical column, < 1 a flat disc. NaN for cells
     with another modality; +inf for a field with vertical spread only. Returns (n_cells,) floats."""
-    c = np.ascontiguousarray(centers, dtype=np.float64)
+    c = np.ascontiguousarray(_real(centers, "centers"), dtype=np.float64)
     if c.ndim != 2 or c.shape[1] != 3:
         raise ValueError(f"centers must be an (N, 3) array, got shape {c.shape}")
     c, m, _ = _centers_maps(c, maps)

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -203,10 +204,16 @@ void FlightSpec::write_yaml(params::CommentedYaml& out) const {
 
 std::vector<ModelStep> flying_walk(const World& world, double hours, std::uint64_t seed, const FlightParams& params) {
     if (!std::isfinite(hours) || hours < 0) throw InputError("flight: hours must be >= 0");
+    if (hours > max_agent_hours)
+        throw InputError("flight: hours = " + format_number(hours) + " is more than the limit of " +
+                         format_number(max_agent_hours) + " simulated hours");
     const auto walk = FlightSpec(params).make(&world, seed);
     std::vector<ModelStep> steps;
     steps.reserve(static_cast<std::size_t>(hours * 3600 / params.model_dt) + 16);
-    while (auto s = walk->next(hours * 3600.0)) steps.push_back(*s);
+    while (auto s = walk->next(hours * 3600.0)) {
+        steps.push_back(*s);
+        if (steps.size() % 4096 == 0) poll_cancel();
+    }
     return steps;
 }
 

@@ -30,6 +30,17 @@ const params::Table<RouteParams>& RouteParams::table() {
 
 namespace {
 
+// A field quoted for a message: control bytes (a NUL would end the message) as \xNN.
+std::string quoted_field(const std::string& field) {
+    static const char* const hex = "0123456789abcdef";
+    std::string out = "'";
+    for (const unsigned char c : field) {
+        if (c < 0x20 || c == 0x7f) out += std::string("\\x") + hex[c >> 4] + hex[c & 15];
+        else out += static_cast<char>(c);
+    }
+    return out + "'";
+}
+
 std::string point_text(const Vec2& p) { return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ")"; }
 
 // A node of the path, every centimeter or so: where, which way, how fast at most.
@@ -213,7 +224,8 @@ std::vector<Vec2> read_waypoints(const std::string& path) {
         for (int k = 0; k < 2; ++k) {
             char* end = nullptr;
             p[k] = std::strtod(fields[k].c_str(), &end);
-            if (end == fields[k].c_str() || *end != '\0') throw InputError(at + "'" + fields[k] + "' is not a number");
+            if (end == fields[k].c_str() || end != fields[k].c_str() + fields[k].size())
+                throw InputError(at + quoted_field(fields[k]) + " is not a number");
             if (!std::isfinite(p[k]) || std::abs(p[k]) > 1e6)
                 throw InputError(at + "coordinates must be finite and within ±1e6 m");
         }

@@ -76,10 +76,21 @@ std::vector<std::string> split_fields(const std::string& line) {
     return out;
 }
 
+// A field quoted for a message: control bytes (a NUL would end the message) as \xNN.
+std::string quoted_field(const std::string& field) {
+    static const char* const hex = "0123456789abcdef";
+    std::string out = "'";
+    for (const unsigned char c : field) {
+        if (c < 0x20 || c == 0x7f) out += std::string("\\x") + hex[c >> 4] + hex[c & 15];
+        else out += static_cast<char>(c);
+    }
+    return out + "'";
+}
+
 bool is_number(const std::string& s) {
     char* end = nullptr;
     std::strtod(s.c_str(), &end);
-    return end != s.c_str() && *end == '\0';
+    return end != s.c_str() && end == s.c_str() + s.size();  // all of it: "1\0junk" is no number
 }
 
 }  // namespace
@@ -138,7 +149,7 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
             throw InputError(at + "expected " + std::to_string(columns.size()) + " values, got " +
                              std::to_string(fields.size()));
         for (std::size_t c = 0; c < fields.size(); ++c) {
-            if (!is_number(fields[c])) throw InputError(at + "'" + fields[c] + "' is not a number");
+            if (!is_number(fields[c])) throw InputError(at + quoted_field(fields[c]) + " is not a number");
             const double v = std::strtod(fields[c].c_str(), nullptr);
             const auto& col = columns[c];
             if (col == "t") t.push_back(v);

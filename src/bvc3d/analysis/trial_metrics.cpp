@@ -5,6 +5,7 @@
 #include <string>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d::analysis {
 
@@ -88,6 +89,22 @@ std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, 
                                                   params.extent));
 }
 
+std::vector<std::string> scale_warnings(const Points& centers, const AnalysisParams& params) {
+    std::vector<std::string> out;
+    if (centers.rows() < 2) return out;
+    const double span = (centers.colwise().maxCoeff() - centers.colwise().minCoeff()).norm();
+    const std::string across = " the visited bins span only " + format_number(std::round(span * 1000) / 1000) + " m";
+    if (span < params.d_th)
+        out.push_back("analysis: d_th = " + format_number(params.d_th) + " m, but" + across +
+                      ": every pair of bins is excluded and the SAI and MSAI mean nothing; give d_th in the "
+                      "arena's scale (analysis key d_th)");
+    if (span < 2 * params.dbscan.eps)
+        out.push_back("analysis: eps = " + format_number(params.dbscan.eps) + " m, but" + across +
+                      ": DBSCAN cannot separate two fields, so no cell can be multimodal; give eps in the arena's "
+                      "scale (analysis key eps)");
+    return out;
+}
+
 template <class T>
 TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eigen::Ref<const RowMatrixX<T>>& rates,
                            const AnalysisParams& params) {
@@ -120,6 +137,7 @@ TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eige
     }
     m.cells = cell_stats(m.maps);
     if (m.dims == 3) m.isotropy = field_isotropy(m.maps.bins.centers, m.maps.map, m.modality, params.dbscan);
+    m.warnings = scale_warnings(m.maps.bins.centers, params);
     return m;
 }
 

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "bvc3d/analysis/aliasing.hpp"
@@ -60,8 +61,15 @@ struct TrialMetrics {
     AliasingResult aliasing;
     DecodingResult decoding;  // on the same grid as the maps, with the same quantile
     CellStats cells;
-    std::vector<double> isotropy;  // per cell, 3-D positions only (isotropy.hpp); empty in 2-D
+    std::vector<double> isotropy;       // per cell, 3-D positions only (isotropy.hpp); empty in 2-D
+    std::vector<std::string> warnings;  // parameters that cannot work at the scale of the bins (scale_warnings)
 };
+
+// eps and d_th are metres, set for the paper's 10 m arena: in a much smaller space they cannot work,
+// and the metrics they drive come out as numbers without meaning (MSAI 0, no multimodal cell). Says
+// so when the visited bins' span (the diagonal of their bounding box) is below d_th (every pair of
+// bins is excluded) or below 2·eps (DBSCAN cannot separate two fields); empty otherwise.
+std::vector<std::string> scale_warnings(const Points& centers, const AnalysisParams& params);
 
 // The grid a trial's positions are binned on: hexagons for 2-D positions (gridsize, extent), voxels
 // for 3-D ones (voxel, volume); InputError for other dimensions.

@@ -147,6 +147,9 @@ SphereSet point_cloud_from_yaml(const YamlView& v) {
     SphereSet set;
     set.radius = v.get("radius", set.radius);
     require_positive(v, "radius", set.radius);
+    if (set.radius > max_coordinate)  // a size in meters, as a box's: held to the limit meshes are
+        v["radius"].fail("is " + format_number(set.radius) + " m: sizes must lie within " +
+                         format_number(max_coordinate) + " m");
     const double scale = v.get("scale", 1.0);
     require_positive(v, "scale", scale);
     double zmin = -INFINITY, zmax = INFINITY;
@@ -160,6 +163,10 @@ SphereSet point_cloud_from_yaml(const YamlView& v) {
     set.centers.reserve(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const Vec3 c = pose * (scale * Vec3(cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]));
+        if (!c.allFinite() || c.cwiseAbs().maxCoeff() > max_coordinate)  // after scaling and placing, as a mesh's
+            v.fail("point " + std::to_string(i) + " reaches (" + format_number(c.x()) + ", " + format_number(c.y()) +
+                   ", " + format_number(c.z()) + "): coordinates must lie within ±" + format_number(max_coordinate) +
+                   " m");
         if (c.z() >= zmin && c.z() <= zmax) set.centers.push_back(c);
     }
     if (set.centers.empty()) v.fail("keeps no points (all cropped away by crop_z)");

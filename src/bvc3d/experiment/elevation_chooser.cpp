@@ -129,7 +129,7 @@ const params::Table<ChooserParams>& ChooserParams::table() {
          real("elevation_max", &ChooserParams::elevation_max, closed(-std::numbers::pi / 2, std::numbers::pi / 2),
               "rad, highest candidate elevation"),
          real("elevation_step", &ChooserParams::elevation_step, above(0), "rad, spacing of the candidate elevations"),
-         real("explore_minutes", &ChooserParams::explore_minutes, above(0),
+         real("explore_minutes", &ChooserParams::explore_minutes, open_closed(0, max_agent_hours * 60),
               "simulated minutes of the exploratory walk")});
     return t;
 }
@@ -155,6 +155,13 @@ void ChooserParams::validate(int n_dir) const {
     if (elevation_min > elevation_max)
         throw InputError("elevation chooser: empty candidate range: elevation_min " + format_number(elevation_min) +
                          " > elevation_max " + format_number(elevation_max));
+    // Each candidate is a short trial in every round of the search: count them before listing them.
+    const double span = (elevation_max - elevation_min) / elevation_step;
+    if (span >= max_candidate_elevations)
+        throw InputError("elevation chooser: elevation_step " + format_number(elevation_step) + " gives " +
+                         format_number(std::floor(span) + 1) + " candidate elevations from " +
+                         format_number(elevation_min) + " to " + format_number(elevation_max) + "; the limit is " +
+                         format_number(max_candidate_elevations));
     const auto n = static_cast<int>(candidate_elevations().size());
     if (n < min_layers)
         throw InputError("elevation chooser: the candidate range holds " + std::to_string(n) +
@@ -188,7 +195,9 @@ ModelSpec model_with_elevations(const ModelSpec& base, const std::vector<double>
                          " directions");
     m.bvc.elevations = elevations;
     m.bvc.n_per_axis = per_axis;
-    m.name = "adaptive[" + elevations_text(elevations) + "]";
+    // A name that is also a file name a shell leaves alone (no brackets, spaces or commas): adaptive-0_0.35.
+    m.name = "adaptive";
+    for (std::size_t i = 0; i < elevations.size(); ++i) m.name += (i ? "_" : "-") + format_number(elevations[i]);
     m.validate();
     return m;
 }

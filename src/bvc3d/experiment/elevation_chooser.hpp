@@ -20,6 +20,10 @@
 
 namespace bvc3d {
 
+// The most candidate elevations a search considers (each is a short trial in every round): an
+// elevation_step of 0.003 rad over the whole sphere.
+inline constexpr double max_candidate_elevations = 1000;
+
 struct ChooserParams {
     int budget = 960;            // BVCs shared by the layers: n_per_axis = budget / (n_dir · layers)
     int min_layers = 1;          // the greedy search adds layers up to at least this many...

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "bvc3d/analysis/metrics.hpp"
@@ -64,8 +65,14 @@ GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunCo
     const WorldDescription none;
     GroupOutcome out;
     out.result = run_trial_group(world ? &*world : nullptr, trials, control);
-    for (std::size_t k = 0; k < trials.size(); ++k)
+    for (std::size_t k = 0; k < trials.size(); ++k) {
         out.trials.push_back(analyze(trials[k], world ? world->description() : none, out.result, k));
+        for (const auto& w : out.trials.back().metrics.warnings) {
+            const std::string message = trials[k].name() + ": " + w;
+            if (control.warn) control.warn(message);
+            else std::fprintf(stderr, "bvc3d: warning: %s\n", message.c_str());
+        }
+    }
     return out;
 }
 
