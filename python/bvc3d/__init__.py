@@ -11,9 +11,11 @@ from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Recording
                     choose_elevations, flying_walk, localize, metric_table, model_presets, model_sensor, random_walk,
                     read_trajectory, replay_simulated, run_trial)
 from ._core import lidar_models, route, tour, write_trajectory
+from ._core import GridCells, HeadDirectionCells
 from . import analysis
 
 __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording", "Sensor", "World", "analysis",
            "choose_elevations", "flying_walk", "localize", "metric_table", "model_presets", "model_sensor",
            "random_walk", "read_trajectory", "replay_simulated", "run_trial"]
 __all__ += ["lidar_models", "route", "tour", "write_trajectory"]
+__all__ += ["GridCells", "HeadDirectionCells"]
