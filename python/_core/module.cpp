@@ -112,4 +112,5 @@ PYBIND11_MODULE(_core, m) {
     bvc3d::py::bind_recording(m);
     bvc3d::py::bind_buildings(m);
     bvc3d::py::bind_navigation(m);
+    bvc3d::py::bind_populations(m);
 }

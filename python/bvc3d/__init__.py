@@ -11,6 +11,7 @@ from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Recording
                     choose_elevations, flying_walk, localize, metric_table, model_presets, model_sensor, random_walk,
                     read_trajectory, replay_simulated, run_trial)
 from ._core import lidar_models, route, tour, write_trajectory
+from ._core import GridCells, HeadDirectionCells
 from . import analysis
 
 __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording", "Sensor", "World", "analysis",
@@ -19,3 +20,4 @@ __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording",
 __all__ += ["lidar_models", "route", "tour", "write_trajectory"]
 from ._core import HdAdjacency, navigate, reward_readout, shortest_path
 __all__ += ["HdAdjacency", "navigate", "reward_readout", "shortest_path"]
+__all__ += ["GridCells", "HeadDirectionCells"]

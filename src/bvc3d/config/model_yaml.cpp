@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "bvc3d/config/population_kinds.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 
 namespace bvc3d::config {
 
 ModelSpec model_from_yaml(const YamlView& v) {
-    v.expect_map({"name", "base", "sensor", "bvc", "place"});
+    v.expect_map({"name", "base", "sensor", "bvc", "place", "populations"});
     ModelSpec m;
     try {
         m = model_preset(v.get("base", "3d-0.2"));
@@ -19,12 +20,13 @@ ModelSpec model_from_yaml(const YamlView& v) {
     // changed when it changes anything.
     const std::string base_name = m.name;
     const bool inline_model = !v.path().empty();
-    const bool changed = v.has("sensor") || v.has("bvc") || v.has("place");
+    const bool changed = v.has("sensor") || v.has("bvc") || v.has("place") || v.has("populations");
     m.name = v.get("name", inline_model ? base_name + (changed ? "-custom" : "")
                                         : std::filesystem::path(v.file()).stem().string());
     if (v.has("sensor")) m.sensor = sensor_from_yaml(v["sensor"]);
     if (v.has("bvc")) read_table(v["bvc"], m.bvc, BvcParams::table());
     if (v.has("place")) read_table(v["place"], m.place, PlaceParams::table());
+    if (v.has("populations")) m.populations = populations_from_yaml(v["populations"]);
     // The sections one by one may still not fit together (too many weights): at the key named.
     try {
         m.validate();

@@ -1,0 +1,174 @@
+#include "bvc3d/config/population_kinds.hpp"
+
+#include <algorithm>
+#include <memory>
+
+namespace bvc3d::config {
+
+namespace {
+
+const std::initializer_list<const char*> item_keys = {"name", "kind", "inputs", "recorded"};
+
+// `kind k1=v1 k2=v2 …`: one line, no ": " (it sits in the model's canonical text).
+template <class S>
+std::string key_of(const std::string& kind, const S& s) {
+    std::string key = kind;
+    for (const auto& f : S::table().fields()) key += " " + f.key + "=" + params::to_text(f.get(s));
+    return key;
+}
+
+template <class S>
+std::vector<std::string> keys_of() {
+    return S::table().keys();
+}
+
+}  // namespace
+
+PopulationSpec head_direction_spec(const std::string& name, const HeadDirectionParams& p) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "head-direction";
+    s.key = key_of(s.kind, p);
+    s.make = [p](const PopulationContext&) { return std::make_unique<HeadDirectionCells>(p); };
+    return s;
+}
+
+PopulationSpec grid_spec(const std::string& name, const GridParams& p) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "grid";
+    s.key = key_of(s.kind, p);
+    s.make = [p](const PopulationContext& c) { return std::make_unique<GridCells>(p, c.seed); };
+    return s;
+}
+
+const std::vector<PopulationKind>& population_kinds() {
+    static const std::vector<PopulationKind> kinds = {
+        {"head-direction", "head-direction cells: cos(θ − θ_k), or the icosahedron's 20 for flying",
+         keys_of<HeadDirectionParams>(), 0,
+         [](const YamlView& v, const std::string& name, std::vector<std::string>) {
+             HeadDirectionParams p;
+             read_table(v, p, HeadDirectionParams::table(), item_keys);
+             return head_direction_spec(name, p);
+         }},
+        {"grid", "grid cells: one module of the sum of three cosines, fed by the pose or path integration",
+         keys_of<GridParams>(), 0,
+         [](const YamlView& v, const std::string& name, std::vector<std::string>) {
+             GridParams p;
+             read_table(v, p, GridParams::table(), item_keys);
+             return grid_spec(name, p);
+         }},
+    };
+    return kinds;
+}
+
+const PopulationKind* find_population_kind(const std::string& name) {
+    for (const auto& k : population_kinds())
+        if (k.name == name) return &k;
+    return nullptr;
+}
+
+}  // namespace bvc3d::config
+
+namespace bvc3d::config {
+
+namespace {
+
+// The names of `items`' inputs that lead back to item `start`, as "a → b → a", or "" when none does.
+std::string cycle_through(std::size_t start, const std::vector<std::vector<std::size_t>>& reads,
+                          const std::vector<std::string>& names) {
+    std::vector<std::size_t> path{start};
+    std::vector<char> seen(names.size(), 0);
+    std::function<bool(std::size_t)> visit = [&](std::size_t i) {
+        for (std::size_t j : reads[i]) {
+            if (j == start) return true;
+            if (seen[j]) continue;
+            seen[j] = 1;
+            path.push_back(j);
+            if (visit(j)) return true;
+            path.pop_back();
+        }
+        return false;
+    };
+    if (!visit(start)) return "";
+    std::string text;
+    for (std::size_t i : path) text += names[i] + " → ";
+    return text + names[start];
+}
+
+}  // namespace
+
+std::vector<PopulationSpec> populations_from_yaml(const YamlView& v) {
+    if (!v.is_sequence()) v.fail("must be a list of populations (name, kind, inputs, parameters)");
+    const std::size_t n = v.size();
+    std::vector<std::string> names(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const YamlView item = v.at(i);
+        if (!item.is_map()) item.fail("must be a mapping with name, kind, inputs and the kind's parameters");
+        names[i] = item["name"].as_string();
+        if (names[i].empty()) item["name"].fail("must not be empty");
+        if (names[i] == "bvc" || names[i] == "place")
+            item["name"].fail("'" + names[i] + "' is the model's own population; choose another name");
+        for (std::size_t j = 0; j < i; ++j)
+            if (names[j] == names[i]) item["name"].fail("'" + names[i] + "' names two populations");
+    }
+    // Inputs: each names a population; the reading graph has no cycle.
+    std::vector<std::vector<std::string>> inputs(n);
+    std::vector<std::vector<std::size_t>> reads(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const YamlView item = v.at(i);
+        if (!item.has("inputs")) continue;
+        const YamlView in = item["inputs"];
+        if (!in.is_sequence()) in.fail("must be a list of population names");
+        for (std::size_t k = 0; k < in.size(); ++k) {
+            const std::string name = in.at(k).as_string();
+            inputs[i].push_back(name);
+            if (name == "bvc" || name == "place") continue;
+            const auto it = std::find(names.begin(), names.end(), name);
+            if (it == names.end())
+                in.at(k).fail("names no population ('" + name + "'; the model has bvc, place" +
+                              (n ? " and its populations" : "") + ")");
+            reads[i].push_back(static_cast<std::size_t>(it - names.begin()));
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (const std::string cycle = cycle_through(i, reads, names); !cycle.empty())
+            v.at(i)["inputs"].fail("populations read each other in a cycle: " + cycle);
+    // Each by its kind.
+    std::vector<PopulationSpec> specs(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const YamlView item = v.at(i);
+        const std::string kind = item["kind"].as_string();
+        const PopulationKind* k = find_population_kind(kind);
+        if (!k) {
+            std::string known;
+            for (const auto& p : population_kinds()) known += (known.empty() ? "" : ", ") + p.name;
+            item["kind"].fail("unknown population kind '" + kind + "' (known: " + known + ")");
+        }
+        if (inputs[i].size() != k->n_inputs)
+            (item.has("inputs") ? item["inputs"] : item)
+                .fail(kind + " reads " + std::to_string(k->n_inputs) + " population(s), got " +
+                      std::to_string(inputs[i].size()));
+        specs[i] = k->read(item, names[i], inputs[i]);
+        specs[i].inputs = inputs[i];
+        specs[i].recorded = item.get_bool("recorded", true);
+    }
+    // In an order where each reads only those before it (file order among the free).
+    std::vector<PopulationSpec> ordered;
+    std::vector<char> placed(n, 0);
+    while (ordered.size() < n)
+        for (std::size_t i = 0; i < n; ++i) {
+            if (placed[i]) continue;
+            bool ready = true;
+            for (std::size_t j : reads[i]) ready = ready && placed[j];
+            if (!ready) continue;
+            placed[i] = 1;
+            ordered.push_back(std::move(specs[i]));
+            break;
+        }
+    return ordered;
+}
+
+}  // namespace bvc3d::config
