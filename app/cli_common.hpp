@@ -108,7 +108,8 @@ void add_experiment_commands(CLI::App& app);
 void add_sweep_command(CLI::App& app);
 void add_flight_command(CLI::App& app);
 void add_recording_commands(CLI::App& app);
-void add_view_command(CLI::App& app);      // view/cmd_view.cpp
-void add_adaptive_command(CLI::App& app);  // cmd_adaptive.cpp
+void add_view_command(CLI::App& app);               // view/cmd_view.cpp
+void add_adaptive_command(CLI::App& app);           // cmd_adaptive.cpp
+void add_place_recognition_command(CLI::App& app);  // cmd_place_recognition.cpp
 
 }  // namespace bvc3d::cli

@@ -158,5 +158,6 @@ void bind_model(pyb::module_& m);
 void bind_experiment(pyb::module_& m);
 void bind_analysis(pyb::module_& m);
 void bind_recording(pyb::module_& m);
+void bind_place_recognition(pyb::module_& m);
 
 }  // namespace bvc3d::py

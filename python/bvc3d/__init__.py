@@ -4,13 +4,16 @@ The compiled core does the work; this package re-exports it with numpy in and nu
 Stages follow the data flow: World -> agent (random_walk, flying_walk, read_trajectory) -> Sensor scan ->
 BoundaryVectorLayer -> PlaceCellNetwork -> recorded samples -> bvc3d.analysis -> bvc3d.report.
 Real LiDAR recordings: Recording.open(scans, poses) -> recording.returns / recording.replay ->
-localize (docs/recordings.md).
+localize (docs/recordings.md). Place recognition, the field's protocol against Scan Context:
+place_recognition (docs/place-recognition.md).
 """
 from ._core import (BoundaryVectorLayer, InputError, PlaceCellNetwork, Recording, Sensor, World, __version__,
                     choose_elevations, flying_walk, localize, metric_table, model_presets, model_sensor, random_walk,
                     read_trajectory, replay_simulated, run_trial)
+from ._core import place_recognition, scan_context, scan_context_distance
 from . import analysis
 
 __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording", "Sensor", "World", "analysis",
            "choose_elevations", "flying_walk", "localize", "metric_table", "model_presets", "model_sensor",
            "random_walk", "read_trajectory", "replay_simulated", "run_trial"]
+__all__ += ["place_recognition", "scan_context", "scan_context_distance"]
