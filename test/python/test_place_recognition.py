@@ -223,6 +223,16 @@ def test_recall_at_1_and_the_exclusion_window_on_a_known_sequence():
     np.testing.assert_array_equal(r["match"], 199 - np.arange(100, 200))
 
 
+def test_a_match_at_exactly_the_revisit_radius_is_right():
+    xy = np.array([[0, 0]] + [[1000 + 10 * k, 0] for k in range(60)] + [[3, 4], [3, 4.000001]], float)
+    rates = np.zeros((len(xy), 4), np.float32)
+    rates[:, 0] = 1  # every scan alike: the oldest candidate wins the tie
+    r = bvc3d.analysis.loop_closure(rates, xy, exclude_scans=5)
+    assert list(r["query"][-2:]) == [61, 62] and list(r["match"][-2:]) == [0, 0]
+    assert list(r["match_m"][-2:]) == [5.0, pytest.approx(5.0000008)]
+    assert list(r["has_revisit"][-2:]) == [True, False] and list(r["correct"][-2:]) == [True, False]
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_the_protocol_is_the_numpy_transcription(seed):
     rng = np.random.default_rng(seed)

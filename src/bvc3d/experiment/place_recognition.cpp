@@ -11,6 +11,7 @@
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/place/place_cell_network.hpp"
 
@@ -74,6 +75,16 @@ std::vector<DescriptorSpec> parse_descriptors(const std::string& list) {
     }
     if (out.empty()) throw InputError("no descriptor given (--descriptors)");
     return out;
+}
+
+void PlaceRecognitionOptions::validate() const {
+    loop.validate();
+    preprocess.validate();
+    scan_context.validate();
+    if (!(drift_deg_per_sqrt_min >= 0) || !std::isfinite(drift_deg_per_sqrt_min))
+        throw InputError("the heading drift (--drift-deg-per-sqrt-min) must be a finite number >= 0, got " +
+                         format_number(drift_deg_per_sqrt_min));
+    if (threads < 0) throw InputError("threads must be >= 0 (0: every core)");
 }
 
 std::vector<double> heading_drift(const std::vector<double>& times, double sigma_per_sqrt_min, std::uint64_t seed) {
@@ -174,6 +185,7 @@ std::vector<double> scan_times(const ScanSequence& seq) {
 }
 
 analysis::QueryPlan query_plan(const ScanSequence& seq, const PlaceRecognitionOptions& o) {
+    o.validate();
     if (o.database.has_value() != o.queries.has_value())
         throw InputError("a database/query split needs both --database and --queries");
     if (o.database) return analysis::split_plan(seq.size(), *o.database, *o.queries);
@@ -185,9 +197,7 @@ analysis::QueryPlan query_plan(const ScanSequence& seq, const PlaceRecognitionOp
 
 PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std::vector<DescriptorSpec>& descriptors,
                                               const PlaceRecognitionOptions& o) {
-    o.loop.validate();
-    o.preprocess.validate();
-    o.scan_context.validate();
+    o.validate();
     if (descriptors.empty()) throw InputError("no descriptor given");
     const std::size_t n = seq.size();
     PlaceRecognitionOutcome out;

@@ -58,6 +58,8 @@ struct PlaceRecognitionOptions {
     std::uint64_t seed = 0;               // the drift and the place cells' initial weights
     int threads = 0;                      // 0: every core
     std::function<void(std::size_t done, std::size_t total)> progress;  // scans described so far
+
+    void validate() const;  // InputError naming the bad value
 };
 
 struct DescriptorOutcome {
