@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 
+#include "bvc3d/analysis/cosine_kernels.hpp"
 #include "bvc3d/analysis/cosine_search.hpp"
 #include "bvc3d/analysis/place_recognition.hpp"
 #include "bvc3d/core/error.hpp"
@@ -75,6 +76,52 @@ TEST(PlaceRecognition, BlockedSearchIsThePlainSearch) {
             EXPECT_NEAR(cosine(queries, static_cast<Eigen::Index>(q), templates, one[q].index), best, 2e-6);
         }
     }
+}
+
+TEST(PlaceRecognition, TheKernelGivesTheSameBitsOnEveryInstructionSet) {
+    // 4 queries x 7 templates of 48 floats (3 blocks of 16 lanes): each dot product against a double
+    // sum, and the instruction sets this CPU runs against each other, bit for bit.
+    const std::size_t stride = 48, n = 7;
+    const RowMatrixXf q = random_rows(4, stride, 10, 0.2), t = random_rows(n, stride, 11, 0.2);
+    std::vector<std::vector<float>> outs;
+    std::vector<simd::Isa> isas{simd::Isa::baseline};
+#if BVC3D_HAVE_DISPATCH
+    if (__builtin_cpu_supports("x86-64-v3")) isas.push_back(simd::Isa::v3);
+    if (__builtin_cpu_supports("x86-64-v4")) isas.push_back(simd::Isa::v4);
+#endif
+    for (const simd::Isa isa : isas) {
+        std::vector<float> out(4 * n);
+        kernels::dots_4xn(q.data(), t.data(), n, stride, out.data(), n, isa);
+        for (Eigen::Index a = 0; a < 4; ++a)
+            for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(n); ++j)
+                EXPECT_NEAR(out[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(j)],
+                            q.row(a).cast<double>().dot(t.row(j).cast<double>()), 1e-5);
+        outs.push_back(out);
+    }
+    for (const auto& out : outs) EXPECT_EQ(out, outs.front());
+}
+
+TEST(PlaceRecognition, FewQueriesSplitTheTemplatesBetweenThreads) {
+    // Two queries, 9000 templates: the templates are searched in chunks, one per thread, and merged.
+    RowMatrixXf templates = random_rows(9000, 24, 8);
+    const RowMatrixXf queries = random_rows(2, 24, 9);
+    templates.row(2000) = queries.row(0);
+    templates.row(8999) = queries.row(0);  // a tie later on: the earlier template wins
+    const std::vector<CosineIndex::Range> ranges{{0, 9000}, {100, 8800}};
+    const CosineIndex index(templates);
+    const auto one = index.best(queries, ranges, {}, 1), four = index.best(queries, ranges, {}, 4);
+    EXPECT_EQ(one[0].index, 2000);
+    EXPECT_EQ(four[0].index, 2000);  // chunk 0 of 2 beats chunk 1
+    EXPECT_EQ(one[1].index, four[1].index);
+    EXPECT_EQ(one[1].similarity, four[1].similarity);
+    double best = -1;
+    for (Eigen::Index j = 100; j < 8800; ++j) best = std::max(best, cosine(queries, 1, templates, j));
+    EXPECT_NEAR(four[1].similarity, best, 2e-6);
+    // The index's own rows as queries give what copies of them give.
+    const std::vector<std::size_t> rows{2000, 3};
+    const auto own = index.best_of_rows(rows, ranges, {}, 4);
+    EXPECT_EQ(own[0].index, 2000);
+    EXPECT_EQ(own[1].index, index.best(templates.middleRows(3, 1), std::span(ranges).subspan(1), {}, 4)[0].index);
 }
 
 TEST(PlaceRecognition, TiesGoToTheOlderScanAndZeroRowsHaveCosineZero) {

@@ -6,65 +6,105 @@
 #include <string>
 #include <thread>
 
+#include "bvc3d/analysis/cosine_kernels.hpp"
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/core/simd.hpp"
+
+#if BVC3D_HAVE_DISPATCH
+#include <immintrin.h>  // the kernels' intrinsics
+#endif
 
 namespace bvc3d::analysis {
 
 namespace {
 
-// The kernel's vectors: 16 floats, which each instruction set lowers to its own registers (one
-// AVX-512 register, two AVX ones, four SSE ones). Every clone adds the same lanes in the same order,
-// so the dot products are the same bits on every CPU.
-typedef float f16 __attribute__((vector_size(64)));
-constexpr std::size_t lanes = 16;
-constexpr std::size_t query_tile = 4, template_tile = 3;  // 12 accumulators: 12 of AVX-512's 32 registers
-constexpr std::size_t row_block = 64;                     // query rows per task (a multiple of query_tile)
-constexpr std::size_t template_block = 256;               // templates per pass (~1 MB of 960 floats: in L2)
+constexpr std::size_t lanes = 16;            // floats per partial sum vector (cosine_dots.inc)
+constexpr std::size_t query_tile = 4;        // query rows per kernel call
+constexpr std::size_t row_block = 64;        // query rows per task (a multiple of query_tile)
+constexpr std::size_t template_block = 256;  // templates per pass (~1 MB of 960 floats: in L2)
 
-inline float lane_sum(const f16& v) {
+// Adds the 16 lanes in order (the same order whatever holds them).
+inline float sum16(const float* v) {
     float s = 0;
     for (std::size_t k = 0; k < lanes; ++k) s += v[k];
     return s;
 }
 
-// out[i·out_stride + j] = q_i · t_j for the 4 query rows at q and the n template rows at t (rows
-// `stride` floats apart, a multiple of 16, zero-padded).
-BVC3D_DISPATCH
-void dots_4xn(const float* q, const float* t, std::size_t n, std::size_t stride, float* out, std::size_t out_stride) {
-    std::size_t j = 0;
-    for (; j + template_tile <= n; j += template_tile) {
-        f16 acc[query_tile][template_tile] = {};
-        const float* t0 = t + j * stride;
-        for (std::size_t k = 0; k < stride; k += lanes) {
-            f16 tv[template_tile], qv;
-            for (std::size_t b = 0; b < template_tile; ++b) simd::load(tv[b], t0 + b * stride + k);
-            for (std::size_t a = 0; a < query_tile; ++a) {
-                simd::load(qv, q + a * stride + k);
-                for (std::size_t b = 0; b < template_tile; ++b) acc[a][b] += qv * tv[b];
-            }
-        }
-        for (std::size_t a = 0; a < query_tile; ++a)
-            for (std::size_t b = 0; b < template_tile; ++b) out[a * out_stride + j + b] = lane_sum(acc[a][b]);
+// The kernel, compiled for each instruction set with fused multiply-adds (see cosine_dots.inc): FMA
+// doubles what each cycle adds, and an exactly rounded fma is the same on every CPU (the baseline's
+// std::fma is slow, but exact).
+#if BVC3D_HAVE_DISPATCH
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v4")
+namespace v4 {
+struct Lanes {
+    __m512 v;
+    static Lanes zero() { return {_mm512_setzero_ps()}; }
+    static Lanes load(const float* p) { return {_mm512_loadu_ps(p)}; }
+    static Lanes fma(const Lanes& a, const Lanes& b, const Lanes& c) { return {_mm512_fmadd_ps(a.v, b.v, c.v)}; }
+    float sum() const {
+        alignas(64) float l[16];
+        _mm512_store_ps(l, v);
+        return sum16(l);
     }
-    for (; j < n; ++j) {
-        f16 acc[query_tile] = {};
-        const float* tj = t + j * stride;
-        for (std::size_t k = 0; k < stride; k += lanes) {
-            f16 tv, qv;
-            simd::load(tv, tj + k);
-            for (std::size_t a = 0; a < query_tile; ++a) {
-                simd::load(qv, q + a * stride + k);
-                acc[a] += qv * tv;
-            }
-        }
-        for (std::size_t a = 0; a < query_tile; ++a) out[a * out_stride + j] = lane_sum(acc[a]);
+};
+constexpr std::size_t rows_per_pass = 4;  // 12 accumulators of AVX-512's 32 registers
+#include "bvc3d/analysis/cosine_dots.inc"
+}  // namespace v4
+#pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v3")
+namespace v3 {
+struct Lanes {
+    __m256 lo, hi;  // lanes 0-7, 8-15
+    static Lanes zero() { return {_mm256_setzero_ps(), _mm256_setzero_ps()}; }
+    static Lanes load(const float* p) { return {_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8)}; }
+    static Lanes fma(const Lanes& a, const Lanes& b, const Lanes& c) {
+        return {_mm256_fmadd_ps(a.lo, b.lo, c.lo), _mm256_fmadd_ps(a.hi, b.hi, c.hi)};
     }
-}
+    float sum() const {
+        alignas(32) float l[16];
+        _mm256_store_ps(l, lo);
+        _mm256_store_ps(l + 8, hi);
+        return sum16(l);
+    }
+};
+constexpr std::size_t rows_per_pass = 2;  // 12 of AVX2's 16 registers
+#include "bvc3d/analysis/cosine_dots.inc"
+}  // namespace v3
+#pragma GCC pop_options
+#endif
+namespace baseline {
+struct Lanes {
+    float v[16];
+    static Lanes zero() { return {}; }
+    static Lanes load(const float* p) {
+        Lanes l;
+        std::copy_n(p, 16, l.v);
+        return l;
+    }
+    static Lanes fma(const Lanes& a, const Lanes& b, const Lanes& c) {
+        Lanes l;
+        for (std::size_t k = 0; k < 16; ++k) l.v[k] = std::fma(a.v[k], b.v[k], c.v[k]);
+        return l;
+    }
+    float sum() const { return sum16(v); }
+};
+constexpr std::size_t rows_per_pass = 4;
+#include "bvc3d/analysis/cosine_dots.inc"
+}  // namespace baseline
 
 std::size_t padded(std::size_t dim) { return (dim + lanes - 1) / lanes * lanes; }
 
 }  // namespace
+
+void kernels::dots_4xn(const float* q, const float* t, std::size_t n, std::size_t stride, float* out,
+                       std::size_t out_stride, simd::Isa isa) {
+#if BVC3D_HAVE_DISPATCH
+    if (isa == simd::Isa::v4) return v4::dots_4xn(q, t, n, stride, out, out_stride);
+    if (isa == simd::Isa::v3) return v3::dots_4xn(q, t, n, stride, out, out_stride);
+#endif
+    baseline::dots_4xn(q, t, n, stride, out, out_stride);
+}
 
 void unit_rows(const Eigen::Ref<const RowMatrixXf>& rows, std::size_t stride, float* out) {
     const auto dim = static_cast<std::size_t>(rows.cols());
@@ -101,28 +141,55 @@ std::vector<CosineIndex::Best> CosineIndex::best(const Eigen::Ref<const RowMatri
     if (static_cast<std::size_t>(queries.rows()) != ranges.size())
         throw InputError("one range of templates per query: " + std::to_string(queries.rows()) + " queries, " +
                          std::to_string(ranges.size()) + " ranges");
+    // The queries as unit rows, checked here (the workers must not throw).
+    std::vector<float, CacheAligned<float>> unit(ranges.size() * stride_);
+    unit_rows(queries, stride_, unit.data());
+    return search(unit.data(), nullptr, ranges, turns, threads);
+}
+
+std::vector<CosineIndex::Best> CosineIndex::best_of_rows(std::span<const std::size_t> rows,
+                                                         std::span<const Range> ranges, QueryTurns turns,
+                                                         int threads) const {
+    if (rows.size() != ranges.size())
+        throw InputError("one range of templates per query: " + std::to_string(rows.size()) + " queries, " +
+                         std::to_string(ranges.size()) + " ranges");
+    for (const std::size_t r : rows)
+        if (r >= n_) throw InputError("query row " + std::to_string(r) + " is not in the index");
+    return search(nullptr, rows.data(), ranges, turns, threads);
+}
+
+std::vector<CosineIndex::Best> CosineIndex::search(const float* unit, const std::size_t* query_rows,
+                                                   std::span<const Range> ranges, QueryTurns turns, int threads) const {
     if (turns.turns < 1 || turns.inner < 1 || dim_ % (static_cast<std::size_t>(turns.turns) * turns.inner) != 0)
         throw InputError("query turns of " + std::to_string(turns.turns) + " steps of " + std::to_string(turns.inner) +
                          " values do not divide vectors of " + std::to_string(dim_));
     for (const Range& r : ranges)
         if (r.first > r.end || r.end > n_) throw InputError("a query's range of templates lies outside the index");
-    // The queries as unit rows, checked here (the workers must not throw).
-    std::vector<float, CacheAligned<float>> unit(ranges.size() * stride_);
-    unit_rows(queries, stride_, unit.data());
+    auto query = [&](std::size_t q) {
+        return query_rows ? rows_.data() + query_rows[q] * stride_ : unit + q * stride_;
+    };
 
+    // Work items: blocks of query rows (a query's turns are rows of their own) × chunks of the
+    // templates, so that a few queries still keep every thread busy. Chunks are searched in order
+    // of their templates and merged in that order: ties still go to the lowest template.
     const auto v = static_cast<std::size_t>(turns.turns), step = turns.inner, period = v * step;
     const std::size_t n_rows = ranges.size() * v, n_blocks = (n_rows + row_block - 1) / row_block;
-    std::vector<Best> row_best(n_rows);
+    const std::size_t cores =
+        threads > 0 ? static_cast<std::size_t>(threads) : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+    const std::size_t chunks = n_blocks == 0 ? 1 : std::max<std::size_t>(1, std::min(cores / n_blocks, n_ / 4096));
+    std::vector<Best> chunk_best(chunks * n_rows);
+    const simd::Isa isa = simd::isa();
     std::atomic<std::size_t> next{0};
     auto work = [&] {
         std::vector<float, CacheAligned<float>> q(row_block * stride_);
         std::vector<float> scores(row_block * template_block);
-        for (std::size_t block; (block = next++) < n_blocks;) {
+        for (std::size_t item; (item = next++) < n_blocks * chunks;) {
+            const std::size_t block = item / chunks, chunk = item % chunks;
             const std::size_t r0 = block * row_block, r1 = std::min(n_rows, r0 + row_block), m = r1 - r0;
             std::fill(q.begin(), q.end(), 0.0f);
             // Row r: query r / v turned by s = r % v steps.
             for (std::size_t r = r0; r < r1; ++r) {
-                const float* src = unit.data() + (r / v) * stride_;
+                const float* src = query(r / v);
                 float* dst = q.data() + (r - r0) * stride_;
                 const std::size_t s = r % v;
                 for (std::size_t outer = 0; outer < dim_; outer += period)
@@ -134,16 +201,19 @@ std::vector<CosineIndex::Best> CosineIndex::best(const Eigen::Ref<const RowMatri
                 const Range& range = ranges[r / v];
                 if (range.first < range.end) lo = std::min(lo, range.first), hi = std::max(hi, range.end);
             }
+            if (lo >= hi) continue;
+            const std::size_t span = (hi - lo + chunks - 1) / chunks;
+            const std::size_t c0 = std::min(hi, lo + chunk * span), c1 = std::min(hi, c0 + span);
             const std::size_t groups = (m + query_tile - 1) / query_tile;
-            for (std::size_t t0 = lo; t0 < hi; t0 += template_block) {
-                const std::size_t t1 = std::min(hi, t0 + template_block);
+            for (std::size_t t0 = c0; t0 < c1; t0 += template_block) {
+                const std::size_t t1 = std::min(c1, t0 + template_block);
                 for (std::size_t g = 0; g < groups; ++g)
-                    dots_4xn(q.data() + g * query_tile * stride_, rows_.data() + t0 * stride_, t1 - t0, stride_,
-                             scores.data() + g * query_tile * template_block, template_block);
+                    kernels::dots_4xn(q.data() + g * query_tile * stride_, rows_.data() + t0 * stride_, t1 - t0,
+                                      stride_, scores.data() + g * query_tile * template_block, template_block, isa);
                 for (std::size_t r = r0; r < r1; ++r) {
                     const Range& range = ranges[r / v];
                     const float* sc = scores.data() + (r - r0) * template_block;
-                    Best& b = row_best[r];
+                    Best& b = chunk_best[chunk * n_rows + r];
                     for (std::size_t j = std::max(t0, range.first), end = std::min(t1, range.end); j < end; ++j)
                         if (b.index < 0 || sc[j - t0] > b.similarity)
                             b = {static_cast<long>(j), sc[j - t0], static_cast<int>(r % v)};
@@ -151,23 +221,23 @@ std::vector<CosineIndex::Best> CosineIndex::best(const Eigen::Ref<const RowMatri
             }
         }
     };
-    const std::size_t cores =
-        threads > 0 ? static_cast<std::size_t>(threads) : std::max<std::size_t>(1, std::thread::hardware_concurrency());
-    const std::size_t n_threads = std::max<std::size_t>(1, std::min(n_blocks, cores));
+    const std::size_t n_threads = std::max<std::size_t>(1, std::min(n_blocks * chunks, cores));
     std::vector<std::thread> pool;
     for (std::size_t k = 1; k < n_threads; ++k) pool.emplace_back(work);
     work();
     for (auto& t : pool) t.join();
 
+    // Per query: the best over its chunks (in template order) and turns.
     std::vector<Best> out(ranges.size());
     for (std::size_t i = 0; i < ranges.size(); ++i)
-        for (std::size_t k = 0; k < v; ++k) {
-            const Best& b = row_best[i * v + k];
-            Best& o = out[i];
-            if (b.index < 0) continue;
-            if (o.index < 0 || b.similarity > o.similarity || (b.similarity == o.similarity && b.index < o.index))
-                o = b;
-        }
+        for (std::size_t k = 0; k < v; ++k)
+            for (std::size_t c = 0; c < chunks; ++c) {
+                const Best& b = chunk_best[c * n_rows + i * v + k];
+                Best& o = out[i];
+                if (b.index < 0) continue;
+                if (o.index < 0 || b.similarity > o.similarity || (b.similarity == o.similarity && b.index < o.index))
+                    o = b;
+            }
     return out;
 }
 

@@ -43,8 +43,14 @@ public:
     // templates. The answer does not depend on `threads` (0: every core).
     std::vector<Best> best(const Eigen::Ref<const RowMatrixXf>& queries, std::span<const Range> ranges,
                            QueryTurns turns = {}, int threads = 0) const;
+    // The same with the index's own rows as the queries (no copy): row rows[q] matches in ranges[q].
+    std::vector<Best> best_of_rows(std::span<const std::size_t> rows, std::span<const Range> ranges,
+                                   QueryTurns turns = {}, int threads = 0) const;
 
 private:
+    // Query q's unit row is at unit[q·stride_] (or at rows_ + rows[q]·stride_).
+    std::vector<Best> search(const float* unit, const std::size_t* rows, std::span<const Range> ranges,
+                             QueryTurns turns, int threads) const;
     std::size_t n_ = 0, dim_ = 0, stride_ = 0;  // stride_: dim_ rounded up to the kernel's 16 floats
     std::vector<float, CacheAligned<float>> rows_;
 };

@@ -95,13 +95,10 @@ QueryPlan split_plan(std::size_t n, const ScanSpan& database, const ScanSpan& qu
 // ----------------------------------------------------------------------------------------- rates
 
 RateMatchIndex::RateMatchIndex(const Eigen::Ref<const RowMatrixXf>& rates, QueryTurns turns, int threads)
-    : rates_(rates), index_(rates), turns_(turns), threads_(threads) {}
+    : index_(rates), turns_(turns), threads_(threads) {}
 
 std::vector<MatchIndex::Match> RateMatchIndex::best(const QueryPlan& plan) const {
-    RowMatrixXf queries(static_cast<Eigen::Index>(plan.queries.size()), rates_.cols());
-    for (std::size_t k = 0; k < plan.queries.size(); ++k)
-        queries.row(static_cast<Eigen::Index>(k)) = rates_.row(static_cast<Eigen::Index>(plan.queries[k]));
-    const auto found = index_.best(queries, plan.ranges, turns_, threads_);
+    const auto found = index_.best_of_rows(plan.queries, plan.ranges, turns_, threads_);
     std::vector<Match> out(found.size());
     for (std::size_t k = 0; k < found.size(); ++k)
         if (found[k].index >= 0) out[k] = {found[k].index, 1.0 - found[k].similarity};

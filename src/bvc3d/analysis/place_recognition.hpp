@@ -74,7 +74,6 @@ public:
     std::vector<Match> best(const QueryPlan& plan) const override;
 
 private:
-    RowMatrixXf rates_;
     CosineIndex index_;
     QueryTurns turns_;
     int threads_;
