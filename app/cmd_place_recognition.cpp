@@ -49,11 +49,12 @@ void write_tables(const fs::path& dir, const PlaceRecognitionOutcome& r) {
             pr += d.spec.label + "," + r.protocol + "," + num(c.threshold[k]) + "," + num(c.precision[k]) + "," +
                   num(c.recall[k]) + "\n";
     }
-    std::string scans = "scan,x,y,z,heading,drift\n";
+    std::string scans = "scan,t,x,y,z,heading,drift\n";
     for (Eigen::Index i = 0; i < r.positions.rows(); ++i) {
         const auto k = static_cast<std::size_t>(i);
-        scans += std::to_string(i) + "," + num(r.positions(i, 0)) + "," + num(r.positions(i, 1)) + "," +
-                 num(r.positions(i, 2)) + "," + num(r.heading[k]) + "," + num(r.drift[k]) + "\n";
+        scans += std::to_string(i) + "," + num(r.times[k]) + "," + num(r.positions(i, 0)) + "," +
+                 num(r.positions(i, 1)) + "," + num(r.positions(i, 2)) + "," + num(r.heading[k]) + "," +
+                 num(r.drift[k]) + "\n";
     }
     write_file_atomically(dir / "queries.csv", queries);
     write_file_atomically(dir / "summary.csv", summary);

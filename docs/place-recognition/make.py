@@ -174,7 +174,7 @@ def nearest_revisits(out, window_s=30.0, window_scans=50):
     scans = read_csv(out / "scans.csv")
     xy = np.array([[float(s["x"]), float(s["y"])] for s in scans])
     h = np.array([float(s["heading"]) for s in scans])
-    t = np.arange(len(scans)) * kitti_bev.SCAN_PERIOD
+    t = np.array([float(s["t"]) for s in scans])
     first = read_csv(out / "details.csv")[0]["descriptor"]
     out_rows = []
     for q in read_csv(out / "queries.csv"):
@@ -208,7 +208,9 @@ def kitti(data, work):
                                                         "--no-figure")
                 queries = read_csv(out / "queries.csv")
                 for d in details:
-                    one = sum(1 for q in queries if q["descriptor"] == d["descriptor"] and float(q["distance"]) >= 1 - 1e-9)
+                    # Queries that share nothing with any candidate (a silent place-cell vector, say).
+                    one = sum(1 for q in queries
+                              if q["descriptor"] == d["descriptor"] and float(q["distance"]) >= 1 - 1e-9)
                     rows.append(dict(d, sequence=s, recording=recording, descriptor=label(d, recording),
                                      distance_one=one))
                 if protocol == "sequential":
@@ -273,20 +275,22 @@ def f1_threshold(pr_rows):
 
 def figure_false_positives(work, sequence):
     """The route of one sequence and, per descriptor, its loop closures at its F1max threshold: right
-    ones (green) and false ones (red lines from the query to where it was matched)."""
+    ones (green) and false ones (red lines from the query to where it was matched); and how far the
+    false ones reach (kitti-false.csv)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     out = work / f"kitti-{sequence}-sequential-flat"
     scans = read_csv(out / "scans.csv")
     xy = np.array([[float(s["x"]), float(s["y"])] for s in scans])
-    names = [f"bvc:street-2d-32", "bvc-free:street-2d-32", "scan-context"]
+    names = ["bvc:street-2d-32", "bvc-free:street-2d-32", "scan-context"]
     pr, queries = read_csv(out / "pr.csv"), read_csv(out / "queries.csv")
     fig, axes = plt.subplots(1, len(names), figsize=(5.4 * len(names), 5.4))
+    rows = []
     for ax, name in zip(axes, names):
         tau = f1_threshold([p for p in pr if p["descriptor"] == name])
         ax.plot(xy[:, 0], xy[:, 1], c="0.75", lw=0.8)
-        right = false = 0
+        right, false = 0, []
         for q in queries:
             if q["descriptor"] != name or float(q["distance"]) > tau:
                 continue
@@ -295,16 +299,23 @@ def figure_false_positives(work, sequence):
                 right += 1
                 ax.plot(*xy[i], ".", c="tab:green", ms=2)
             else:
-                false += 1
+                false.append(float(q["match_m"]))
                 ax.plot([xy[i, 0], xy[m, 0]], [xy[i, 1], xy[m, 1]], "-", c="tab:red", lw=0.6)
                 ax.plot(*xy[i], ".", c="tab:red", ms=3)
-        ax.set_title(f"KITTI {sequence}, {name}\nat its F1max threshold: {right} right, {false} false", fontsize=9)
+        ax.set_title(f"KITTI {sequence}, {name}\nat its F1max threshold: {right} right, {len(false)} false",
+                     fontsize=9)
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x (m)")
+        f = np.array(false)
+        rows.append(dict(sequence=sequence, descriptor=name, threshold=f"{tau:.6f}", right=right, false=len(f),
+                         false_median_m=f"{np.median(f):.1f}", false_within_20m=int(np.sum(f <= 20)),
+                         false_min_m=f"{f.min():.1f}", false_max_m=f"{f.max():.1f}"))
     fig.tight_layout()
     fig.savefig(FIGURES / "pr-kitti-false.png", dpi=110)
     plt.close(fig)
     log("wrote", FIGURES / "pr-kitti-false.png")
+    write_csv("kitti-false.csv", rows, ["sequence", "descriptor", "threshold", "right", "false", "false_median_m",
+                                        "false_within_20m", "false_min_m", "false_max_m"])
 
 
 # ------------------------------------------------------------------------------------------- drift
@@ -337,23 +348,148 @@ def hall(data, work):
         queries = read_csv(out / "queries.csv")
         for d in details:
             mine = [q for q in queries if q["descriptor"] == d["descriptor"]]
-            wrong = [float(q["distance"]) for q in mine if q["correct"] != "1"]
+            wrong = [q for q in mine if q["correct"] != "1"]
             right = [float(q["distance"]) for q in mine if q["correct"] == "1"]
+            wrong_d = [float(q["distance"]) for q in wrong]
+            wrong_m = [float(q["match_m"]) for q in wrong]
             rows.append(dict(d, protocol=protocol,
-                             min_wrong_distance=f"{min(wrong):.4f}" if wrong else "",
+                             min_wrong_distance=f"{min(wrong_d):.4f}" if wrong else "",
                              median_right_distance=f"{np.median(right):.4f}" if right else "",
-                             median_wrong_match_m=f"{np.median([float(q['match_m']) for q in mine if q['correct'] != '1']):.2f}"
-                             if wrong else ""))
+                             median_wrong_match_m=f"{np.median(wrong_m):.2f}" if wrong else "",
+                             min_wrong_match_m=f"{min(wrong_m):.2f}" if wrong else "",
+                             max_wrong_match_m=f"{max(wrong_m):.2f}" if wrong else ""))
     write_csv("hall.csv", rows, ["protocol", "descriptor", "uses_heading", "recall_at_1", "f1_max", "auc", "queries",
                                  "revisits", "correct", "median_match_m", "min_wrong_distance",
-                                 "median_right_distance", "median_wrong_match_m"])
+                                 "median_right_distance", "median_wrong_match_m", "min_wrong_match_m",
+                                 "max_wrong_match_m"])
 
 
 # ------------------------------------------------------------------------------------------- buildings
 
+BUILDINGS = {"hospital": "gazebo/aws-robomaker-hospital-world/worlds/hospital.world",
+             "small-house": "gazebo/aws-robomaker-small-house-world/worlds/small_house.world"}
+BUILDING_SENSOR = "os1-64"  # a real 64-beam sensor model with its range noise (issue 27's presets)
+BUILDING3D = str(HERE / "building-3d.yaml")
+BUILDING_DESCRIPTORS = ["bvc:2d", "bvc:3d-0.1", "bvc:3d-0.2", "bvc:3d-3l", f"bvc:{BUILDING3D}", "bvc-free:3d-3l",
+                        f"bvc-free:{BUILDING3D}", "place-cells:3d-3l", f"place-cells:{BUILDING3D}", "scan-context"]
+BUILDING_FIGURE = ["bvc:2d", "bvc:3d-3l", "bvc:building-3d", "scan-context"]
+RAISED = 0.5  # m: the sensor's height above the map's, for the height step (queries 0.5 m higher)
+
+
+def bvc3d(*args, **kw):
+    cmd = [str(ROOT / "build" / "bvc3d"), *map(str, args)]
+    log(" ".join(cmd))
+    return subprocess.run(cmd, check=True, **kw)
+
+
+def floor_plan(world, route, work, name):
+    """The building seen from above: the points a scan of every 20th route pose hits between 0.3 and 1.8 m
+    above the floor (export-scans' scans in the world frame)."""
+    rows = np.loadtxt(route, delimiter=",", skiprows=1)
+    header = route.read_text().splitlines()[0]
+    sparse = work / f"{name}-plan-route.csv"
+    np.savetxt(sparse, rows[::20], delimiter=",", header=header, comments="", fmt="%.9g")
+    folder = work / f"{name}-plan"
+    bvc3d("export-scans", "--world", world, "--trajectory", sparse, "--sensor", BUILDING_SENSOR, "--format", "pcd",
+          "--out", folder)
+    poses = np.loadtxt(folder / "poses.txt").reshape(-1, 4, 4)
+    points = []
+    for k, pose in enumerate(poses):
+        data = (folder / f"{k:06d}.pcd").read_bytes()
+        p = np.frombuffer(data[data.index(b"DATA binary\n") + 12:], dtype="<f4").reshape(-1, 3).astype(float)
+        w = p @ pose[:3, :3].T + pose[:3, 3]
+        points.append(w[(w[:, 2] > 0.3) & (w[:, 2] < 1.8), :2])
+    return np.vstack(points)
+
+
+def building_figure(work, name, plan):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    out = work / f"{name}-tour"
+    scans = read_csv(out / "scans.csv")
+    xy = np.array([[float(s["x"]), float(s["y"])] for s in scans])
+    pr, queries = read_csv(out / "pr.csv"), read_csv(out / "queries.csv")
+    fig, axes = plt.subplots(1, len(BUILDING_FIGURE), figsize=(4.8 * len(BUILDING_FIGURE), 5))
+    rows = []
+    for ax, descriptor in zip(axes, BUILDING_FIGURE):
+        tau = f1_threshold([p for p in pr if p["descriptor"] == descriptor])
+        ax.plot(plan[:, 0], plan[:, 1], ",", c="0.6")
+        ax.plot(xy[:, 0], xy[:, 1], c="0.3", lw=0.5)
+        right, false = 0, []
+        for q in queries:
+            if q["descriptor"] != descriptor or float(q["distance"]) > tau:
+                continue
+            i, m = int(q["query"]), int(q["match"])
+            if q["correct"] == "1":
+                right += 1
+            else:
+                false.append(float(q["match_m"]))
+                ax.plot([xy[i, 0], xy[m, 0]], [xy[i, 1], xy[m, 1]], "-", c="tab:red", lw=0.7)
+                ax.plot(*xy[i], ".", c="tab:red", ms=3)
+        ax.set_title(f"{name}, {descriptor}\nat its F1max threshold: {right} right, {len(false)} false", fontsize=9)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x (m)")
+        f = np.array(false) if false else np.array([np.nan])
+        rows.append(dict(building=name, descriptor=descriptor, threshold=f"{tau:.6f}", right=right, false=len(false),
+                         false_median_m=f"{np.nanmedian(f):.1f}"))
+    fig.tight_layout()
+    fig.savefig(FIGURES / f"pr-{name}.png", dpi=110)
+    plt.close(fig)
+    log("wrote", FIGURES / f"pr-{name}.png")
+    return rows
+
+
+def raised(route, work, name):
+    """The tour driven twice, the second time with the sensor RAISED higher (times continue): with the
+    first drive as the database and the second as the queries, a map made at one height queried at another."""
+    rows = np.loadtxt(route, delimiter=",", skiprows=1)
+    names = route.read_text().splitlines()[0].split(",")
+    if "z" not in names:
+        rows = np.insert(rows, 3, 0.0, axis=1)
+        names.insert(3, "z")
+    second = rows.copy()
+    second[:, 0] += rows[-1, 0] + 1.0
+    second[:, names.index("z")] += RAISED
+    path = work / f"{name}-raised.csv"
+    np.savetxt(path, np.vstack([rows, second]), delimiter=",", header=",".join(names), comments="", fmt="%.9g")
+    return path, len(rows)
+
+
 def buildings(data, work):
-    sys.exit("the buildings step needs the Gazebo worlds, real sensor presets and tours of issue 27 "
-             "(docs/place-recognition.md#realistic-indoor-3-d): not in this build yet")
+    """Tours of the Gazebo hospital and small house scanned by a real sensor model (issue 27's worlds,
+    sensors and tours): every descriptor, the sequential protocol, where the false positives lie, and the
+    same tour queried with the sensor 0.5 m higher than the map's."""
+    if subprocess.run([str(ROOT / "build" / "bvc3d"), "route", "--help"], capture_output=True).returncode != 0:
+        sys.exit("the buildings step needs `bvc3d route --tour`, Gazebo worlds and real sensor presets (issue 27): "
+                 "not in this build")
+    rows, directions, false_rows = [], [], []
+    for name, relative in BUILDINGS.items():
+        world = data / relative
+        route = work / f"{name}-tour-route.csv"
+        if not route.exists():
+            bvc3d("route", "--world", world, "--tour", "--out", route)
+        for protocol, path, extra in [("sequential", route, []), ("raised", *raised_args(route, work, name))]:
+            out = work / f"{name}-{'tour' if protocol == 'sequential' else 'raised'}"
+            details, _, _, _ = place_recognition(out, "--world", world, "--route", path, "--sensor", BUILDING_SENSOR,
+                                                 "--descriptors", ",".join(BUILDING_DESCRIPTORS), *extra,
+                                                 "--no-figure")
+            for d in details:
+                rows.append(dict(d, building=name, protocol=protocol))
+            if protocol == "sequential":
+                directions += [dict(r, sequence=name) for r in direction_rows(out, name, protocol)]
+        false_rows += building_figure(work, name, floor_plan(world, route, work, name))
+    write_csv("buildings.csv", rows, ["building", "protocol", "descriptor", "uses_heading", "recall_at_1", "f1_max",
+                                      "auc", "queries", "revisits", "correct", "median_match_m"])
+    write_csv("buildings-direction.csv", directions, ["sequence", "protocol", "descriptor", "direction", "revisits",
+                                                      "recall_at_1"])
+    write_csv("buildings-false.csv", false_rows, ["building", "descriptor", "threshold", "right", "false",
+                                                  "false_median_m"])
+
+
+def raised_args(route, work, name):
+    path, n = raised(route, work, name)
+    return path, ["--database", f"0:{n - 1}", "--queries", f"{n}:{2 * n - 1}"]
 
 
 def main():

@@ -124,6 +124,7 @@ pyb::dict outcome_dict(const PlaceRecognitionOutcome& r) {
     std::vector<std::int64_t> index(static_cast<std::size_t>(n));
     for (std::size_t i = 0; i < index.size(); ++i) index[i] = static_cast<std::int64_t>(i);
     scans["scan"] = vec(index);
+    scans["t"] = vec(r.times);
     scans["x"] = vec(x);
     scans["y"] = vec(y);
     scans["z"] = vec(z);
@@ -242,7 +243,7 @@ place-cells:MODEL, scan-context. database, queries: (first, last) or "A:B" scans
 the split protocol; else sequential loop closure. Returns a dict of tables, each a dict of columns:
 queries (descriptor, query, match, distance, match_m, has_revisit, correct), summary (descriptor,
 protocol, recall_at_1, f1_max, auc, queries, revisits, uses_heading, median_match_m, describe_s,
-search_s), pr (descriptor, protocol, threshold, precision, recall), scans (scan, x, y, z, heading,
+search_s), pr (descriptor, protocol, threshold, precision, recall), scans (scan, t, x, y, z, heading,
 drift); and sequence, protocol. Keywords: )doc") +
          describe(analysis::LoopClosureParams::table(), analysis::LoopClosureParams{}) +
          describe(RecordedReturnParams::table(), RecordedReturnParams{}))

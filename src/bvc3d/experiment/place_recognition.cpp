@@ -215,6 +215,7 @@ PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std
         out.heading[i] = heading_of(pose.linear());
     }
     out.drift = heading_drift(times, deg_to_rad(o.drift_deg_per_sqrt_min), o.seed);
+    out.times = times;
 
     std::vector<RateStream> streams;
     std::vector<std::optional<std::size_t>> stream_of(descriptors.size());

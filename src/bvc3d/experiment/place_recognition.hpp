@@ -73,6 +73,7 @@ struct PlaceRecognitionOutcome {
     std::string sequence, protocol;
     analysis::Points positions;   // x, y, z of every scan
     std::vector<double> heading;  // the pose's heading of every scan, rad
+    std::vector<double> times;    // every scan's time, s (scan_times)
     std::vector<double> drift;    // the drifting descriptors' heading error of every scan, rad
     std::vector<DescriptorOutcome> descriptors;
     double read_seconds = 0;  // thread time spent reading (or simulating) the scans
