@@ -91,7 +91,11 @@ TEST(PlaceRecognition, TheKernelGivesTheSameBitsOnEveryInstructionSet) {
 #endif
     for (const simd::Isa isa : isas) {
         std::vector<float> out(4 * n);
-        kernels::dots_4xn(q.data(), t.data(), n, stride, out.data(), n, isa);
+        kernels::dots(q.data(), 4, t.data(), n, stride, out.data(), n, isa);
+        std::vector<float> three(4 * n, -1.0f);  // fewer rows: the same numbers, nothing written past them
+        kernels::dots(q.data(), 3, t.data(), n, stride, three.data(), n, isa);
+        EXPECT_TRUE(std::equal(three.begin(), three.begin() + 3 * n, out.begin()));
+        EXPECT_TRUE(std::all_of(three.begin() + 3 * n, three.end(), [](float x) { return x == -1.0f; }));
         for (Eigen::Index a = 0; a < 4; ++a)
             for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(n); ++j)
                 EXPECT_NEAR(out[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(j)],

@@ -97,13 +97,13 @@ std::size_t padded(std::size_t dim) { return (dim + lanes - 1) / lanes * lanes; 
 
 }  // namespace
 
-void kernels::dots_4xn(const float* q, const float* t, std::size_t n, std::size_t stride, float* out,
-                       std::size_t out_stride, simd::Isa isa) {
+void kernels::dots(const float* q, std::size_t rows, const float* t, std::size_t n, std::size_t stride, float* out,
+                   std::size_t out_stride, simd::Isa isa) {
 #if BVC3D_HAVE_DISPATCH
-    if (isa == simd::Isa::v4) return v4::dots_4xn(q, t, n, stride, out, out_stride);
-    if (isa == simd::Isa::v3) return v3::dots_4xn(q, t, n, stride, out, out_stride);
+    if (isa == simd::Isa::v4) return v4::dots(q, rows, t, n, stride, out, out_stride);
+    if (isa == simd::Isa::v3) return v3::dots(q, rows, t, n, stride, out, out_stride);
 #endif
-    baseline::dots_4xn(q, t, n, stride, out, out_stride);
+    baseline::dots(q, rows, t, n, stride, out, out_stride);
 }
 
 void unit_rows(const Eigen::Ref<const RowMatrixXf>& rows, std::size_t stride, float* out) {
@@ -208,8 +208,9 @@ std::vector<CosineIndex::Best> CosineIndex::search(const float* unit, const std:
             for (std::size_t t0 = c0; t0 < c1; t0 += template_block) {
                 const std::size_t t1 = std::min(c1, t0 + template_block);
                 for (std::size_t g = 0; g < groups; ++g)
-                    kernels::dots_4xn(q.data() + g * query_tile * stride_, rows_.data() + t0 * stride_, t1 - t0,
-                                      stride_, scores.data() + g * query_tile * template_block, template_block, isa);
+                    kernels::dots(q.data() + g * query_tile * stride_, std::min(query_tile, m - g * query_tile),
+                                  rows_.data() + t0 * stride_, t1 - t0, stride_,
+                                  scores.data() + g * query_tile * template_block, template_block, isa);
                 for (std::size_t r = r0; r < r1; ++r) {
                     const Range& range = ranges[r / v];
                     const float* sc = scores.data() + (r - r0) * template_block;
