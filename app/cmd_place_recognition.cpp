@@ -117,12 +117,15 @@ void add_place_recognition_command(CLI::App& app) {
                     "Folder for queries.csv, summary.csv, details.csv, pr.csv, scans.csv, place-recognition.png")
         ->capture_default_str();
     cmd->add_flag("--no-figure", o->no_figure, "Skip the figure");
-    cmd->footer(descriptor_help() +
-                "Sequential protocol (default): each scan queries the scans older than the exclusion window; it has a\n"
-                "revisit when one of them lies within --revisit-m. Split (--database, --queries): each query scan\n"
-                "queries the database. A query's match is right when it lies within --revisit-m; precision and recall\n"
-                "over thresholds on the distance give the curve, its area (AUC) and F1max; recall@1 is the fraction\n"
-                "of revisits whose match is right (docs/place-recognition.md).");
+    cmd->footer(
+        descriptor_help() +
+        "Sequential protocol (default): each scan queries the scans older than the exclusion window; it has a\n"
+        "revisit when one of them lies within --revisit-m. Split (--database, --queries): each query scan\n"
+        "queries the database. A query's match is right when it lies within --revisit-m; precision and recall\n"
+        "over thresholds on the distance give the curve, its area (AUC) and F1max; recall@1 is the fraction\n"
+        "of revisits whose match is right. --min-range, --max-range and --slice-half-width-deg say how the BVC\n"
+        "models read a scan (as replay reads it); Scan Context reads every point within 80 m\n"
+        "(docs/place-recognition.md).");
     cmd->callback([o] {
         o->run.threads = check_jobs(o->run.threads);
         const auto descriptors = parse_descriptors(o->descriptors);

@@ -1,10 +1,12 @@
 #include "bvc3d/experiment/place_recognition.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <mutex>
+#include <numeric>
 #include <thread>
 
 #include "bvc3d/config/model_yaml.hpp"
@@ -135,16 +137,39 @@ struct RateStream {
     std::vector<double> seconds;  // per thread
 };
 
-std::size_t stream_for(std::vector<RateStream>& streams, const ModelSpec& model, HeadingUse frame) {
-    const std::string key = config::model_to_yaml(model);
-    for (std::size_t k = 0; k < streams.size(); ++k)
-        if (streams[k].frame == frame && config::model_to_yaml(streams[k].model) == key) return k;
-    RateStream s;
-    s.model = model;
-    s.frame = frame;
-    s.selection = selection_for(model.sensor, model.bvc.elevations.empty());
-    streams.push_back(std::move(s));
-    return streams.size() - 1;
+// What the scans are described by: the rate streams the descriptors read, and Scan Context.
+struct Descriptions {
+    std::vector<RateStream> streams;
+    std::vector<std::optional<std::size_t>> stream_of;  // per descriptor; none: Scan Context
+    bool scan_context = false;
+    std::vector<ScanContext> contexts;
+    std::vector<double> context_seconds, read_seconds;  // per thread
+};
+
+Descriptions descriptions_for(const std::vector<DescriptorSpec>& descriptors) {
+    Descriptions d;
+    for (const auto& spec : descriptors) {
+        if (!spec.kind->takes_model) {
+            d.scan_context = true;
+            d.stream_of.emplace_back();
+            continue;
+        }
+        const std::string key = config::model_to_yaml(*spec.model);
+        auto same = [&](const RateStream& s) {
+            return s.frame == spec.kind->heading && config::model_to_yaml(s.model) == key;
+        };
+        auto it = std::find_if(d.streams.begin(), d.streams.end(), same);
+        if (it == d.streams.end()) {
+            RateStream s;
+            s.model = *spec.model;
+            s.frame = spec.kind->heading;
+            s.selection = selection_for(s.model.sensor, s.model.bvc.elevations.empty());
+            it = d.streams.insert(d.streams.end(), std::move(s));
+        }
+        it->keep_double = it->keep_double || spec.kind->learns;
+        d.stream_of.push_back(static_cast<std::size_t>(it - d.streams.begin()));
+    }
+    return d;
 }
 
 // Runs `work(thread)` on `n` threads; rethrows the first exception (the others stop at their next scan).
@@ -195,73 +220,40 @@ analysis::QueryPlan query_plan(const ScanSequence& seq, const PlaceRecognitionOp
     return analysis::sequential_plan(seq.size(), times, o.loop);
 }
 
-PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std::vector<DescriptorSpec>& descriptors,
-                                              const PlaceRecognitionOptions& o) {
-    o.validate();
-    if (descriptors.empty()) throw InputError("no descriptor given");
+namespace {
+
+// Every scan read once, described by every stream and by Scan Context, on `threads` threads. `heading`
+// and `drift` are each scan's (rad).
+void describe_scans(const ScanSequence& seq, const std::vector<double>& heading, const std::vector<double>& drift,
+                    const PlaceRecognitionOptions& o, std::size_t threads, Descriptions& d) {
     const std::size_t n = seq.size();
-    PlaceRecognitionOutcome out;
-    out.sequence = seq.name();
-
-    const std::vector<double> times = scan_times(seq);
-    const analysis::QueryPlan plan = query_plan(seq, o);
-    out.protocol = plan.protocol;
-
-    out.positions.resize(static_cast<Eigen::Index>(n), 3);
-    out.heading.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const auto& pose = seq.pose(i);
-        out.positions.row(static_cast<Eigen::Index>(i)) = pose.translation().transpose();
-        out.heading[i] = heading_of(pose.linear());
-    }
-    out.drift = heading_drift(times, deg_to_rad(o.drift_deg_per_sqrt_min), o.seed);
-    out.times = times;
-
-    std::vector<RateStream> streams;
-    std::vector<std::optional<std::size_t>> stream_of(descriptors.size());
-    bool scan_context = false;
-    for (std::size_t d = 0; d < descriptors.size(); ++d) {
-        const auto& spec = descriptors[d];
-        if (!spec.kind->takes_model) {
-            scan_context = true;
-            continue;
-        }
-        const std::size_t k = stream_for(streams, *spec.model, spec.kind->heading);
-        streams[k].keep_double = streams[k].keep_double || spec.kind->learns;
-        stream_of[d] = k;
-    }
-
-    // Every scan read once, described by every stream and by Scan Context, on every core.
-    const std::size_t threads = std::max<std::size_t>(
-        1, std::min<std::size_t>(n, o.threads > 0 ? static_cast<std::size_t>(o.threads)
-                                                  : std::max(1u, std::thread::hardware_concurrency())));
-    for (auto& s : streams) {
+    for (auto& s : d.streams) {
         s.rates.resize(static_cast<Eigen::Index>(n), s.model.bvc.n_cells());
         if (s.keep_double) s.rates_double.resize(n * static_cast<std::size_t>(s.model.bvc.n_cells()));
         s.seconds.assign(threads, 0.0);
     }
-    std::vector<ScanContext> contexts(scan_context ? n : 0);
-    std::vector<double> read_seconds(threads, 0.0), context_seconds(threads, 0.0);
+    d.contexts.resize(d.scan_context ? n : 0);
+    d.read_seconds.assign(threads, 0.0);
+    d.context_seconds.assign(threads, 0.0);
     std::atomic<std::size_t> next{0}, done{0};
     std::mutex progress_lock;
-    const auto describe_start = Clock::now();
     on_threads(threads, [&](std::size_t t) {
         std::vector<BoundaryVectorLayer> layers;
-        for (const auto& s : streams) layers.emplace_back(s.model.bvc);
+        for (const auto& s : d.streams) layers.emplace_back(s.model.bvc);
         Scan returns;
         std::vector<double> rates, level_xyz;
         for (std::size_t i; (i = next++) < n;) {
             poll_cancel();
             auto start = Clock::now();
             const recording::PointCloud cloud = seq.points(i);
-            read_seconds[t] += since(start);
+            d.read_seconds[t] += since(start);
             const Eigen::Matrix3d r = seq.pose(i).linear();
-            const Eigen::Matrix3d level = rotation_z(-out.heading[i]) * r;  // turns with the sensor, z up
-            for (std::size_t k = 0; k < streams.size(); ++k) {
-                RateStream& s = streams[k];
+            const Eigen::Matrix3d level = rotation_z(-heading[i]) * r;  // turns with the sensor, z up
+            for (std::size_t k = 0; k < d.streams.size(); ++k) {
+                RateStream& s = d.streams[k];
                 start = Clock::now();
                 const Eigen::Matrix3d rot = s.frame == HeadingUse::free      ? level
-                                            : s.frame == HeadingUse::drifted ? rotation_z(out.drift[i]) * r
+                                            : s.frame == HeadingUse::drifted ? rotation_z(drift[i]) * r
                                                                              : r;
                 returns_from_points(cloud.xyz, rot, o.preprocess, s.selection, returns);
                 rates.resize(layers[k].n_cells());
@@ -271,15 +263,15 @@ PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std
                 if (s.keep_double) std::copy(rates.begin(), rates.end(), s.rates_double.begin() + i * rates.size());
                 s.seconds[t] += since(start);
             }
-            if (scan_context) {
+            if (d.scan_context) {
                 start = Clock::now();
                 level_xyz.resize(cloud.xyz.size());
                 for (std::size_t p = 0; p < cloud.size(); ++p) {
                     const Vec3 v = level * Vec3(cloud.xyz[3 * p], cloud.xyz[3 * p + 1], cloud.xyz[3 * p + 2]);
                     level_xyz[3 * p] = v.x(), level_xyz[3 * p + 1] = v.y(), level_xyz[3 * p + 2] = v.z();
                 }
-                contexts[i] = bvc3d::scan_context(level_xyz, o.scan_context);
-                context_seconds[t] += since(start);
+                d.contexts[i] = scan_context(level_xyz, o.scan_context);
+                d.context_seconds[t] += since(start);
             }
             const std::size_t finished = ++done;
             if (o.progress) {
@@ -288,50 +280,78 @@ PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std
             }
         }
     });
-    out.describe_wall_seconds = since(describe_start);
-    for (const double s : read_seconds) out.read_seconds += s;
-    auto total = [](const std::vector<double>& v) {
-        double s = 0;
-        for (const double x : v) s += x;
-        return s;
-    };
+}
 
-    for (std::size_t d = 0; d < descriptors.size(); ++d) {
-        const DescriptorSpec& spec = descriptors[d];
+// The place-cell rates of a network learning online along the sequence, one step per scan: each scan
+// is described by the network as it was when the scan arrived.
+analysis::RowMatrixXf learn_along(const RateStream& s, std::uint64_t seed) {
+    PlaceCellNetwork net(s.model.bvc.n_cells(), s.model.place, seed);
+    const auto cells = static_cast<std::size_t>(s.model.bvc.n_cells());
+    const auto n = static_cast<Eigen::Index>(s.rates.rows());
+    analysis::RowMatrixXf place(n, s.model.place.n_place);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        if (i % 256 == 0) poll_cancel();
+        const auto rates = std::span<const double>(s.rates_double).subspan(static_cast<std::size_t>(i) * cells, cells);
+        const auto v = net.step(rates, true);
+        for (std::size_t c = 0; c < v.size(); ++c) place(i, static_cast<Eigen::Index>(c)) = v[c];
+    }
+    return place;
+}
+
+double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
+
+}  // namespace
+
+PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std::vector<DescriptorSpec>& descriptors,
+                                              const PlaceRecognitionOptions& o) {
+    o.validate();
+    if (descriptors.empty()) throw InputError("no descriptor given");
+    const std::size_t n = seq.size();
+    PlaceRecognitionOutcome out;
+    out.sequence = seq.name();
+    const analysis::QueryPlan plan = query_plan(seq, o);
+    out.protocol = plan.protocol;
+    out.times = scan_times(seq);
+    out.positions.resize(static_cast<Eigen::Index>(n), 3);
+    out.heading.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto& pose = seq.pose(i);
+        out.positions.row(static_cast<Eigen::Index>(i)) = pose.translation().transpose();
+        out.heading[i] = heading_of(pose.linear());
+    }
+    out.drift = heading_drift(out.times, deg_to_rad(o.drift_deg_per_sqrt_min), o.seed);
+
+    Descriptions d = descriptions_for(descriptors);
+    const std::size_t cores = o.threads > 0 ? static_cast<std::size_t>(o.threads)
+                                            : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+    const auto start = Clock::now();
+    describe_scans(seq, out.heading, out.drift, o, std::max<std::size_t>(1, std::min(n, cores)), d);
+    out.describe_wall_seconds = since(start);
+    out.read_seconds = total(d.read_seconds);
+
+    for (std::size_t k = 0; k < descriptors.size(); ++k) {
+        const DescriptorSpec& spec = descriptors[k];
         DescriptorOutcome r;
         r.spec = spec;
+        auto begin = Clock::now();
         std::unique_ptr<analysis::MatchIndex> index;
-        auto start = Clock::now();
-        if (!stream_of[d]) {
-            r.describe_seconds = total(context_seconds);
-            index = std::make_unique<analysis::ScanContextIndex>(contexts, o.scan_context.candidates);
+        if (!d.stream_of[k]) {
+            r.describe_seconds = total(d.context_seconds);
+            index = std::make_unique<analysis::ScanContextIndex>(d.contexts, o.scan_context.candidates);
+        } else if (const RateStream& s = d.streams[*d.stream_of[k]]; spec.kind->learns) {
+            const analysis::RowMatrixXf place = learn_along(s, o.seed);
+            r.describe_seconds = total(s.seconds) + since(begin);
+            begin = Clock::now();
+            index = std::make_unique<analysis::RateMatchIndex>(place, analysis::QueryTurns{}, o.threads);
         } else {
-            const RateStream& s = streams[*stream_of[d]];
             r.describe_seconds = total(s.seconds);
-            if (spec.kind->learns) {
-                // One network step per scan, learning as it goes: each scan is described by the
-                // network as it was when the scan arrived.
-                PlaceCellNetwork net(s.model.bvc.n_cells(), s.model.place, o.seed);
-                const auto cells = static_cast<std::size_t>(s.model.bvc.n_cells());
-                analysis::RowMatrixXf place(static_cast<Eigen::Index>(n), s.model.place.n_place);
-                for (std::size_t i = 0; i < n; ++i) {
-                    if (i % 256 == 0) poll_cancel();
-                    const auto v = net.step(std::span<const double>(s.rates_double).subspan(i * cells, cells), true);
-                    for (std::size_t c = 0; c < v.size(); ++c)
-                        place(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = v[c];
-                }
-                r.describe_seconds += since(start);
-                start = Clock::now();
-                index = std::make_unique<analysis::RateMatchIndex>(place, analysis::QueryTurns{}, o.threads);
-            } else {
-                analysis::QueryTurns turns;
-                if (spec.kind->heading == HeadingUse::free)
-                    turns = {s.model.bvc.n_dir, static_cast<std::size_t>(s.model.bvc.n_per_axis)};
-                index = std::make_unique<analysis::RateMatchIndex>(s.rates, turns, o.threads);
-            }
+            analysis::QueryTurns turns;  // the heading-free match turns the query over the BVC directions
+            if (spec.kind->heading == HeadingUse::free)
+                turns = {s.model.bvc.n_dir, static_cast<std::size_t>(s.model.bvc.n_per_axis)};
+            index = std::make_unique<analysis::RateMatchIndex>(s.rates, turns, o.threads);
         }
         r.result = analysis::evaluate(*index, plan, out.positions, o.loop.revisit_m);
-        r.search_seconds = since(start);
+        r.search_seconds = since(begin);
         out.descriptors.push_back(std::move(r));
     }
     return out;
