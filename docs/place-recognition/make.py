@@ -392,7 +392,7 @@ def floor_plan(world, route, work, name):
     folder = work / f"{name}-plan"
     bvc3d("export-scans", "--world", world, "--trajectory", sparse, "--sensor", BUILDING_SENSOR, "--format", "pcd",
           "--out", folder)
-    poses = np.loadtxt(folder / "poses.txt").reshape(-1, 4, 4)
+    poses = np.loadtxt(folder / "poses.txt", delimiter=",", usecols=(0, 1, 2, 3)).reshape(-1, 4, 4)  # 4x4 rows, time
     points = []
     for k, pose in enumerate(poses):
         data = (folder / f"{k:06d}.pcd").read_bytes()
@@ -430,9 +430,8 @@ def building_figure(work, name, plan):
         ax.set_title(f"{name}, {descriptor}\nat its F1max threshold: {right} right, {len(false)} false", fontsize=9)
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x (m)")
-        f = np.array(false) if false else np.array([np.nan])
         rows.append(dict(building=name, descriptor=descriptor, threshold=f"{tau:.6f}", right=right, false=len(false),
-                         false_median_m=f"{np.nanmedian(f):.1f}"))
+                         false_median_m=f"{np.median(false):.1f}" if false else ""))
     fig.tight_layout()
     fig.savefig(FIGURES / f"pr-{name}.png", dpi=110)
     plt.close(fig)
