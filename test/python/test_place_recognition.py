@@ -446,3 +446,33 @@ def test_bad_requests_are_refused_with_the_reason(tmp_path):
     proc = run_cli("place-recognition", "--world", "cross", "--route", route, "--sensor", "horizontal",
                    "--descriptors", "scan-context", "--database", "0:10", "--queries", "5:20", "--out", tmp_path / "x")
     assert proc.returncode == 2 and "overlaps itself" in proc.stderr and not (tmp_path / "x").exists()
+
+
+def test_a_recording_of_the_route_gives_what_the_route_gives(tmp_path):
+    """The route's scans written as a recording (export-scans, float64) and read back: the same queries,
+    matches and revisits, distances within float rounding."""
+    route, n = two_laps(tmp_path, turn_second=math.pi / 2)
+    run_cli("export-scans", "--world", "cross", "--trajectory", route, "--sensor", "horizontal", "--format", "pcd-f8",
+            "--out", tmp_path / "rec", check=True)
+    descriptors = "bvc:2d,bvc-free:2d,place-cells:2d,scan-context"
+    sim = bvc3d.place_recognition(world="cross", route=route, sensor="horizontal", descriptors=descriptors,
+                                  exclude_seconds=10)
+    rec = bvc3d.place_recognition(tmp_path / "rec" / "scans.txt", tmp_path / "rec" / "poses.txt",
+                                  descriptors=descriptors, exclude_seconds=10)
+    for key in ["query", "match", "has_revisit", "correct"]:
+        np.testing.assert_array_equal(rec["queries"][key], sim["queries"][key], err_msg=key)
+    np.testing.assert_allclose(rec["queries"]["distance"], sim["queries"]["distance"], atol=1e-5)
+    np.testing.assert_allclose(rec["scans"]["t"], sim["scans"]["t"], atol=1e-9)
+    np.testing.assert_allclose(rec["scans"]["heading"], sim["scans"]["heading"], atol=1e-9)
+
+
+HALL = SOURCE_DIR.parent / "shared" / "data" / "hall-lidar"
+
+
+@pytest.mark.skipif(not (HALL / "poses.csv").exists(), reason=f"the hall-lidar recording is not at {HALL}")
+def test_the_hall_has_no_revisit_in_the_sequential_sense():
+    r = bvc3d.place_recognition(HALL, HALL / "poses.csv", descriptors="bvc:2d,scan-context")
+    assert list(r["summary"]["queries"]) == [9, 9] and list(r["summary"]["revisits"]) == [0, 0]
+    assert all(math.isnan(v) for v in r["summary"]["recall_at_1"])
+    np.testing.assert_array_equal(r["queries"]["query"][:9], np.arange(51, 60))
+    assert np.all(r["queries"]["match_m"] > 5)
