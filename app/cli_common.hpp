@@ -111,5 +111,6 @@ void add_recording_commands(CLI::App& app);
 void add_view_command(CLI::App& app);               // view/cmd_view.cpp
 void add_adaptive_command(CLI::App& app);           // cmd_adaptive.cpp
 void add_place_recognition_command(CLI::App& app);  // cmd_place_recognition.cpp
+void add_route_command(CLI::App& app);              // cmd_route.cpp
 
 }  // namespace bvc3d::cli

@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
     bvc3d::cli::add_view_command(app);
     bvc3d::cli::add_adaptive_command(app);
     bvc3d::cli::add_place_recognition_command(app);
+    bvc3d::cli::add_route_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::Success& e) {

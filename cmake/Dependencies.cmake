@@ -5,6 +5,11 @@ find_package(assimp REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(CLI11 REQUIRED)
+# Gazebo (SDF) worlds: Debian's libsdformat-dev (SDFormat 12, the reference parser).
+find_package(sdformat12 REQUIRED)
+# SDFormat falls back to urdfdom on a file it cannot read, which logs through console_bridge: kept
+# quiet while bvc3d parses (its own message says what is wrong). Debian's libconsole-bridge-dev.
+find_package(console_bridge REQUIRED)
 find_package(Threads REQUIRED)
 
 if(BVC3D_WITH_MPI)

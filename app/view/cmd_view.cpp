@@ -7,6 +7,7 @@
 
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/world/gazebo_world.hpp"
 #include "cli_common.hpp"
 #include "view/export.hpp"
 #include "view/safe_path.hpp"
@@ -19,7 +20,10 @@ namespace {
 namespace fs = std::filesystem;
 
 bool is_trial_name(const fs::path& p) { return p.extension() == ".h5"; }
-bool is_yaml_name(const fs::path& p) { return p.extension() == ".yaml" || p.extension() == ".yml"; }
+// A world YAML, or a Gazebo world (.world, .sdf: docs/buildings.md).
+bool is_world_name(const fs::path& p) {
+    return p.extension() == ".yaml" || p.extension() == ".yml" || is_gazebo_file(p.string());
+}
 
 // Trial files in a folder (and below it when `recursive`), sorted by path.
 std::vector<std::string> list_trials(const fs::path& root, const fs::path& folder, bool recursive) {
@@ -41,7 +45,7 @@ std::vector<std::string> list_worlds(const fs::path& root) {
     if (root.empty()) return out;
     std::vector<std::string> files;
     for (const auto& e : fs::directory_iterator(root))
-        if (e.is_regular_file() && is_yaml_name(e.path())) files.push_back(view::relative_name(root, e.path()));
+        if (e.is_regular_file() && is_world_name(e.path())) files.push_back(view::relative_name(root, e.path()));
     std::sort(files.begin(), files.end());
     out.insert(out.end(), files.begin(), files.end());
     return out;
@@ -78,14 +82,15 @@ view::ViewTarget make_target(const std::vector<std::string>& args, const std::st
             if (t.trials.empty()) throw InputError("'" + a + "' holds no trial files (*.h5)");
             t.open = {t.trials.front()};
         } else if (fs::exists(p, ec)) {
-            if (is_yaml_name(p)) {
+            if (is_world_name(p)) {
                 if (args.size() > 1) throw InputError("a world file is viewed on its own");
                 t.root = fs::canonical(p).parent_path();
                 t.world = p.filename().string();
             } else if (is_trial_name(p)) {
                 files.push_back(fs::canonical(p));
             } else {
-                throw InputError("'" + a + "' is neither a trial file (.h5), a results folder nor a world (.yaml)");
+                throw InputError("'" + a +
+                                 "' is neither a trial file (.h5), a results folder nor a world (.yaml, .world, .sdf)");
             }
         } else {
             const auto presets = config::world_preset_names();
@@ -137,8 +142,8 @@ void add_view_command(CLI::App& app) {
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("paths", o->paths,
-                    "A trial file (.h5), two to compare side by side, a results folder, a world YAML or a world preset "
-                    "(default: the cross arena)");
+                    "A trial file (.h5), two to compare side by side, a results folder, a world YAML or Gazebo world, "
+                    "or a world preset (default: the cross arena)");
     cmd->add_option("--port", o->port, "Port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
     cmd->add_option("--scans", o->scans, "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");

@@ -154,7 +154,7 @@ std::shared_ptr<const World> ViewData::world_by_source(const std::string& source
         if (target_.root.empty() || !file) throw RequestError(403, "'" + source + "' is not inside the served folder");
         std::error_code ec;
         if (!fs::is_regular_file(*file, ec)) throw RequestError(404, "world file '" + source + "' does not exist");
-        world = std::make_shared<World>(config::load_world_file(file->string()));
+        world = std::make_shared<World>(config::resolve_world(file->string()));  // YAML or Gazebo (.world, .sdf)
     }
     std::lock_guard lock(mutex_);
     return worlds_.emplace(source, std::move(world)).first->second;

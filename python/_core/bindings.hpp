@@ -159,5 +159,6 @@ void bind_experiment(pyb::module_& m);
 void bind_analysis(pyb::module_& m);
 void bind_recording(pyb::module_& m);
 void bind_place_recognition(pyb::module_& m);
+void bind_buildings(pyb::module_& m);  // after bind_simulator: it adds to World
 
 }  // namespace bvc3d::py

@@ -111,4 +111,5 @@ PYBIND11_MODULE(_core, m) {
     bvc3d::py::bind_analysis(m);
     bvc3d::py::bind_recording(m);
     bvc3d::py::bind_place_recognition(m);  // after bind_analysis: it adds to bvc3d.analysis
+    bvc3d::py::bind_buildings(m);
 }

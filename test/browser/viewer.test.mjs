@@ -5,7 +5,7 @@
 // in the folder printed at the start (test artifacts).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { writeFileSync, copyFileSync, existsSync, readFileSync } from 'node:fs';
+import { writeFileSync, copyFileSync, existsSync, readFileSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { execFileSync } from 'node:child_process';
@@ -206,6 +206,32 @@ test('a world YAML with a mesh renders, and a click probes the floor', async () 
     assert.deepEqual(page.foreignRequests, []);
     assert.deepEqual(page.consoleErrors, []);
     await shot(page, 'world-two-rooms');
+    await page.close();
+  } finally {
+    assert.equal(await world.stop(), 0);
+  }
+});
+
+test('a Gazebo world (.world) renders with all its triangles', async () => {
+  // A room of SDF boxes: a floor slab, four walls and a pillar, each a box of 12 triangles.
+  const dir = scratch('gazebo');
+  mkdirSync(join(dir, 'worlds'));
+  const box = (name, [x, y, z], [sx, sy, sz]) =>
+    `<model name="${name}"><static>true</static><pose>${x} ${y} ${z} 0 0 0.3</pose><link name="l"><visual name="v">` +
+    `<geometry><box><size>${sx} ${sy} ${sz}</size></box></geometry></visual></link></model>`;
+  const boxes = [box('floor', [0, 0, -0.1], [8, 8, 0.2]), box('n', [0, 4.05, 1], [8.2, 0.1, 2]), box('s', [0, -4.05, 1], [8.2, 0.1, 2]),
+    box('e', [4.05, 0, 1], [0.1, 8, 2]), box('w', [-4.05, 0, 1], [0.1, 8, 2]), box('pillar', [1, 1, 1], [0.5, 0.5, 2])];
+  const file = join(dir, 'worlds', 'room.world');
+  writeFileSync(file, `<?xml version="1.0"?>\n<sdf version="1.6"><world name="w">${boxes.join('\n')}</world></sdf>\n`);
+  const world = await serve([file]);
+  try {
+    const page = await openPage(browser, world.url);
+    await waitReady(page);
+    assert.ok((await paintedPixels(page, '.view3d canvas')) > 20000, 'the world is not drawn');
+    assert.equal(await page.$eval('.readout', (e) => Number(e.dataset.triangles)), boxes.length * 12);
+    assert.ok((await shownStep(page)).returns > 1000);
+    assert.deepEqual(page.consoleErrors, []);
+    await shot(page, 'world-gazebo');
     await page.close();
   } finally {
     assert.equal(await world.stop(), 0);

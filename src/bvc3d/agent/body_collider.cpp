@@ -81,6 +81,20 @@ double point_segment_distance(const Vec2& p, const Segment2& s) {
     return (p - (s.a + lam * ab)).norm() - s.radius;
 }
 
+// Distance between segments pq and s (s grown by its radius).
+double segment_segment_distance(const Vec2& p, const Vec2& q, const Segment2& s) {
+    const auto cross = [](const Vec2& u, const Vec2& v) { return u.x() * v.y() - u.y() * v.x(); };
+    const Vec2 r = q - p, e = s.b - s.a;
+    const double denom = cross(r, e);
+    if (denom != 0.0) {  // proper crossing
+        const double t = cross(s.a - p, e) / denom, u = cross(s.a - p, r) / denom;
+        if (t >= 0 && t <= 1 && u >= 0 && u <= 1) return -s.radius;
+    }
+    const Segment2 pq{p, q, 0.0};
+    return std::min({point_segment_distance(p, s), point_segment_distance(q, s),
+                     point_segment_distance(s.a, pq) - s.radius, point_segment_distance(s.b, pq) - s.radius});
+}
+
 }  // namespace
 
 BodyCollider::BodyCollider(const WorldDescription& world, double radius, double height)
@@ -90,8 +104,12 @@ BodyCollider::BodyCollider(const WorldDescription& world, double radius, double 
         throw InputError("world '" + world.name + "': the walkable region needs at least 3 points and a positive area");
 
     // Triangles touching the slab just above the floor up to the body's top. The tiny lower bound
-    // keeps floor triangles (z = 0) out while walls standing on the floor count from their base.
-    const double z_lo = 1e-9;
+    // keeps floor triangles (z = 0) out while walls standing on the floor count from their base; a
+    // world may let the body pass over low things (its step height).
+    const double z_lo = std::max(1e-9, world.step_height);
+    if (!(z_lo < height))
+        throw InputError("world '" + world.name + "': its step height (" + std::to_string(world.step_height) +
+                         " m) must be below the robot's height");
     for (std::size_t t = 0; t < world.mesh.size(); ++t) {
         const auto poly = clip_to_slab(world.mesh.corners(t), z_lo, height);
         for (std::size_t i = 0; i < poly.size(); ++i) {
@@ -103,6 +121,7 @@ BodyCollider::BodyCollider(const WorldDescription& world, double radius, double 
     for (const auto& set : world.spheres) add_spheres(set, z_lo, height);
     const auto& w = walkable_.points;
     for (std::size_t i = 0; i < w.size(); ++i) add_segment(w[i], w[(i + 1) % w.size()]);
+    for (const auto& e : world.drop_edges) add_segment(e[0], e[1]);
 
     // Grid cells about the size of the body: a move query touches a handful of them.
     for (const auto& s : segments_) {
@@ -271,6 +290,20 @@ bool BodyCollider::can_start_in(const Polygon2& region) const {
 bool BodyCollider::can_start_at(const Vec2& p) const {
     const auto [area, largest] = free_area(p);
     return area > 0 && area >= 0.25 * largest;
+}
+
+double BodyCollider::clearance(const Vec2& a, const Vec2& b) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (double reach = cell_;; reach *= 2) {
+        Eigen::AlignedBox2d box;
+        box.extend(a - Vec2::Constant(reach));
+        box.extend(b + Vec2::Constant(reach));
+        box.extend(a + Vec2::Constant(reach));
+        box.extend(b - Vec2::Constant(reach));
+        for_segments_near(box, [&](int i) { best = std::min(best, segment_segment_distance(a, b, segments_[i])); });
+        if (best <= reach || reach > 2 * (bounds_.sizes().norm() + (a - bounds_.center()).norm())) break;
+    }
+    return best - radius_;
 }
 
 double BodyCollider::clearance(const Vec2& p) const {

@@ -4,7 +4,8 @@
 // The cylinder, radius R and height H, touches a triangle iff its disc touches the floor-plane
 // projection of the triangle's part with 0 < z <= H. Those projections are convex polygons, so
 // the 3-D test reduces to a disc against 2-D segments (their edges), exactly. Triangles lying at
-// z <= 0 are floor and never collide. The walkable region's boundary also counts as a wall.
+// z <= 0 (or below the world's step height) are floor and never collide. The walkable region's
+// boundary and the world's drop edges (where its floor ends) also count as walls.
 // A sphere (a point of a point cloud, center c, radius ρ) cut by the same slab is a ball whose
 // floor-plane projection is the disc of radius √(ρ² − dz²) around c's (x, y), dz being the distance
 // from c.z to the slab (0 inside it): the body touches it iff its disc touches that disc, so a
@@ -27,6 +28,7 @@ public:
     BodyCollider(const WorldDescription& world, double radius, double height);
 
     double radius() const { return radius_; }
+    const Polygon2& walkable() const { return walkable_; }
     const std::vector<Segment2>& segments() const { return segments_; }
 
     // How far the body can move from center p along the unit direction u, up to max_dist, before
@@ -36,6 +38,9 @@ public:
     // Distance from the center p to the nearest obstacle (segment or disc), minus the body's radius
     // (< 0: overlap).
     double clearance(const Vec2& p) const;
+    // The same for every center on the segment ab (its nearest approach): a body driven from a to b
+    // stays clear of geometry iff this is >= 0.
+    double clearance(const Vec2& a, const Vec2& b) const;
 
     // Inside the walkable region and not touching any wall. (A center deep inside a solid obstacle is
     // far from its walls too: see can_start_at.)

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "bvc3d/core/angles.hpp"
+#include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
@@ -148,6 +149,21 @@ std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path) {
         }
     }
     return trajectory_steps(t, x, y, z, heading, name, pitch, roll);
+}
+
+void write_trajectory_file(const std::filesystem::path& path, const std::vector<ModelStep>& steps) {
+    bool tilted = false;
+    for (const auto& s : steps) tilted = tilted || !s.pose.level();
+    AtomicFile file(path);
+    auto& out = file.stream();
+    out << (tilted ? "t,x,y,z,heading,pitch,roll\n" : "t,x,y,z,heading\n");
+    for (const auto& s : steps) {
+        out << format_number(s.t) << ',' << format_number(s.pose.x) << ',' << format_number(s.pose.y) << ','
+            << format_number(s.pose.z) << ',' << format_number(s.pose.heading);
+        if (tilted) out << ',' << format_number(s.pose.pitch) << ',' << format_number(s.pose.roll);
+        out << '\n';
+    }
+    file.commit();
 }
 
 namespace {

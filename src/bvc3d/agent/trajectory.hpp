@@ -43,6 +43,11 @@ std::vector<ModelStep> trajectory_steps(const std::vector<double>& t, const std:
 // file, the line and the reason.
 std::vector<ModelStep> read_trajectory_file(const std::filesystem::path& path);
 
+// Writes steps as read_trajectory_file() reads them back, bit for bit: a header `t,x,y,z,heading`
+// (`,pitch,roll` when a step is tilted), one row per step, shortest round-trip decimals. Atomic: the
+// file appears whole or not at all (InputError naming it).
+void write_trajectory_file(const std::filesystem::path& path, const std::vector<ModelStep>& steps);
+
 // A trajectory as a trial's agent: from a file (its name and contents fix the key) or from arrays.
 class TrajectorySpec : public AgentSpec {
 public:

@@ -3,9 +3,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "bvc3d/config/building.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/recording/scan_file.hpp"
+#include "bvc3d/sensor/lidar_models.hpp"
 #include "bvc3d/world/mesh_import.hpp"
 
 namespace bvc3d::config {
@@ -316,14 +318,22 @@ bool world_preset_takes_tilt(const std::string& name) {
 }
 
 WorldDescription world_from_yaml(const YamlView& v) {
-    v.expect_map({"name", "objects", "walkable", "start", "flight_volume"});
+    const bool sdf = v.has("sdf");  // a Gazebo building (config/building.hpp)
+    if (sdf)
+        v.expect_map({"name", "sdf", "model_path", "geometry", "missing_models", "collada_up_axis", "floor_z",
+                      "step_height", "walkable", "start", "flight_volume"});
+    else v.expect_map({"name", "objects", "walkable", "start", "flight_volume"});
     WorldDescription w;
-    w.name = v.get("name", std::filesystem::path(v.file()).stem().string());
-    w.file = v.file();
-    const YamlView objects = v["objects"];
-    if (objects.size() == 0) objects.fail("lists no objects: a world needs geometry");
     std::optional<WorldDescription> arena;
-    for (std::size_t i = 0; i < objects.size(); ++i) add_object(objects.at(i), w, arena);
+    const YamlView objects = sdf ? v["sdf"] : v["objects"];
+    if (sdf) {
+        w = building_from_yaml(v);
+    } else {
+        w.name = v.get("name", std::filesystem::path(v.file()).stem().string());
+        w.file = v.file();
+        if (objects.size() == 0) objects.fail("lists no objects: a world needs geometry");
+        for (std::size_t i = 0; i < objects.size(); ++i) add_object(objects.at(i), w, arena);
+    }
 
     if (arena) w.tilt_deg = arena->tilt_deg;
     if (static_cast<double>(w.mesh.size()) > max_mesh_triangles)
@@ -333,12 +343,12 @@ WorldDescription world_from_yaml(const YamlView& v) {
         w.walkable = region_from_yaml(v["walkable"]);
     } else if (arena) {
         w.walkable = arena->walkable;
-    } else if (!v.has("flight_volume")) {
+    } else if (!sdf && !v.has("flight_volume")) {  // a building's is its floor's extent
         v.fail_key("walkable",
                    "is required (the floor region the robot may use) unless the world has a cross_arena "
                    "or a flight_volume");
     }
-    if (v.has("flight_volume")) {
+    if (v.has("flight_volume") && !(sdf && v["flight_volume"].is_scalar())) {  // sdf: `storey` is the building's
         w.flight = flight_from_yaml(v["flight_volume"], w);
     } else if (arena && !v.has("walkable")) {
         w.flight = arena->flight;
@@ -380,7 +390,13 @@ WorldDescription load_world_file(const std::string& path) { return world_from_ya
 
 std::vector<std::string> world_file_meshes(const std::string& path) {
     std::vector<std::string> files;
+    if (is_gazebo_file(path)) {  // the file itself is hashed by the caller
+        files = gazebo_world_files(path);
+        files.erase(std::remove(files.begin(), files.end(), path), files.end());
+        return files;
+    }
     const YamlView v = YamlView::load_file(path);
+    if (v.has("sdf")) return building_yaml_files(v);
     if (!v.has("objects") || !v["objects"].is_sequence()) return files;
     const YamlView objects = v["objects"];
     for (std::size_t i = 0; i < objects.size(); ++i) {
@@ -412,21 +428,31 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
     if (!std::filesystem::exists(name, ec)) {
         std::string list;
         for (const auto& p : presets) list += (list.empty() ? "" : ", ") + p;
-        throw InputError("world '" + name + "' is neither a preset (" + list + ") nor an existing YAML file");
+        throw InputError("world '" + name + "' is neither a preset (" + list +
+                         ") nor an existing YAML or Gazebo world (.world, .sdf) file");
+    }
+    if (is_gazebo_file(name)) {
+        BuildingSpec spec;
+        spec.file = name;
+        return building_world(spec);
     }
     return load_world_file(name);
 }
 
 namespace {
 
-// The built-in sensors, by name.
+// The built-in sensors, by name: the paper's scanners, then the real LiDAR models (sensor/lidar_models.hpp).
 const std::vector<std::pair<std::string, LidarSpec>>& builtin_sensors() {
-    static const std::vector<std::pair<std::string, LidarSpec>> sensors{
-        {"horizontal", LidarSpec::horizontal()},
-        {"spherical", LidarSpec::spherical()},
-        {"spherical-full", LidarSpec::spherical_full()},
-        {"spherical-authors", LidarSpec::spherical_as_authors()},
-    };
+    static const std::vector<std::pair<std::string, LidarSpec>> sensors = [] {
+        std::vector<std::pair<std::string, LidarSpec>> list{
+            {"horizontal", LidarSpec::horizontal()},
+            {"spherical", LidarSpec::spherical()},
+            {"spherical-full", LidarSpec::spherical_full()},
+            {"spherical-authors", LidarSpec::spherical_as_authors()},
+        };
+        for (const auto& m : lidar_models()) list.emplace_back(m.name, lidar_model_spec(m));
+        return list;
+    }();
     return sensors;
 }
 
@@ -436,28 +462,49 @@ const LidarSpec* find_builtin_sensor(const std::string& name) {
     return nullptr;
 }
 
+// "vlp16, hdl32, ..." (quoted: "'vlp16', 'hdl32', ...").
+std::string lidar_model_list(bool quoted = false) {
+    std::string list;
+    for (const auto& m : lidar_models()) list += (list.empty() ? "" : ", ") + (quoted ? "'" + m.name + "'" : m.name);
+    return list;
+}
+
+// The rows an upper-half model keeps of a beam table: elevations >= 0 (as `keep_rows: upper` of the
+// spherical scanner).
+LidarSpec upper_rows(LidarSpec s) {
+    std::erase_if(s.elevations, [](double e) { return e < 0; });
+    return s;
+}
+
 }  // namespace
 
 LidarSpec sensor_from_yaml(const YamlView& v) {
     if (v.is_scalar()) {
         const std::string name = v.as_string();
         if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
-        v.fail("expected horizontal, spherical, spherical-full, spherical-authors, or a sensor mapping");
+        v.fail("expected horizontal, spherical, spherical-full, spherical-authors, a LiDAR model (" +
+               lidar_model_list() + "), or a sensor mapping");
     }
-    if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping");
+    if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping (or a LiDAR model's name)");
     const std::string preset = v.get("preset", "");
     const bool own_rows = v.has("elevations") || v.has("elevations_deg");
     LidarSpec s;
     if (preset == "horizontal") {
         s = LidarSpec::horizontal();
-        if (v.has("keep_rows")) v.fail_key("keep_rows", "only applies to the spherical preset");
+        if (v.has("keep_rows")) v.fail_key("keep_rows", "only applies to the spherical preset and the LiDAR models");
     } else if (preset == "spherical") {
         const std::string rows = v.get("keep_rows", "upper");
         if (rows != "upper" && rows != "all") v["keep_rows"].fail("must be 'upper' or 'all'");
         if (own_rows && v.has("keep_rows")) v.fail_key("keep_rows", "cannot be combined with elevations");
         s = LidarSpec::spherical(rows == "upper");
+    } else if (const LidarModel* model = find_lidar_model(preset)) {
+        const std::string rows = v.get("keep_rows", "all");  // a real scanner's beams, all of them
+        if (rows != "upper" && rows != "all") v["keep_rows"].fail("must be 'upper' or 'all'");
+        if (own_rows && v.has("keep_rows")) v.fail_key("keep_rows", "cannot be combined with elevations");
+        s = rows == "upper" ? upper_rows(lidar_model_spec(*model)) : lidar_model_spec(*model);
     } else if (!preset.empty()) {
-        v["preset"].fail("unknown sensor preset '" + preset + "' (expected horizontal or spherical)");
+        v["preset"].fail("unknown sensor preset '" + preset +
+                         "' (expected horizontal, spherical or a LiDAR model: " + lidar_model_list() + ")");
     } else if (!own_rows) {
         v.fail("a custom sensor needs 'elevations_deg' (or a 'preset')");
     } else {
@@ -493,7 +540,8 @@ LidarSpec resolve_sensor(const std::string& name) {
     if (!std::filesystem::exists(name, ec))
         throw InputError(
             "sensor '" + name +
-            "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors' nor an existing YAML file");
+            "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors', a LiDAR model (" +
+            lidar_model_list(true) + ") nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }

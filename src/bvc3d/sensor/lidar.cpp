@@ -62,6 +62,8 @@ const params::Table<LidarSpec>& LidarSpec::table() {
          real("azimuth_offset", &LidarSpec::azimuth_offset, closed(-2 * pi, 2 * pi), "rad, the first column's azimuth")
              .in_radians(),
          real("height", &LidarSpec::height, closed(0, 1000), "m above the agent's base"),
+         real("min_range", &LidarSpec::min_range, closed_open(0, 1e5), "m, nearest return (nearer ones are dropped)")
+             .quiet_at_default(),
          real("max_range", &LidarSpec::max_range, open_closed(0, 1e5), "m, farthest return"),
          real("range_noise_sd", &LidarSpec::range_noise_sd, closed(0, 1000), "m, Gaussian noise added to each range"),
          real("dropout", &LidarSpec::dropout, closed_open(0, 1), "probability that a beam returns nothing"),
@@ -82,6 +84,8 @@ const params::Table<LidarSpec>& LidarSpec::table() {
 
 void LidarSpec::validate() const {
     table().check(*this);
+    if (!(min_range < max_range))
+        table().fail("min_range", "must be less than max_range (" + format_number(max_range) + " m)");
     if (!elevation_labels.empty() && elevation_labels.size() != elevations.size())
         table().fail("elevation_labels", "must list one label per row (" + std::to_string(elevations.size()) +
                                              "), got " + std::to_string(elevation_labels.size()));
@@ -208,8 +212,11 @@ void Lidar::write_returns(Scan& out, const NoiseKey& noise) const {
         for (std::size_t j = 0; j < n_cols; ++j) {
             double r = range[j * n_cast + c];
             if (r == RayCaster::no_hit) continue;
-            if constexpr (noisy)
+            if constexpr (noisy) {
                 if (!add_noise(r, noise, i * n_cols + j)) continue;
+            } else if (r < spec_.min_range) {
+                continue;
+            }
             out.push_back({r, azimuth[j], elevation});
         }
     }
@@ -223,7 +230,7 @@ bool Lidar::add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) cons
         r += spec_.range_noise_sd * std::sqrt(-2.0 * std::log(u1)) * std::cos(two_pi * u2);
         if (r <= 0.0 || r > spec_.max_range) return false;
     }
-    return true;
+    return r >= spec_.min_range;
 }
 
 void Lidar::scan_tilted(const World& world, const Pose& pose, Scan& out, const NoiseKey& noise) const {
@@ -241,7 +248,8 @@ void Lidar::scan_tilted(const World& world, const Pose& pose, Scan& out, const N
         world.rays().cast(origin, dirs_, spec_.max_range, ranges_);
         for (std::size_t j = 0; j < n_cols; ++j) {
             double r = ranges_[j];
-            if (r == RayCaster::no_hit || (noisy && !add_noise(r, noise, i * n_cols + j))) continue;
+            if (r == RayCaster::no_hit || (noisy ? !add_noise(r, noise, i * n_cols + j) : r < spec_.min_range))
+                continue;
             const Vec3& d = dirs_[j];
             out.push_back({r, wrap_pi(std::atan2(d.y(), d.x())), std::atan2(d.z(), std::hypot(d.x(), d.y()))});
         }

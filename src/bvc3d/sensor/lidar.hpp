@@ -43,6 +43,7 @@ struct LidarSpec {
     int azimuth_count = 720;
     double azimuth_offset = 0.0;  // radians
     double height = 0.08;         // m above the agent's base (for a ground robot, above the floor)
+    double min_range = 0.0;       // m, nearer returns are dropped (a real scanner's blind zone)
     double max_range = 20.0;      // m
     double range_noise_sd = 0.0;  // m, Gaussian noise added to each range
     double dropout = 0.0;         // probability that a beam returns nothing
@@ -72,9 +73,9 @@ struct LidarSpec {
     // Same beams, same labels, same noise: scans are identical whatever the names.
     bool same_beams(const LidarSpec& o) const {
         return elevations == o.elevations && azimuth_count == o.azimuth_count && azimuth_offset == o.azimuth_offset &&
-               height == o.height && max_range == o.max_range && range_noise_sd == o.range_noise_sd &&
-               dropout == o.dropout && azimuth_labels == o.azimuth_labels && heading_roll == o.heading_roll &&
-               elevation_labels == o.elevation_labels;
+               height == o.height && min_range == o.min_range && max_range == o.max_range &&
+               range_noise_sd == o.range_noise_sd && dropout == o.dropout && azimuth_labels == o.azimuth_labels &&
+               heading_roll == o.heading_roll && elevation_labels == o.elevation_labels;
     }
     static const params::Table<LidarSpec>& table();
     void validate() const;                    // throws params::ParamError naming the bad field
@@ -113,7 +114,7 @@ private:
     void set_beams(double heading) const;
     template <bool noisy>
     void write_returns(Scan& out, const NoiseKey& noise) const;
-    // Adds the beam's noise to r; false if the beam drops out or leaves (0, max_range].
+    // Adds the beam's noise to r; false if the beam drops out or leaves [min_range, max_range].
     bool add_noise(double& r, const NoiseKey& noise, std::uint64_t beam) const;
 
     LidarSpec spec_;

@@ -1,11 +1,13 @@
 #include "bvc3d/world/mesh_import.hpp"
 
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -85,9 +87,33 @@ void collect(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d& pa
     for (unsigned c = 0; c < node->mNumChildren; ++c) collect(scene, node->mChildren[c], xf, out, depth + 1);
 }
 
+bool is_collada(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".dae";
+}
+
+// assimp 5.2 cannot read a number list that starts with white space (`<color> 0.3 0.3 0.3 1</color>`,
+// assimp issue #4951, fixed in 5.4): such files are read again with the white space between a tag
+// and a number removed, which changes no value (XML lists of numbers ignore it).
+std::string without_space_before_numbers(const std::string& xml) {
+    std::string out;
+    out.reserve(xml.size());
+    for (std::size_t i = 0; i < xml.size(); ++i) {
+        out += xml[i];
+        if (xml[i] != '>') continue;
+        std::size_t j = i + 1;
+        while (j < xml.size() && std::isspace(static_cast<unsigned char>(xml[j]))) ++j;
+        if (j < xml.size() && j > i + 1 &&
+            (std::isdigit(static_cast<unsigned char>(xml[j])) || xml[j] == '-' || xml[j] == '+' || xml[j] == '.'))
+            i = j - 1;
+    }
+    return out;
+}
+
 }  // namespace
 
-TriangleMesh load_mesh_file(const std::string& path) {
+TriangleMesh load_mesh_file(const std::string& path, const MeshFileOptions& options) {
     const std::string where = "mesh file '" + path + "'";
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw InputError(where + ": file does not exist");
@@ -112,9 +138,17 @@ TriangleMesh load_mesh_file(const std::string& path) {
     std::vector<std::string> warnings;
     WarningCapture::current = &warnings;
     Assimp::Importer importer;
+    const bool collada = is_collada(path);
+    if (collada && options.collada_up_axis == ColladaUpAxis::ignored)
+        importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
     // Validation checks what assimp built (indices in range, ...) before we read it.
-    const aiScene* scene = importer.ReadFile(
-        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);
+    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure;
+    const aiScene* scene = importer.ReadFile(path, flags);
+    if (!scene && collada && std::string(importer.GetErrorString()).find("Cannot parse string") != std::string::npos) {
+        warnings.clear();
+        const std::string fixed = without_space_before_numbers(bytes);
+        scene = importer.ReadFileFromMemory(fixed.data(), fixed.size(), flags, "dae");
+    }
     WarningCapture::current = nullptr;
     if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
         throw InputError(where + ": cannot be read as a mesh (" + importer.GetErrorString() + ")");
@@ -126,8 +160,12 @@ TriangleMesh load_mesh_file(const std::string& path) {
                              ")");
         }
     TriangleMesh mesh;
+    // assimp turned the declared up axis to +y; +y becomes +z: (x, y, z) -> (x, -z, y).
+    Eigen::Matrix4d root = Eigen::Matrix4d::Identity();
+    if (collada && options.collada_up_axis == ColladaUpAxis::to_z_up)
+        root.topLeftCorner<3, 3>() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
     try {
-        collect(scene, scene->mRootNode, Eigen::Matrix4d::Identity(), mesh);
+        collect(scene, scene->mRootNode, root, mesh);
     } catch (const InputError& e) {
         throw InputError(where + ": " + e.what());
     }

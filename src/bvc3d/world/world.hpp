@@ -33,6 +33,17 @@ struct SphereSet {
     double radius = 0.05;  // m
 };
 
+// A named piece of a world's geometry (an SDF visual or collision: docs/buildings.md), for messages,
+// tests and the viewer: a range of triangles, or one sphere.
+struct WorldPart {
+    std::string name;   // its element path: world/model/link/visual
+    std::string shape;  // box, cylinder, sphere, plane or mesh
+    std::string file;   // the file that declares it
+    std::size_t first_triangle = 0, triangle_count = 0;
+    int sphere_set = -1;  // a sphere: its set in `spheres` and its index there
+    std::size_t sphere_index = 0;
+};
+
 struct WorldDescription {
     std::string name;
     std::string file;                // the YAML file it came from (errors about its keys name it); empty for presets
@@ -42,6 +53,19 @@ struct WorldDescription {
     Polygon2 walkable;  // the robot's body stays inside this floor polygon (none in a flight-only world)
     StartRegion start;
     std::optional<FlightVolume> flight;  // where a flying agent may fly; none in a ground-only world
+    // Where the floor the ground agent stands on ends (a stairwell, the edge of a slab): its body may
+    // not cross them. They are no geometry: the sensors do not see them.
+    std::vector<std::array<Vec2, 2>> drop_edges;
+    // A building read from a file whose floors are not at z = 0 (docs/buildings.md#floors) was moved
+    // down by the chosen floor's height, so that its floor is at z = 0: file z = world z + floor_z.
+    double floor_z = 0.0;
+    // The ground robot's body passes over geometry lower than this above the floor (a carpet, a
+    // door sill); 0: everything above the floor blocks it.
+    double step_height = 0.0;
+    std::vector<WorldPart> parts;  // named pieces of `mesh` and `spheres` (empty: none named)
+    // Models a building's file includes but that were not found and were left out on request
+    // (docs/buildings.md: missing_models: skip), as "NAME at world/...".
+    std::vector<std::string> left_out;
 
     bool has_geometry() const;
     // The box holding every triangle and sphere (empty for a world without geometry).
