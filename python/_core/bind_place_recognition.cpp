@@ -207,7 +207,11 @@ void bind_place_recognition(pyb::module_& m) {
             const bool recorded = !scans.is_none() || !poses.is_none();
             if (recorded == (!world.is_none() || !route.is_none() || !sensor.is_none()))
                 throw InputError("give either a recording (scans, poses) or a route (world, route, sensor)");
-            if (recorded) {
+            if (recorded && pyb::isinstance<recording::Recording>(scans)) {
+                // A Recording however it was opened (Recording.open, or any other reader of one).
+                if (!poses.is_none()) throw InputError("a Recording carries its poses: give no poses with it");
+                seq = std::make_unique<RecordingSequence>(scans.cast<std::shared_ptr<recording::Recording>>());
+            } else if (recorded) {
                 if (scans.is_none() || poses.is_none()) throw InputError("a recording needs scans and poses");
                 recording::RecordingOptions ro;
                 ro.pose_format = recording::parse_pose_format(pose_format);
@@ -237,7 +241,8 @@ void bind_place_recognition(pyb::module_& m) {
         pyb::arg("pose_format") = "auto", pyb::arg("time_tolerance") = 0.05,
         (std::string(
              R"doc(Place recognition, the field's protocol (docs/place-recognition.md), as `bvc3d place-recognition`:
-on a recording (scans, poses) or a simulated route (world, route = a trajectory file, sensor).
+on a recording (scans, poses; or a Recording as scans) or a simulated route (world, route = a trajectory
+file, sensor).
 descriptors: a comma-separated string or a list of bvc:MODEL, bvc-drift:MODEL, bvc-free:MODEL,
 place-cells:MODEL, scan-context. database, queries: (first, last) or "A:B" scans (both included) for
 the split protocol; else sequential loop closure. Returns a dict of tables, each a dict of columns:

@@ -464,6 +464,13 @@ def test_a_recording_of_the_route_gives_what_the_route_gives(tmp_path):
     np.testing.assert_allclose(rec["queries"]["distance"], sim["queries"]["distance"], atol=1e-5)
     np.testing.assert_allclose(rec["scans"]["t"], sim["scans"]["t"], atol=1e-9)
     np.testing.assert_allclose(rec["scans"]["heading"], sim["scans"]["heading"], atol=1e-9)
+    # A Recording opened beforehand (as any reader of recordings gives one) is the same input.
+    opened = bvc3d.Recording.open(tmp_path / "rec" / "scans.txt", tmp_path / "rec" / "poses.txt")
+    again = bvc3d.place_recognition(opened, descriptors=descriptors, exclude_seconds=10)
+    for key in rec["queries"]:
+        np.testing.assert_array_equal(again["queries"][key], rec["queries"][key], err_msg=key)
+    with pytest.raises(ValueError, match="carries its poses"):
+        bvc3d.place_recognition(opened, tmp_path / "rec" / "poses.txt")
 
 
 HALL = SOURCE_DIR.parent / "shared" / "data" / "hall-lidar"
