@@ -12,8 +12,11 @@ own tables stay there. Steps (default: all but buildings, in this order):
   kitti      KITTI 00, 02, 05: every descriptor, both protocols (kitti.csv, kitti-published.csv,
              kitti-direction.csv, figures pr-kitti.png and pr-kitti-false.png)
   drift      the allocentric BVC descriptor with the heading drifting 0-60 degrees per sqrt(min) (kitti-drift.csv)
-  hall       the hall recording: every descriptor, the protocols that apply (hall.csv, pr-hall.png)
-  buildings  tours of the Gazebo hospital and small house (needs the buildings worlds, sensors and tours)
+  hall       the hall recording: every descriptor, the protocols that apply (hall.csv)
+  buildings  tours of the Gazebo hospital and small house scanned by an os1-64: every descriptor, recall by
+             revisit radius and direction, the false loop closures; the tour driven again at the same height
+             and with the sensor 0.5 m higher (buildings.csv, buildings-radius.csv, buildings-false.csv,
+             figures pr-buildings.png, pr-hospital.png, pr-small-house.png)
 """
 import argparse
 import csv
@@ -43,7 +46,7 @@ SPLITS = {"00": ("0:3000", "3200:4540"), "02": ("0:3400", "3600:4660"), "05": ("
 # quotes it): learned, rotation-invariant, and none reads the pose.
 PUBLISHED = {"PointNetVLAD": (91.6, 62.3, 76.9), "MinkLoc3D-V2": (95.9, 72.3, 86.4),
              "OverlapTransformer": (96.7, 80.1, 91.9), "BEVPlace": (99.7, 98.1, 99.3)}
-KITTI_DESCRIPTORS = [f"bvc:2d", f"bvc:{STREET}", f"bvc:{STREET32}", f"bvc-drift:{STREET32}", f"bvc-free:{STREET32}",
+KITTI_DESCRIPTORS = ["bvc:2d", f"bvc:{STREET}", f"bvc:{STREET32}", f"bvc-drift:{STREET32}", f"bvc-free:{STREET32}",
                      f"place-cells:{STREET32}", "scan-context"]
 # KITTI-BEV's points reach 35 m (the image's corners): nothing is dropped for range.
 KITTI_RANGE = ["--max-range", "40"]
@@ -366,14 +369,26 @@ def hall(data, work):
 
 # ------------------------------------------------------------------------------------------- buildings
 
+# The AWS worlds include models that Gazebo fetches from its online store; they are not in the data set,
+# so the buildings are loaded without them (docs/buildings.md).
 BUILDINGS = {"hospital": "gazebo/aws-robomaker-hospital-world/worlds/hospital.world",
              "small-house": "gazebo/aws-robomaker-small-house-world/worlds/small_house.world"}
-BUILDING_SENSOR = "os1-64"  # a real 64-beam sensor model with its range noise (issue 27's presets)
+BUILDING_SENSOR = "os1-64"  # a real 64-beam sensor model with its range noise (0.03 m), 0.18 m above the base
 BUILDING3D = str(HERE / "building-3d.yaml")
-BUILDING_DESCRIPTORS = ["bvc:2d", "bvc:3d-0.1", "bvc:3d-0.2", "bvc:3d-3l", f"bvc:{BUILDING3D}", "bvc-free:3d-3l",
-                        f"bvc-free:{BUILDING3D}", "place-cells:3d-3l", f"place-cells:{BUILDING3D}", "scan-context"]
+BUILDING1L = str(HERE / "building-1l.yaml")  # building-3d's horizontal layer alone: what its upward layers add
+BUILDING_DESCRIPTORS = ["bvc:2d", "bvc:3d-0.1", "bvc:3d-0.2", "bvc:3d-3l", f"bvc:{BUILDING1L}", f"bvc:{BUILDING3D}",
+                        f"bvc-drift:{BUILDING3D}", "bvc-free:3d-3l", f"bvc-free:{BUILDING3D}", "place-cells:3d-3l",
+                        f"place-cells:{BUILDING3D}", "scan-context"]
+# The drives at two heights: the descriptors whose answer the height could change, one of each kind.
+HEIGHT_DESCRIPTORS = ["bvc:2d", "bvc:3d-3l", f"bvc:{BUILDING1L}", f"bvc:{BUILDING3D}", f"bvc-free:{BUILDING3D}",
+                      f"place-cells:{BUILDING3D}", "scan-context"]
 BUILDING_FIGURE = ["bvc:2d", "bvc:3d-3l", "bvc:building-3d", "scan-context"]
-RAISED = 0.5  # m: the sensor's height above the map's, for the height step (queries 0.5 m higher)
+RADII = [1.0, 2.0, 5.0]  # m: recall@1 with these revisit radii, from the runs at the protocol's 5 m
+FAR_M = 10.0  # m: a false loop closure this far from the query joins two different places
+# The step further: the tour driven twice, the second drive as queries against the first. "level": the
+# same height (only the sensor's noise differs: the control); "raised": the sensor 0.5 m higher, as a
+# robot of another height, or a map made by another platform, would see the building.
+HEIGHT_STEPS = {"level": 0.0, "raised": 0.5}
 
 
 def bvc3d(*args, **kw):
@@ -382,113 +397,217 @@ def bvc3d(*args, **kw):
     return subprocess.run(cmd, check=True, **kw)
 
 
-def floor_plan(world, route, work, name):
-    """The building seen from above: the points a scan of every 20th route pose hits between 0.3 and 1.8 m
-    above the floor (export-scans' scans in the world frame)."""
+def world_yaml(data, work, name):
+    """A world YAML in work that loads the building without the models it cannot find."""
+    path = work / f"{name}.yaml"
+    path.write_text(f"sdf: {data / BUILDINGS[name]}\nmissing_models: skip\n")
+    return path
+
+
+def floor_plan(world, route, every=20):
+    """The building seen from above: the points that os1-64 scans from every 20th pose of the route hit
+    between 0.3 and 1.8 m above the floor (x, y)."""
+    import bvc3d as py
+    w = py.World.from_yaml(world)
     rows = np.loadtxt(route, delimiter=",", skiprows=1)
-    header = route.read_text().splitlines()[0]
-    sparse = work / f"{name}-plan-route.csv"
-    np.savetxt(sparse, rows[::20], delimiter=",", header=header, comments="", fmt="%.9g")
-    folder = work / f"{name}-plan"
-    bvc3d("export-scans", "--world", world, "--trajectory", sparse, "--sensor", BUILDING_SENSOR, "--format", "pcd",
-          "--out", folder)
-    poses = np.loadtxt(folder / "poses.txt", delimiter=",", usecols=(0, 1, 2, 3)).reshape(-1, 4, 4)  # 4x4 rows, time
     points = []
-    for k, pose in enumerate(poses):
-        data = (folder / f"{k:06d}.pcd").read_bytes()
-        p = np.frombuffer(data[data.index(b"DATA binary\n") + 12:], dtype="<f4").reshape(-1, 3).astype(float)
-        w = p @ pose[:3, :3].T + pose[:3, 3]
-        points.append(w[(w[:, 2] > 0.3) & (w[:, 2] < 1.8), :2])
+    for t, x, y, z, heading in rows[::every, :5]:
+        s = w.scan(BUILDING_SENSOR, x, y, heading, z=z)
+        r, az, el = s[:, 0], s[:, 1], s[:, 2]
+        p = np.column_stack([x + r * np.cos(el) * np.cos(az), y + r * np.cos(el) * np.sin(az),
+                             z + 0.18 + r * np.sin(el)])
+        points.append(p[(p[:, 2] > 0.3) & (p[:, 2] < 1.8), :2])
     return np.vstack(points)
 
 
-def building_figure(work, name, plan):
+def nearest_older(out, window_s=30.0, window_scans=50):
+    """Per scan of a sequential run: the distance (m) to the nearest scan outside its exclusion window and
+    that scan's heading difference (rad); NaN where none is old enough."""
+    scans = read_csv(out / "scans.csv")
+    xy = np.array([[float(s["x"]), float(s["y"])] for s in scans])
+    h = np.array([float(s["heading"]) for s in scans])
+    t = np.array([float(s["t"]) for s in scans])
+    near, turn = np.full(len(xy), np.nan), np.full(len(xy), np.nan)
+    for i in range(len(xy)):
+        old = np.nonzero((i - np.arange(len(xy)) > window_scans) & (t[i] - t > window_s))[0]
+        if len(old):
+            d = np.hypot(*(xy[old] - xy[i]).T)
+            near[i] = d.min()
+            turn[i] = abs(math.remainder(h[i] - h[old[np.argmin(d)]], 2 * math.pi))
+    return near, turn
+
+
+def radius_rows(out, name):
+    """Recall@1 with revisit radii of 1, 2 and 5 m (the best match does not depend on the radius): the
+    queries whose nearest older scan lies within R, and how many of their matches lie within R; split by
+    the direction of that nearest scan (same: within 90 degrees)."""
+    near, turn = nearest_older(out)
+    rows = []
+    for q_desc in [d["descriptor"] for d in read_csv(out / "details.csv")]:
+        queries = [q for q in read_csv(out / "queries.csv") if q["descriptor"] == q_desc]
+        i = np.array([int(q["query"]) for q in queries])
+        m = np.array([float(q["match_m"]) for q in queries])
+        for radius in RADII:
+            for direction, keep in [("both", np.ones(len(i), bool)), ("same", turn[i] <= math.pi / 2),
+                                    ("opposite", turn[i] > math.pi / 2)]:
+                has = (near[i] <= radius) & keep
+                rows.append(dict(building=name, descriptor=q_desc, radius_m=radius, direction=direction,
+                                 revisits=int(has.sum()),
+                                 recall_at_1=f"{np.mean(m[has] <= radius):.4f}" if has.any() else "nan"))
+    return rows
+
+
+def false_rows(out, name):
+    """False loop closures per descriptor: at its F1max threshold (how many, how far, how many join places
+    more than 10 m apart), and at equal recall (25 and 50 % of the revisits: the false ones then accepted,
+    from the curve's interpolated precision)."""
+    pr, queries = read_csv(out / "pr.csv"), read_csv(out / "queries.csv")
+    rows = []
+    for d in read_csv(out / "details.csv"):
+        name_d = d["descriptor"]
+        curve = [p for p in pr if p["descriptor"] == name_d]
+        tau = f1_threshold(curve)
+        accepted = [q for q in queries if q["descriptor"] == name_d and float(q["distance"]) <= tau]
+        false = np.array([float(q["match_m"]) for q in accepted if q["correct"] != "1"])
+        row = dict(building=name, descriptor=name_d, threshold=f"{tau:.6f}",
+                   right=sum(1 for q in accepted if q["correct"] == "1"), false=len(false),
+                   false_far=int(np.sum(false > FAR_M)),
+                   false_median_m=f"{np.median(false):.1f}" if len(false) else "")
+        revisits = int(d["revisits"])
+        for r in (0.25, 0.5):
+            ps = [float(p["precision"]) for p in curve if float(p["recall"]) >= r]
+            p = max(ps) if ps else 0.0
+            row[f"false_at_recall_{int(r * 100)}"] = f"{r * revisits * (1 - p) / p:.0f}" if p > 0 else ""
+        rows.append(row)
+    return rows
+
+
+def threshold_at_recall(curve, recall):
+    """The smallest threshold at which a curve reaches `recall` (its largest if it never does)."""
+    reached = [float(p["threshold"]) for p in curve if float(p["recall"]) >= recall]
+    return min(reached) if reached else max(float(p["threshold"]) for p in curve)
+
+
+def building_figure(out, name, plan):
+    """The building from above with the tour, and per descriptor its false loop closures where it finds a
+    quarter of the revisits (red: from the query to where it was matched): the same recall for each."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    out = work / f"{name}-tour"
     scans = read_csv(out / "scans.csv")
     xy = np.array([[float(s["x"]), float(s["y"])] for s in scans])
     pr, queries = read_csv(out / "pr.csv"), read_csv(out / "queries.csv")
-    fig, axes = plt.subplots(1, len(BUILDING_FIGURE), figsize=(4.8 * len(BUILDING_FIGURE), 5))
-    rows = []
-    for ax, descriptor in zip(axes, BUILDING_FIGURE):
-        tau = f1_threshold([p for p in pr if p["descriptor"] == descriptor])
-        ax.plot(plan[:, 0], plan[:, 1], ",", c="0.6")
-        ax.plot(xy[:, 0], xy[:, 1], c="0.3", lw=0.5)
-        right, false = 0, []
+    wide = np.ptp(plan[:, 0]) > np.ptp(plan[:, 1])
+    n = len(BUILDING_FIGURE)
+    fig, axes = plt.subplots(2 if wide else 1, n // 2 if wide else n, figsize=(13, 8.4) if wide else (4.4 * n, 9.4))
+    for ax, descriptor in zip(axes.flat, BUILDING_FIGURE):
+        tau = threshold_at_recall([p for p in pr if p["descriptor"] == descriptor], 0.25)
+        ax.plot(plan[:, 0], plan[:, 1], ",", c="0.55")
+        ax.plot(xy[:, 0], xy[:, 1], c="tab:blue", lw=0.4, alpha=0.6)
+        right, false = 0, 0
         for q in queries:
             if q["descriptor"] != descriptor or float(q["distance"]) > tau:
                 continue
             i, m = int(q["query"]), int(q["match"])
             if q["correct"] == "1":
                 right += 1
-            else:
-                false.append(float(q["match_m"]))
-                ax.plot([xy[i, 0], xy[m, 0]], [xy[i, 1], xy[m, 1]], "-", c="tab:red", lw=0.7)
-                ax.plot(*xy[i], ".", c="tab:red", ms=3)
-        ax.set_title(f"{name}, {descriptor}\nat its F1max threshold: {right} right, {len(false)} false", fontsize=9)
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel("x (m)")
-        rows.append(dict(building=name, descriptor=descriptor, threshold=f"{tau:.6f}", right=right, false=len(false),
-                         false_median_m=f"{np.median(false):.1f}" if false else ""))
+                continue
+            false += 1
+            ax.plot([xy[i, 0], xy[m, 0]], [xy[i, 1], xy[m, 1]], "-", c="tab:red", lw=0.5, alpha=0.5)
+            ax.plot(*xy[i], "o", c="tab:red", ms=2)
+        ax.set_title(f"{name}, {descriptor}\nat a quarter of the revisits: {right} right, {false} false", fontsize=9)
+        ax.set_xlim(plan[:, 0].min() - 0.5, plan[:, 0].max() + 0.5)
+        ax.set_ylim(plan[:, 1].min() - 0.5, plan[:, 1].max() + 0.5)
+        ax.set_aspect("equal")
+        ax.tick_params(labelsize=7)
     fig.tight_layout()
-    fig.savefig(FIGURES / f"pr-{name}.png", dpi=110)
+    fig.savefig(FIGURES / f"pr-{name}.png", dpi=100)
     plt.close(fig)
     log("wrote", FIGURES / f"pr-{name}.png")
-    return rows
 
 
-def raised(route, work, name):
-    """The tour driven twice, the second time with the sensor RAISED higher (times continue): with the
-    first drive as the database and the second as the queries, a map made at one height queried at another."""
+def figure_buildings_pr(work):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(BUILDINGS), figsize=(12, 5.2), sharey=True)
+    for ax, name in zip(axes, BUILDINGS):
+        out = work / f"{name}-tour"
+        pr = read_csv(out / "pr.csv")
+        for d in read_csv(out / "details.csv"):
+            points = [p for p in pr if p["descriptor"] == d["descriptor"]]
+            heading = " *" if d["uses_heading"] == "1" else ""
+            ax.plot([float(p["recall"]) for p in points], [float(p["precision"]) for p in points], lw=1.1,
+                    ls="--" if d["descriptor"].startswith(("bvc-", "place-")) else "-",
+                    label=f"{d['descriptor']}{heading}: R@1 {100 * float(d['recall_at_1']):.1f}%, "
+                          f"F1 {float(d['f1_max']):.2f}")
+        ax.set_title(f"{name} tour ({BUILDING_SENSOR}), sequential loop closure", fontsize=10)
+        ax.set_xlabel("recall")
+        ax.set_xlim(0, 1.02)
+        ax.set_ylim(0, 1.02)
+        ax.legend(fontsize=6.5, loc="lower left")
+    axes[0].set_ylabel("precision")
+    fig.suptitle("* reads the pose's heading", fontsize=9, x=0.99, ha="right")
+    fig.tight_layout()
+    fig.savefig(FIGURES / "pr-buildings.png", dpi=110)
+    plt.close(fig)
+    log("wrote", FIGURES / "pr-buildings.png")
+
+
+def driven_twice(route, work, name, lift):
+    """The tour driven twice (times continue), the second time with the base `lift` m higher; returns the
+    route file and the number of rows of one drive."""
     rows = np.loadtxt(route, delimiter=",", skiprows=1)
     names = route.read_text().splitlines()[0].split(",")
-    if "z" not in names:
-        rows = np.insert(rows, 3, 0.0, axis=1)
-        names.insert(3, "z")
     second = rows.copy()
     second[:, 0] += rows[-1, 0] + 1.0
-    second[:, names.index("z")] += RAISED
-    path = work / f"{name}-raised.csv"
-    np.savetxt(path, np.vstack([rows, second]), delimiter=",", header=",".join(names), comments="", fmt="%.9g")
+    second[:, names.index("z")] += lift
+    path = work / f"{name}-twice-{lift:g}.csv"
+    np.savetxt(path, np.vstack([rows, second]), delimiter=",", header=",".join(names), comments="", fmt="%.17g")
     return path, len(rows)
 
 
 def buildings(data, work):
     """Tours of the Gazebo hospital and small house scanned by a real sensor model (issue 27's worlds,
-    sensors and tours): every descriptor, the sequential protocol, where the false positives lie, and the
-    same tour queried with the sensor 0.5 m higher than the map's."""
+    sensors and tours): every descriptor, the sequential protocol, recall by revisit radius and direction,
+    where the false loop closures lie; then the tour driven again as queries, at the same height and with
+    the sensor 0.5 m higher."""
     if subprocess.run([str(ROOT / "build" / "bvc3d"), "route", "--help"], capture_output=True).returncode != 0:
-        sys.exit("the buildings step needs `bvc3d route --tour`, Gazebo worlds and real sensor presets (issue 27): "
-                 "not in this build")
-    rows, directions, false_rows = [], [], []
-    for name, relative in BUILDINGS.items():
-        world = data / relative
+        sys.exit("the buildings step needs `bvc3d route --tour`, Gazebo worlds and real sensor presets: not in "
+                 "this build")
+    model, cores = machine()
+    rows, radius, false = [], [], []
+    for name in BUILDINGS:
+        world = world_yaml(data, work, name)
         route = work / f"{name}-tour-route.csv"
         if not route.exists():
             bvc3d("route", "--world", world, "--tour", "--out", route)
-        for protocol, path, extra in [("sequential", route, []), ("raised", *raised_args(route, work, name))]:
-            out = work / f"{name}-{'tour' if protocol == 'sequential' else 'raised'}"
-            details, _, _, _ = place_recognition(out, "--world", world, "--route", path, "--sensor", BUILDING_SENSOR,
-                                                 "--descriptors", ",".join(BUILDING_DESCRIPTORS), *extra,
-                                                 "--no-figure")
+        runs = [("sequential", f"{name}-tour", route, BUILDING_DESCRIPTORS, [])]
+        for step, lift in HEIGHT_STEPS.items():
+            path, n = driven_twice(route, work, name, lift)
+            runs.append((step, f"{name}-{step}", path, HEIGHT_DESCRIPTORS,
+                         ["--database", f"0:{n - 1}", "--queries", f"{n}:{2 * n - 1}"]))
+        for protocol, folder, path, descriptors, extra in runs:
+            out = work / folder
+            load = os.getloadavg()[0]
+            details, wall, user, _ = place_recognition(out, "--world", world, "--route", path, "--sensor",
+                                                       BUILDING_SENSOR, "--descriptors", ",".join(descriptors),
+                                                       "--threads", 2, *extra, "--no-figure")
             for d in details:
-                rows.append(dict(d, building=name, protocol=protocol))
-            if protocol == "sequential":
-                directions += [dict(r, sequence=name) for r in direction_rows(out, name, protocol)]
-        false_rows += building_figure(work, name, floor_plan(world, route, work, name))
+                rows.append(dict(d, building=name, protocol=protocol, scans=len(read_csv(out / "scans.csv")),
+                                 wall_s=f"{wall:.1f}", user_s=f"{user:.1f}", load_before=f"{load:.2f}", cpu=model,
+                                 cores=cores))
+        radius += radius_rows(work / f"{name}-tour", name)
+        false += false_rows(work / f"{name}-tour", name)
+        building_figure(work / f"{name}-tour", name, floor_plan(world, route))
     write_csv("buildings.csv", rows, ["building", "protocol", "descriptor", "uses_heading", "recall_at_1", "f1_max",
-                                      "auc", "queries", "revisits", "correct", "median_match_m"])
-    write_csv("buildings-direction.csv", directions, ["sequence", "protocol", "descriptor", "direction", "revisits",
-                                                      "recall_at_1"])
-    write_csv("buildings-false.csv", false_rows, ["building", "descriptor", "threshold", "right", "false",
-                                                  "false_median_m"])
-
-
-def raised_args(route, work, name):
-    path, n = raised(route, work, name)
-    return path, ["--database", f"0:{n - 1}", "--queries", f"{n}:{2 * n - 1}"]
+                                      "auc", "queries", "revisits", "correct", "median_match_m", "describe_s",
+                                      "scans", "wall_s", "user_s", "load_before", "cpu", "cores"])
+    write_csv("buildings-radius.csv", radius, ["building", "descriptor", "radius_m", "direction", "revisits",
+                                               "recall_at_1"])
+    write_csv("buildings-false.csv", false, ["building", "descriptor", "threshold", "right", "false", "false_far",
+                                             "false_median_m", "false_at_recall_25", "false_at_recall_50"])
+    figure_buildings_pr(work)
 
 
 def main():
