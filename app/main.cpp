@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
     bvc3d::cli::add_recording_commands(app);
     bvc3d::cli::add_view_command(app);
     bvc3d::cli::add_adaptive_command(app);
+    bvc3d::cli::add_place_recognition_command(app);
     bvc3d::cli::add_route_command(app);
     bvc3d::cli::add_navigate_command(app);
     try {

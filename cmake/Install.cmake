@@ -17,6 +17,7 @@ set(BVC3D_PRIVATE_HEADERS
   bvc3d/place/place_kernels.hpp
   bvc3d/core/simd.hpp
   bvc3d/analysis/point_grid.hpp
+  bvc3d/analysis/cosine_kernels.hpp
   bvc3d/recorder/hdf5_io.hpp
   bvc3d/recording/file_io.hpp
   bvc3d/recording/parsing.hpp

@@ -158,6 +158,7 @@ void bind_model(pyb::module_& m);
 void bind_experiment(pyb::module_& m);
 void bind_analysis(pyb::module_& m);
 void bind_recording(pyb::module_& m);
+void bind_place_recognition(pyb::module_& m);
 void bind_buildings(pyb::module_& m);  // after bind_simulator: it adds to World
 void bind_navigation(pyb::module_& m);
 void bind_populations(pyb::module_& m);

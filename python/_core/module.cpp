@@ -110,6 +110,7 @@ PYBIND11_MODULE(_core, m) {
     bvc3d::py::bind_experiment(m);
     bvc3d::py::bind_analysis(m);
     bvc3d::py::bind_recording(m);
+    bvc3d::py::bind_place_recognition(m);  // after bind_analysis: it adds to bvc3d.analysis
     bvc3d::py::bind_buildings(m);
     bvc3d::py::bind_navigation(m);
     bvc3d::py::bind_populations(m);

@@ -398,3 +398,9 @@ def analyze3d(positions, rates, voxel=_D3["voxel"], volume=None, quantile=_D3["q
     for key in ("decoding", "modality_summary", "cells", "metrics"):
         out[key] = dict(out[key])
     return out
+
+
+# Place recognition's protocol on arrays (docs/place-recognition.md): the compiled functions as they are.
+precision_recall = _an.precision_recall
+loop_closure = _an.loop_closure
+__all__ += ["precision_recall", "loop_closure"]
