@@ -16,8 +16,8 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "python_module.hpp"
-#include "run_options.hpp"
 #include "recording_options.hpp"
+#include "run_options.hpp"
 
 namespace bvc3d::cli {
 
