@@ -20,6 +20,7 @@ own tables stay there. Steps (default: all but buildings, in this order):
 """
 import argparse
 import csv
+import json
 import math
 import os
 import pathlib
@@ -90,6 +91,21 @@ def place_recognition(out, *args):
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     log(f"  {wall:.1f} s")
     return read_csv(out / "details.csv"), wall, after.ru_utime - before.ru_utime, after.ru_stime - before.ru_stime
+
+
+def place_recognition_once(out, *args):
+    """place_recognition(), unless OUT already holds the tables of an earlier run of this script (their
+    timing.json beside them: the command writes its tables whole or not at all), so that a long step
+    interrupted part-way resumes. Returns the details rows, wall and user time, and the load before."""
+    timing = out / "timing.json"
+    if timing.exists() and (out / "details.csv").exists():
+        log("reusing", out)
+        t = json.loads(timing.read_text())
+        return read_csv(out / "details.csv"), t["wall_s"], t["user_s"], t["load_before"]
+    load = os.getloadavg()[0]
+    details, wall, user, _ = place_recognition(out, *args)
+    timing.write_text(json.dumps({"wall_s": wall, "user_s": user, "load_before": load}))
+    return details, wall, user, load
 
 
 def kitti_recording(data, work, sequence, heights):
@@ -407,6 +423,7 @@ def world_yaml(data, work, name):
 def floor_plan(world, route, every=20):
     """The building seen from above: the points that os1-64 scans from every 20th pose of the route hit
     between 0.3 and 1.8 m above the floor (x, y)."""
+    sys.path.insert(0, os.environ["PYTHONPATH"])  # main() points it at this build's package
     import bvc3d as py
     w = py.World.from_yaml(world)
     rows = np.loadtxt(route, delimiter=",", skiprows=1)
@@ -513,8 +530,9 @@ def building_figure(out, name, plan):
                 right += 1
                 continue
             false += 1
-            ax.plot([xy[i, 0], xy[m, 0]], [xy[i, 1], xy[m, 1]], "-", c="tab:red", lw=0.5, alpha=0.5)
-            ax.plot(*xy[i], "o", c="tab:red", ms=2)
+            # Thousands of lines: faint, so that where they gather shows; the queries as dots on top.
+            ax.plot([xy[i, 0], xy[m, 0]], [xy[i, 1], xy[m, 1]], "-", c="tab:red", lw=0.3, alpha=0.06)
+            ax.plot(*xy[i], "o", c="tab:red", ms=1.5, alpha=0.6)
         ax.set_title(f"{name}, {descriptor}\nat a quarter of the revisits: {right} right, {false} false", fontsize=9)
         ax.set_xlim(plan[:, 0].min() - 0.5, plan[:, 0].max() + 0.5)
         ax.set_ylim(plan[:, 1].min() - 0.5, plan[:, 1].max() + 0.5)
@@ -589,13 +607,13 @@ def buildings(data, work):
                          ["--database", f"0:{n - 1}", "--queries", f"{n}:{2 * n - 1}"]))
         for protocol, folder, path, descriptors, extra in runs:
             out = work / folder
-            load = os.getloadavg()[0]
-            details, wall, user, _ = place_recognition(out, "--world", world, "--route", path, "--sensor",
-                                                       BUILDING_SENSOR, "--descriptors", ",".join(descriptors),
-                                                       "--threads", 2, *extra, "--no-figure")
+            details, wall, user, load = place_recognition_once(out, "--world", world, "--route", path, "--sensor",
+                                                               BUILDING_SENSOR, "--descriptors", ",".join(descriptors),
+                                                               "--threads", 2, *extra, "--no-figure")
             for d in details:
                 rows.append(dict(d, building=name, protocol=protocol, scans=len(read_csv(out / "scans.csv")),
-                                 wall_s=f"{wall:.1f}", user_s=f"{user:.1f}", load_before=f"{load:.2f}", cpu=model,
+                                 wall_s=f"{wall:.1f}", user_s="" if user is None else f"{user:.1f}",
+                                 load_before="" if load is None else f"{load:.2f}", cpu=model,
                                  cores=cores))
         radius += radius_rows(work / f"{name}-tour", name)
         false += false_rows(work / f"{name}-tour", name)

@@ -127,9 +127,11 @@ std::vector<PopulationSpec> populations_from_yaml(const YamlView& v) {
             inputs[i].push_back(name);
             if (name == "bvc" || name == "place") continue;
             const auto it = std::find(names.begin(), names.end(), name);
-            if (it == names.end())
-                in.at(k).fail("names no population ('" + name + "'; the model has bvc, place" +
-                              (n ? " and its populations" : "") + ")");
+            if (it == names.end()) {
+                std::string known = "bvc, place";
+                for (const std::string& other : names) known += ", " + other;
+                in.at(k).fail("names no population '" + name + "' (the model has " + known + ")");
+            }
             reads[i].push_back(static_cast<std::size_t>(it - names.begin()));
         }
     }
