@@ -486,7 +486,8 @@ RecordingScene::RecordingScene(std::shared_ptr<const recording::Recording> recor
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) rotation.push_back(static_cast<float>(T.linear()(r, c)));
         names.push_back(recording_->store->scan_name(i));
-        times.push_back(poses_[i].time ? json(*poses_[i].time) : json(nullptr));
+        const auto t = recording_->time(i);  // the scan list's, else the pose's
+        times.push_back(t ? json(*t) : json(nullptr));
     }
     json header = {{"kind", "recording"},
                    {"scans", scans_.size()},
@@ -579,7 +580,7 @@ std::string RecordingScene::scan_blob(std::size_t i) const {
     json header = {{"kind", "scan"}, {"scan", i}, {"name", recording_->store->scan_name(i)}};
     auto arrays = recorded_scan_arrays(*recording_, i, model_, params_, header);
     arrays.push_back(f32_array("bvc", std::span<const double>(recorded_scan_rates(*recording_, i, model_, params_))));
-    if (recording_->poses[i].time) header["t"] = *recording_->poses[i].time;
+    if (const auto t = recording_->time(i)) header["t"] = *t;
     return encode_blob(std::move(header), arrays);
 }
 
