@@ -222,8 +222,13 @@ void TrialScene::resolve_recording(const fs::path& file, const GivenRecording& g
     std::string problem;
     if (!rec) {
         try {
-            if (poses.rfind("BAG:", 0) == 0 || scans.rfind("BAG:", 0) == 0 || poses.find(".bag:") != std::string::npos)
-                throw InputError("it was read from a ROS bag");
+            // A bag's scans are named "<bag>:<topic>": its options (topics, tf frames) are not recorded.
+            std::error_code ec;
+            const auto colon = scans.find(':');
+            if (!fs::exists(beside_or_here(file, scans), ec) && colon != std::string::npos &&
+                fs::exists(beside_or_here(file, scans.substr(0, colon)), ec))
+                throw InputError("its scans are the messages of ROS bag '" + scans.substr(0, colon) +
+                                 "', which is not opened again on its own");
             rec = std::make_shared<const recording::Recording>(
                 recording::open_recording(beside_or_here(file, scans), beside_or_here(file, poses)));
         } catch (const InputError& e) {

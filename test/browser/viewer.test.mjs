@@ -451,7 +451,7 @@ test('README screenshot', { skip: !process.env.BVC3D_UPDATE_FIGURES && 'set BVC3
   const readme = scratch('readme');
   run(['run', '--tilt', '60', '--model', '3d-3l', '--hours', '0.5', '--out', join(readme, 'cross-60_3d-3l.h5')]);
   run(['run', '--tilt', '60', '--model', '2d', '--hours', '0.5', '--out', join(readme, 'cross-60_2d.h5')]);
-  const cell = h5(join(readme, 'cross-60_3d-3l.h5'), 'int(np.argmax(f["metrics/spatial_info"][:]))');
+  const cell = h5(join(readme, 'cross-60_3d-3l.h5'), 'int(np.nanargmax(f["metrics/spatial_info"][:]))');
   const srv = await serve([readme]);
   try {
     const page = await openPage(browser, `${srv.url}?a=cross-60_3d-3l.h5&b=cross-60_2d.h5&i=2000&cell=${cell}`,

@@ -183,6 +183,12 @@ def test_a_replay_whose_recording_is_not_found_says_so(replay, tmp_path):
     try:
         status, trial, _ = blob(url + "api/trial?path=moved.h5")
         assert trial["world_problem"] == "" and trial["recording"]["shown"], trial["world_problem"]
+        # The recording's own page computes the BVC rates from each scan as the replay did.
+        with h5py.File(moved) as f:
+            recorded = f["samples/bvc_rates"][:]
+        for i in range(len(recorded)):
+            status, scan, a = blob(url + f"api/scan?i={i}")
+            np.testing.assert_allclose(a["bvc"], recorded[i], atol=1e-6, err_msg=f"scan {i}")
     finally:
         stop(proc)
 
