@@ -124,7 +124,10 @@ std::shared_ptr<const TrialScene> ViewData::trial(const std::string& relative) {
     }
     // Read outside the lock: another browser may be loading another file meanwhile. Two requests for
     // the same new file may both read it; the second result is dropped.
-    auto scene = TrialScene::load(*file, target_.recording);
+    // A recording given on the command line belongs to the trials opened first (checked when
+    // serving starts); the other trials of a folder find their own.
+    const bool opened = std::find(target_.open.begin(), target_.open.end(), relative) != target_.open.end();
+    auto scene = TrialScene::load(*file, opened ? target_.recording : nullptr);
     std::lock_guard lock(mutex_);
     auto& slot = trials_[*file];
     if (!slot.scene) slot.scene = scene;
