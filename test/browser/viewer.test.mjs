@@ -386,6 +386,7 @@ test('a recording\'s times are shown since its first scan, not as recorded (seco
     const readout = await page.$eval('.readout', (e) => e.textContent);
     assert.match(readout, /t 1\.000 s since the first scan/);
     assert.doesNotMatch(readout, /1700000/);
+    assert.equal(await page.$eval('#slider-label', (e) => e.textContent), 'sample 2 / 2 · 1.0 s');
     await page.close();
   } finally {
     await srv.stop();

@@ -260,6 +260,9 @@ export class TrialPane extends Pane {
       'the red dot is the agent';
   }
 
+  // Seconds since the trial's start at sample i (as the trial file has them).
+  timeAt(i) { return this.trial.arrays.t[i]; }
+
   // The sample to show: the agent moves at once; the step's data follows when it arrives.
   moveTo(i) {
     if (!this.trial) return;
@@ -422,6 +425,12 @@ export class RecordingPane extends Pane {
     this.steps = exportedSteps('#recording');
     this.loader = new StepLoader((i) => get('scan', { i }), (s, e) => this.applyStep(s, e));
     return true;
+  }
+
+  // Seconds since the first scan (null for a recording without times).
+  timeAt(i) {
+    const t = this.rec.header.times[i];
+    return t === null || this.t0 === null ? null : t - this.t0;
   }
 
   heading_of(i) {
