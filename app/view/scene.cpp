@@ -272,7 +272,7 @@ void TrialScene::resolve_recording(const fs::path& file, const GivenRecording& g
             "the trial replayed recording '" + replayed_ + "' (scans '" + scans + "', poses '" + poses + "')";
         if (given) throw InputError("--scans/--poses (or --bag) with trial file '" + file.string() + "': " + problem);
         world_problem_ = what + ", which cannot be shown: " + problem +
-                         "; give it to bvc3d view with --scans and --poses (or --bag) beside the trial file";
+                         "; give the recording to bvc3d view with --scans and --poses (or --bag) after the trial file";
         return;
     }
     recording_ = rec;
