@@ -154,7 +154,9 @@ void add_view_command(CLI::App& app) {
                     "A trial file (.h5), two to compare side by side, a results folder, a world YAML or Gazebo world, "
                     "or a world preset (default: the cross arena)");
     cmd->add_option("--port", o->port, "Port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
-    cmd->add_option("--scans", o->scans, "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list");
+    cmd->add_option("--scans", o->scans,
+                    "A recording's scans: a folder of .pcd/.ply/.bin files or a scan list (with a replay's trial "
+                    "file: the recording it replayed, when it is not found beside it)");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");
     o->recording.add_to(*cmd);
     cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")

@@ -128,7 +128,8 @@ ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::pat
             }
         }
     }
-    if (const std::size_t n = data.recording_scans(); n > 0) {
+    // A recording given with trial files is theirs: shown through them, not on its own.
+    if (const std::size_t n = data.recording_scans(); n > 0 && shown.trials.empty()) {
         w.add("recording", {});
         w.add("world", {{"recording", "1"}});
         json kept = json::array();

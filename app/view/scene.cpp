@@ -83,6 +83,14 @@ std::vector<char> kept_rows(const LidarSpec& drawn, const ModelSpec& model) {
     return kept;
 }
 
+// What a model reads of a recorded scan: the preprocessing's range limits and the elevations kept.
+json reading_json(const RecordedReturnParams& p, const ModelSpec& model) {
+    return {{"min_range", p.min_range},
+            {"max_range", p.max_range},
+            {"selection", selection_name(selection_for(model.sensor, model.bvc.elevations.empty()))},
+            {"slice_half_width", p.slice_half_width}};
+}
+
 std::size_t nearest_row(const std::vector<double>& elevations, double e) {
     std::size_t best = 0;
     for (std::size_t r = 1; r < elevations.size(); ++r)
@@ -138,7 +146,18 @@ LidarSpec drawn_sensor(const LidarSpec& model_sensor) {
     return all;
 }
 
-std::shared_ptr<const TrialScene> TrialScene::load(const fs::path& file) {
+std::shared_ptr<const TrialScene> TrialScene::load(const fs::path& file, const GivenRecording& given) {
+    // Every error names the file: a reader's message that does not is prefixed with it.
+    try {
+        return load_unchecked(file, given);
+    } catch (const InputError& e) {
+        const std::string why = e.what();
+        if (why.find(file.string()) != std::string::npos) throw;
+        throw InputError("trial file '" + file.string() + "': " + why);
+    }
+}
+
+std::shared_ptr<const TrialScene> TrialScene::load_unchecked(const fs::path& file, const GivenRecording& given) {
     auto s = std::make_shared<TrialScene>();
     s->data_ = read_trial_samples(file);
     auto doubles = [&](const char* name) {
@@ -152,8 +171,124 @@ std::shared_ptr<const TrialScene> TrialScene::load(const fs::path& file) {
     if (s->t_.size() != s->data_.x.size() || s->heading_.size() != s->data_.x.size())
         throw InputError("'" + file.string() + "': samples/t and samples/heading must have one value per sample");
     s->resolve_model_and_world(file);
+    s->resolve_recording(file, given);
     s->encode(file);
     return s;
+}
+
+TrialScene::TrialScene() = default;
+TrialScene::~TrialScene() = default;
+
+namespace {
+
+// A path a trial file names: as it is when absolute, else beside the trial file, else from the
+// current folder (where the command that wrote the trial ran, most often).
+fs::path beside_or_here(const fs::path& trial, const std::string& named) {
+    const fs::path p(named);
+    std::error_code ec;
+    if (p.is_absolute() || !fs::exists(trial.parent_path() / p, ec)) return p;
+    return trial.parent_path() / p;
+}
+
+std::string attribute(const TrialIdentity& id, const std::string& name) {
+    for (const auto& [k, v] : id.data_source)
+        if (k == name) return v;
+    return {};
+}
+
+}  // namespace
+
+void TrialScene::resolve_recording(const fs::path& file, const GivenRecording& given) {
+    replayed_ = attribute(data_, "recording");
+    if (replayed_.empty()) return;
+    // A replay has no world: what it saw is its recording.
+    world_.reset();
+    world_source_.clear();
+    world_problem_.clear();
+    std::string files;  // the recorded fingerprint of the scan and pose files
+    try {
+        const auto yaml = config::YamlView::load_string(data_.config, file.string());
+        if (yaml.has("returns")) {
+            const auto r = yaml["returns"];
+            if (r.has("files")) files = r["files"].as_string();
+            config::read_table(r, recorded_params_, RecordedReturnParams::table(), {"recording", "scans", "files"});
+        }
+    } catch (const InputError& e) {
+        world_problem_ = e.what();
+        return;
+    }
+    const std::string scans = attribute(data_, "recording_scans"), poses = attribute(data_, "recording_poses");
+    std::shared_ptr<const recording::Recording> rec = given;
+    std::string problem;
+    if (!rec) {
+        try {
+            // A bag's scans are named "<bag>:<topic>": its options (topics, tf frames) are not recorded.
+            std::error_code ec;
+            const auto colon = scans.find(':');
+            if (!fs::exists(beside_or_here(file, scans), ec) && colon != std::string::npos &&
+                fs::exists(beside_or_here(file, scans.substr(0, colon)), ec))
+                throw InputError("its scans are the messages of ROS bag '" + scans.substr(0, colon) +
+                                 "', which is not opened again on its own");
+            rec = std::make_shared<const recording::Recording>(
+                recording::open_recording(beside_or_here(file, scans), beside_or_here(file, poses)));
+        } catch (const InputError& e) {
+            problem = e.what();
+        }
+    }
+    // The files must be the ones replayed, and the poses those the trial recorded.
+    if (rec && !files.empty() && rec->fingerprint() != files)
+        problem = "the scan and pose files found are not those the trial replayed (their fingerprint is " +
+                  rec->fingerprint() + ", the trial's " + files + ")";
+    std::vector<ModelStep> steps;
+    if (rec && problem.empty()) {
+        try {
+            steps = recording_steps(*rec);
+        } catch (const InputError& e) {
+            problem = e.what();
+        }
+    }
+    if (rec && problem.empty()) {
+        // Sample i read the scan recorded at its time (samples/t starts at the first scan's time).
+        scan_of_sample_.resize(samples());
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < samples(); ++i) {
+            while (k + 1 < steps.size() && std::abs(steps[k + 1].t - t_[i]) <= std::abs(steps[k].t - t_[i])) ++k;
+            scan_of_sample_[i] = k;
+            const ModelStep& s = steps[k];
+            const double dz = data_.z.empty() ? 0.0 : data_.z[i] - s.pose.z;
+            if (std::hypot(s.pose.x - data_.x[i], s.pose.y - data_.y[i], dz) > 1e-3 || std::abs(s.t - t_[i]) > 1e-3) {
+                problem = "sample " + std::to_string(i) + " at t " + format_number(t_[i]) + " s, (" +
+                          format_number(data_.x[i]) + ", " + format_number(data_.y[i]) +
+                          ") m, matches no scan of the recording: scan " + std::to_string(k) + " is at t " +
+                          format_number(s.t) + " s, (" + format_number(s.pose.x) + ", " + format_number(s.pose.y) +
+                          ") m (other poses, extrinsics or pairing than the replay's?)";
+                break;
+            }
+        }
+    }
+    if (!problem.empty()) {
+        scan_of_sample_.clear();
+        const std::string what =
+            "the trial replayed recording '" + replayed_ + "' (scans '" + scans + "', poses '" + poses + "')";
+        if (given) throw InputError("--scans/--poses (or --bag) with trial file '" + file.string() + "': " + problem);
+        world_problem_ = what + ", which cannot be shown: " + problem +
+                         "; give the recording to bvc3d view with --scans and --poses (or --bag) after the trial file";
+        return;
+    }
+    recording_ = rec;
+    if (model_) recording_scene_ = std::make_unique<RecordingScene>(rec, *model_, recorded_params_);
+    if (const auto b = read_trial_array(file, "samples/bvc_rates");
+        b && b->shape.size() == 2 && b->shape[0] == samples()) {
+        n_bvc_ = b->shape[1];
+        if (const auto* f = std::get_if<std::vector<float>>(&b->data)) bvc_rates_ = *f;
+        if (const auto* d = std::get_if<std::vector<double>>(&b->data)) bvc_rates_.assign(d->begin(), d->end());
+    }
+}
+
+std::string TrialScene::recording_map_blob() const {
+    if (!recording_scene_)
+        throw InputError(world_problem_.empty() ? "the trial replayed no recording" : world_problem_);
+    return recording_scene_->map_blob();
 }
 
 void TrialScene::resolve_model_and_world(const fs::path& file) {
@@ -214,7 +349,18 @@ void TrialScene::encode(const fs::path& file) {
                    {"model_problem", model_problem_}};
     if (model_) {
         header["model"] = model_json(*model_);
-        header["drawn_sensor"] = sensor_json(drawn_sensor(model_->sensor));
+        if (replayed_.empty()) header["drawn_sensor"] = sensor_json(drawn_sensor(model_->sensor));
+    }
+    if (!replayed_.empty()) {
+        // A replay: the recording's scans are what the model read; its rates are the recorded ones.
+        json r = {{"name", replayed_},
+                  {"scans_file", attribute(data_, "recording_scans")},
+                  {"poses_file", attribute(data_, "recording_poses")},
+                  {"shown", recording_ != nullptr},
+                  {"bvc_recorded", n_bvc_ > 0}};
+        if (recording_) r["scans"] = recording_->size();
+        if (model_) r["reading"] = reading_json(recorded_params_, *model_);
+        header["recording"] = r;
     }
     if (data_.extent) header["extent"] = *data_.extent;
     float rate_max = 0;  // the population's color scale
@@ -235,8 +381,14 @@ void TrialScene::encode(const fs::path& file) {
     if (centers != arrays.end() && centers->shape.size() == 2 && centers->shape[1] == 2 && n > 0) {
         int gridsize = 50;
         for (const auto& [name, v] : data_.metric_attributes)
-            if (name == "gridsize" && std::holds_alternative<long long>(v))
-                gridsize = static_cast<int>(std::get<long long>(v));
+            if (name == "gridsize" && std::holds_alternative<long long>(v)) {
+                // Checked as read, before narrowing: 2^40 must not become 0.
+                const long long g = std::get<long long>(v);
+                if (g < 2 || g > 100000)
+                    throw InputError("trial file '" + file.string() + "': attribute 'metrics/gridsize' is " +
+                                     std::to_string(g) + "; the hexagonal grid needs 2 to 100000");
+                gridsize = static_cast<int>(g);
+            }
         std::optional<analysis::Extent> extent;
         if (data_.extent && data_.extent->size() == 4)
             extent = analysis::Extent{(*data_.extent)[0], (*data_.extent)[1], (*data_.extent)[2], (*data_.extent)[3]};
@@ -297,8 +449,23 @@ std::string TrialScene::step_blob(std::size_t i) const {
     json header = {{"kind", "step"}, {"sample", i}, {"t", t_[i]},          {"x", p.x},
                    {"y", p.y},       {"z", p.z},    {"heading", p.heading}};
     std::vector<BlobArray> arrays;
-    if (world_ && model_) {
+    if (recording_ && model_) {
+        const std::size_t scan = scan_of_sample_[i];
+        header["scan"] = scan;
+        header["scan_name"] = recording_->store->scan_name(scan);
+        arrays = recorded_scan_arrays(*recording_, scan, *model_, recorded_params_, header);
+        // The BVC rates the replay recorded; computed again from the scan when it did not record them.
+        if (n_bvc_ > 0) {
+            header["bvc_source"] = "recorded";
+            arrays.push_back(f32_array("bvc", std::span<const float>(bvc_rates_.data() + i * n_bvc_, n_bvc_)));
+        } else {
+            header["bvc_source"] = "computed";
+            arrays.push_back(f32_array(
+                "bvc", std::span<const double>(recorded_scan_rates(*recording_, scan, *model_, recorded_params_))));
+        }
+    } else if (world_ && model_) {
         arrays = sensed_arrays(*world_, *model_, p, header);
+        header["bvc_source"] = "computed";
     } else {
         const std::vector<float> none;
         arrays = {f32_array("points", std::span<const float>(none), {0, 3}),
@@ -311,8 +478,9 @@ std::string TrialScene::step_blob(std::size_t i) const {
 
 // ---- recordings ----
 
-RecordingScene::RecordingScene(std::shared_ptr<const recording::Recording> recording, ModelSpec model)
-    : recording_(std::move(recording)), model_(std::move(model)) {
+RecordingScene::RecordingScene(std::shared_ptr<const recording::Recording> recording, ModelSpec model,
+                               RecordedReturnParams params)
+    : recording_(std::move(recording)), model_(std::move(model)), params_(params) {
     const auto& scans_ = recording_->scans;
     const auto& poses_ = recording_->poses;
     std::vector<float> position, rotation;
@@ -323,11 +491,16 @@ RecordingScene::RecordingScene(std::shared_ptr<const recording::Recording> recor
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) rotation.push_back(static_cast<float>(T.linear()(r, c)));
         names.push_back(recording_->store->scan_name(i));
-        times.push_back(poses_[i].time ? json(*poses_[i].time) : json(nullptr));
+        const auto t = recording_->time(i);  // the scan list's, else the pose's
+        times.push_back(t ? json(*t) : json(nullptr));
     }
-    json header = {
-        {"kind", "recording"}, {"scans", scans_.size()},      {"names", names},
-        {"times", times},      {"model", model_json(model_)}, {"paired_by_time", recording_->paired_by_time}};
+    json header = {{"kind", "recording"},
+                   {"scans", scans_.size()},
+                   {"names", names},
+                   {"times", times},
+                   {"model", model_json(model_)},
+                   {"paired_by_time", recording_->paired_by_time},
+                   {"reading", reading_json(params_, model_)}};
     blob_ =
         encode_blob(std::move(header), {f32_array("position", std::span<const float>(position), {scans_.size(), 3}),
                                         f32_array("rotation", std::span<const float>(rotation), {scans_.size(), 9})});
@@ -355,48 +528,65 @@ std::string RecordingScene::map_blob() const {
     return world_blob(empty, "recording", points);
 }
 
-std::string RecordingScene::scan_blob(std::size_t i) const {
-    const auto& poses_ = recording_->poses;
-    if (i >= recording_->size())
-        throw InputError("scan " + std::to_string(i) + " is past the recording's " +
-                         std::to_string(recording_->size()));
-    const auto cloud = recording_->load(i);
-    const auto& T = poses_[i].world_from_sensor;
+std::vector<BlobArray> recorded_scan_arrays(const recording::Recording& rec, std::size_t i, const ModelSpec& model,
+                                            const RecordedReturnParams& params, json& header) {
+    const auto cloud = rec.load(i);
+    const auto& T = rec.poses[i].world_from_sensor;
+    const Eigen::Matrix3d R = T.linear();
+    const ReturnSelection selection = selection_for(model.sensor, model.bvc.elevations.empty());
+    const auto& psi = model.bvc.elevations;
+    const double window = 4 * model.bvc.sigma_phi;
     std::vector<float> xyz, range;
     std::vector<std::uint8_t> kept;
-    Scan returns;
-    const auto& psi = model_.bvc.elevations;
-    const double window = 4 * model_.bvc.sigma_phi;
+    std::size_t read = 0;
+    Scan one;
     for (std::size_t p = 0; p < cloud.size(); ++p) {
-        const Vec3 local(cloud.xyz[3 * p], cloud.xyz[3 * p + 1], cloud.xyz[3 * p + 2]);
-        const Vec3 v = T.linear() * local;  // world-aligned, from the sensor
-        const double r = v.norm();
+        const std::span<const double> point(cloud.xyz.data() + 3 * p, 3);
+        const Vec3 local(point[0], point[1], point[2]);
+        const double r = (R * local).norm();
         if (!(r > 0)) continue;
-        const LidarReturn ret{r, std::atan2(v.y(), v.x()), std::asin(std::clamp(v.z() / r, -1.0, 1.0))};
-        returns.push_back(ret);
+        // Whether the model reads it: the replay's own preprocessing, on this one point.
+        returns_from_points(point, R, params, selection, one);
+        const bool is_read = !one.empty();
+        read += is_read;
+        const bool near_layer = psi.empty() || (is_read && std::any_of(psi.begin(), psi.end(), [&](double e) {
+                                                    return std::abs(one.front().elevation - e) <= window;
+                                                }));
         const Vec3 w = T * local;
         for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(w[k]));
         range.push_back(static_cast<float>(r));
-        const bool near_layer = psi.empty() || std::any_of(psi.begin(), psi.end(), [&](double e) {
-                                    return std::abs(ret.elevation - e) <= window;
-                                });
-        kept.push_back(near_layer ? 1 : 0);
+        kept.push_back(is_read && near_layer ? 1 : 0);
     }
-    const BoundaryVectorLayer layer(model_.bvc);
+    const Vec3 origin = T.translation();
+    header["returns"] = read;
+    header["points"] = range.size();
+    header["sensor_origin"] = {origin.x(), origin.y(), origin.z()};
+    header["dropped_nonfinite"] = cloud.dropped_nonfinite;
+    return {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),
+            f32_array("range", std::span<const float>(range)), u8_array("kept", kept)};
+}
+
+std::vector<double> recorded_scan_rates(const recording::Recording& rec, std::size_t i, const ModelSpec& model,
+                                        const RecordedReturnParams& params) {
+    const auto cloud = rec.load(i);
+    Scan returns;
+    returns_from_points(cloud.xyz, rec.poses[i].world_from_sensor.linear(), params,
+                        selection_for(model.sensor, model.bvc.elevations.empty()), returns);
+    const BoundaryVectorLayer layer(model.bvc);
     std::vector<double> rates(layer.n_cells());
     layer.rates(returns, rates);
-    const std::vector<float> bvc(rates.begin(), rates.end());
-    const Vec3 origin = T.translation();
-    json header = {{"kind", "scan"},
-                   {"scan", i},
-                   {"name", recording_->store->scan_name(i)},
-                   {"returns", returns.size()},
-                   {"sensor_origin", {origin.x(), origin.y(), origin.z()}},
-                   {"dropped_nonfinite", cloud.dropped_nonfinite}};
-    if (poses_[i].time) header["t"] = *poses_[i].time;
-    return encode_blob(std::move(header), {f32_array("points", std::span<const float>(xyz), {xyz.size() / 3, 3}),
-                                           f32_array("range", std::span<const float>(range)), u8_array("kept", kept),
-                                           f32_array("bvc", std::span<const float>(bvc))});
+    return rates;
+}
+
+std::string RecordingScene::scan_blob(std::size_t i) const {
+    if (i >= recording_->size())
+        throw InputError("scan " + std::to_string(i) + " is past the recording's " +
+                         std::to_string(recording_->size()));
+    json header = {{"kind", "scan"}, {"scan", i}, {"name", recording_->store->scan_name(i)}};
+    auto arrays = recorded_scan_arrays(*recording_, i, model_, params_, header);
+    arrays.push_back(f32_array("bvc", std::span<const double>(recorded_scan_rates(*recording_, i, model_, params_))));
+    if (const auto t = recording_->time(i)) header["t"] = *t;
+    return encode_blob(std::move(header), arrays);
 }
 
 }  // namespace bvc3d::view

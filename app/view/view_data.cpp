@@ -51,6 +51,15 @@ Reply blob_reply(std::string body) { return Reply{200, "application/octet-stream
 ViewData::ViewData(ViewTarget target) : target_(std::move(target)) {
     if (target_.recording)  // opened already: a bad recording fails before serving
         recording_ = std::make_unique<RecordingScene>(target_.recording, config::resolve_model(target_.model));
+    // A recording given with trial files is the recording those trials replayed: checked before serving.
+    if (target_.recording)
+        for (const auto& name : target_.open) {
+            const auto scene = trial(name);
+            if (scene->replayed().empty())
+                throw InputError("--scans/--poses (or --bag) with trial file '" + name +
+                                 "': the trial did not replay a recording (its returns were cast in its world); "
+                                 "view the recording on its own, or the trial without it");
+        }
 }
 
 Reply ViewData::get(const std::string& endpoint, const Query& query) {
@@ -115,7 +124,10 @@ std::shared_ptr<const TrialScene> ViewData::trial(const std::string& relative) {
     }
     // Read outside the lock: another browser may be loading another file meanwhile. Two requests for
     // the same new file may both read it; the second result is dropped.
-    auto scene = TrialScene::load(*file);
+    // A recording given on the command line belongs to the trials opened first (checked when
+    // serving starts); the other trials of a folder find their own.
+    const bool opened = std::find(target_.open.begin(), target_.open.end(), relative) != target_.open.end();
+    auto scene = TrialScene::load(*file, opened ? target_.recording : nullptr);
     std::lock_guard lock(mutex_);
     auto& slot = trials_[*file];
     if (!slot.scene) slot.scene = scene;
@@ -131,6 +143,7 @@ std::shared_ptr<const TrialScene> ViewData::trial(const std::string& relative) {
 std::string ViewData::world_reply(const Query& query) {
     if (query.count("trial")) {
         const auto scene = trial(param(query, "trial"));
+        if (!scene->replayed().empty()) return scene->recording_map_blob();
         if (!scene->world()) throw RequestError(422, scene->world_problem());
         return world_blob(scene->world()->description(), scene->world_source());
     }

@@ -63,7 +63,7 @@ test('a trial opens: the 3-D view is drawn and the step numbers are the file\'s'
   const want = h5(file, '{k: float(f["samples/" + k][0]) for k in ["t", "x", "y", "heading"]}');
   const step = await shownStep(page);
   for (const k of ['t', 'x', 'y', 'heading']) assert.equal(step.header[k], want[k], `${k} of sample 0`);
-  assert.match(step.readout, new RegExp(`x ${want.x.toFixed(4)}\\s+y ${want.y.toFixed(4)}`));
+  assert.match(step.readout, new RegExp(`x ${want.x.toFixed(4)} m\\s+y ${want.y.toFixed(4)} m`));
   assert.deepEqual(page.foreignRequests, [], 'the page asked for something elsewhere');
   assert.deepEqual(page.consoleErrors, []);
   await shot(page, 'trial');
@@ -98,7 +98,7 @@ test('moving the slider changes the returns and the numbers, which match the fil
   // The returns drawn are the full spherical scan at that pose: as many as `bvc3d scan` gives.
   const csv = run(['scan', '--world', 'cross', '--tilt', '45', '--sensor', sensorYaml(), '--pose', `${want.x},${want.y},${want.heading}`]);
   assert.equal(step.returns, csv.trim().split('\n').length - 1, 'returns differ from bvc3d scan');
-  assert.match(step.readout, new RegExp(`returns ${step.returns} `));
+  assert.match(step.readout, new RegExp(`${step.returns} LiDAR returns drawn`));
   await shot(page, 'trial-scrubbed');
   await page.close();
 });
@@ -115,7 +115,7 @@ test('clicking a place cell shows its rate map and MI', async () => {
   await page.waitForFunction((k) => document.querySelector('.cell-map .cell-info').dataset.cell === String(k), cell);
   const info = await page.$eval('.cell-map .cell-info', (e) => ({ mi: e.dataset.mi, text: e.textContent }));
   assert.equal(Number(info.mi), modality[cell]);
-  assert.match(info.text, new RegExp(`cell ${cell} · MI \\(modality\\) ${modality[cell]}`));
+  assert.match(info.text, new RegExp(`cell ${cell} · fields \\(modality index\\) ${modality[cell]}`));
   const painted = await paintedPixels(page, '.cell-map canvas');
   assert.ok(painted > blank + 50, `the rate map is not drawn (${painted} pixels)`);
   assert.ok((await paintedPixels(page, '.sai-map canvas')) > 50, 'the SAI map is not drawn');
@@ -285,6 +285,114 @@ test('a recording: scans step with the slider, in the world frame', async () => 
   }
 });
 
+// Issue 32, finding 4: a trial file of `bvc3d replay` shows the recording it replayed (not a world
+// it never had), the points the model read, and the BVC rates the replay recorded.
+test('a replay\'s trial file shows its recording and its recorded rates', async () => {
+  run(['export-scans', '--world', 'cross', '--tilt', '45', '--hours', '0.004', '--seed', '5', '--format', 'pcd', '--out', 'walk'], { cwd: dir });
+  run(['replay', '--scans', 'walk', '--poses', 'walk/poses.txt', '--model', '3d-0.2', '--out', 'replay.h5'], { cwd: dir });
+  const page = await openPage(browser, `${server.url}?a=replay.h5`);
+  await waitReady(page);
+  assert.deepEqual(await page.$$eval('.pane .error', (e) => e.map((x) => x.textContent)), [], 'the page shows errors');
+  const legend = await page.$eval('.legend', (e) => e.textContent);
+  assert.match(legend, /recorded scan \(recording 'walk'\)/);
+  assert.doesNotMatch(legend, /spherical|90 rows/, 'a recording described as a simulated scanner');
+  const map = await page.evaluate(() => window.bvc3dViewer.panes[0].view.world.children
+    .filter((c) => c.isPoints).reduce((n, c) => n + c.geometry.attributes.position.count, 0));
+  assert.ok(map > 1000, `the recording's map has ${map} points`);
+  const file = join(dir, 'replay.h5');
+  const n = h5(file, 'int(f["samples/x"].shape[0])');
+  for (const i of [0, n - 1]) {
+    await moveSlider(page, i);
+    const step = await shownStep(page);
+    const want = h5(file, `f["samples/bvc_rates"][${i}].astype(float).tolist()`);
+    assert.deepEqual(step.bvc, want, `sample ${i}: the BVC maps do not show the recorded rates`);
+    assert.ok(step.bvc.some((v) => v > 0), 'the BVC rates are all zero');
+    const header = readFileSync(join(dir, 'walk', `${String(i).padStart(6, '0')}.pcd`)).subarray(0, 400).toString('latin1');
+    assert.equal(step.returns, Number(header.match(/POINTS (\d+)/)[1]), `sample ${i}: not every point of its scan drawn`);
+    assert.match(step.readout, new RegExp(`scan ${i} \\(${String(i).padStart(6, '0')}\\.pcd\\)`));
+  }
+  const painted = await paintedPixels(page, '.bvc-maps canvas');
+  assert.ok(painted > 5000, 'the BVC maps are empty');
+  assert.deepEqual(page.consoleErrors, []);
+  await shot(page, 'replay');
+  await page.close();
+});
+
+// Issue 32, finding 10: every panel can be read without the docs: the BVC maps' distance rings
+// are labeled and their colors have a scale, the place cells a color bar, the maps axes in metres
+// (checked: the agent's dot sits where the axes say its position is), times since the start, and
+// no jargon.
+test('every panel says what it shows: scales, axes in metres, times since the start', async () => {
+  const file = join(dir, 't45.h5');
+  const n = h5(file, 'int(f["samples/x"].shape[0])');
+  const i = Math.floor(n / 2);
+  const page = await openPage(browser, `${server.url}?a=t45.h5&i=${i}&cell=0`);
+  await waitReady(page);
+  const bvc = await page.$eval('.bvc-maps', (e) => ({ rings: JSON.parse(e.dataset.rings), maxDist: Number(e.dataset.maxDist),
+    key: e.parentElement.querySelector('.key').textContent, bar: { ...e.parentElement.querySelector('.colorbar').dataset } }));
+  assert.deepEqual(bvc.rings, [2, 4, 6, 8, 10]);
+  assert.equal(bvc.maxDist, 12);
+  assert.match(bvc.key, /rings every 2 m.*the rim is 12 m/);
+  assert.equal(Number(bvc.bar.lo), 0);
+  assert.equal(Number(bvc.bar.hi), 0.5);
+  const bars = await page.$$eval('.colorbar', (b) => b.map((e) => ({ ...e.dataset, ticks: e.querySelector('.ticks').textContent })));
+  const rateMax = h5(file, 'float(f["samples/rates"][:].max())');
+  const population = bars.find((b) => /place-cell rate/.test(b.label));
+  assert.ok(population, 'no color bar for the place cells');
+  assert.ok(Math.abs(Number(population.hi) - rateMax) < 1e-6 * rateMax, `${population.hi} vs ${rateMax}`);
+  const saiMax = h5(file, 'float(np.nanmax(f["metrics/sai"][:]))');
+  const sai = bars.find((b) => /spatial aliasing index/.test(b.label));
+  assert.ok(sai && Math.abs(Number(sai.hi) - saiMax) < 1e-6, `SAI color bar ${sai && sai.hi} vs ${saiMax}`);
+  assert.ok(bars.some((b) => /distance from the scanner/.test(b.label) && Number(b.hi) === 20), 'no color bar for the returns');
+  // The maps' axes: metres, and the agent's red dot where the axes put the sample's x and y.
+  const at = h5(file, `[float(f["samples/x"][${i}]), float(f["samples/y"][${i}])]`);
+  for (const selector of ['.cell-map canvas', '.sai-map canvas']) {
+    const found = await page.$eval(selector, (c) => {
+      const axes = JSON.parse(c.dataset.axes), d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let sx = 0, sy = 0, k = 0;
+      for (let p = 0; p < d.length; p += 4) {
+        if (d[p] === 192 && d[p + 1] === 57 && d[p + 2] === 43) { sx += (p / 4) % c.width; sy += Math.floor(p / 4 / c.width); k++; }
+      }
+      return { axes, dot: [sx / k + 0.5, sy / k + 0.5], k };
+    });
+    assert.equal(found.axes.unit, 'm');
+    assert.ok(found.axes.x.length >= 2 && found.axes.y.length >= 2, `${selector}: too few ticks`);
+    assert.ok(found.k > 10, `${selector}: no red dot`);
+    const metres = (ticks, pixel) => {
+      const [[v0, p0], [v1, p1]] = [ticks[0], ticks[ticks.length - 1]];
+      return v0 + ((pixel - p0) * (v1 - v0)) / (p1 - p0);
+    };
+    const x = metres(found.axes.x, found.dot[0]), y = metres(found.axes.y, found.dot[1]);
+    assert.ok(Math.hypot(x - at[0], y - at[1]) < 0.15, `${selector}: the dot reads (${x}, ${y}), the agent is at ${at}`);
+  }
+  const readout = await page.$eval('.readout', (e) => e.textContent);
+  assert.match(readout, /s since the trial's start/);
+  const text = await page.$eval('.pane', (e) => e.textContent);
+  for (const jargon of [/rows the model keeps/, /MI \(modality\)/, /\bMSAI \d/, /BVC activity per layer/]) {
+    assert.doesNotMatch(text, jargon);
+  }
+  await shot(page, 'readable');
+  await page.close();
+});
+
+test('a recording\'s times are shown since its first scan, not as recorded (seconds since 1970)', async () => {
+  const rec = makeRecording();
+  writeFileSync(join(rec, 'scans.txt'), [0, 1, 2].map((s) => `${s}.pcd ${1700000000 + 0.5 * s}`).join('\n') + '\n');
+  const srv = await serve(['--scans', join(rec, 'scans.txt'), '--poses', join(rec, 'poses.txt')]);
+  try {
+    const page = await openPage(browser, srv.url);
+    await waitReady(page);
+    await moveSlider(page, 2);
+    const readout = await page.$eval('.readout', (e) => e.textContent);
+    assert.match(readout, /t 1\.000 s since the first scan/);
+    assert.doesNotMatch(readout, /1700000/);
+    assert.equal(await page.$eval('#slider-label', (e) => e.textContent), 'sample 2 / 2 · 1.0 s');
+    await page.close();
+  } finally {
+    await srv.stop();
+  }
+});
+
 test('the real recording (hall-lidar), when present: map and scans', async (t) => {
   const hall = join(source, '..', 'shared', 'data', 'hall-lidar');
   if (!existsSync(join(hall, 'poses.csv'))) return t.skip(`no recording at ${hall}`);
@@ -344,7 +452,7 @@ test('README screenshot', { skip: !process.env.BVC3D_UPDATE_FIGURES && 'set BVC3
   const readme = scratch('readme');
   run(['run', '--tilt', '60', '--model', '3d-3l', '--hours', '0.5', '--out', join(readme, 'cross-60_3d-3l.h5')]);
   run(['run', '--tilt', '60', '--model', '2d', '--hours', '0.5', '--out', join(readme, 'cross-60_2d.h5')]);
-  const cell = h5(join(readme, 'cross-60_3d-3l.h5'), 'int(np.argmax(f["metrics/spatial_info"][:]))');
+  const cell = h5(join(readme, 'cross-60_3d-3l.h5'), 'int(np.nanargmax(f["metrics/spatial_info"][:]))');
   const srv = await serve([readme]);
   try {
     const page = await openPage(browser, `${srv.url}?a=cross-60_3d-3l.h5&b=cross-60_2d.h5&i=2000&cell=${cell}`,

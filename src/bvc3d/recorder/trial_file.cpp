@@ -250,6 +250,9 @@ TrialIdentity read_identity(const TrialReader& r) {
     id.fingerprint = r.text(f, "/", "fingerprint", false);
     id.explore_hours = r.number(f, "/", "explore_hours");
     id.sample_hours = r.number(f, "/", "sample_hours");
+    // Where a replay's returns came from (as write_identity writes data_source).
+    for (const char* name : {"recording", "recording_scans", "recording_poses", "recording_t0", "simulated_sensor"})
+        if (h5::exists_attr(f, name)) id.data_source.emplace_back(name, r.text(f, "/", name));
     // Files from before conditions were recorded: the paper's condition, model and world.
     id.condition = h5::exists_attr(f, "condition") ? r.text(f, "/", "condition") : id.world + "_" + id.model;
     std::istringstream swept(r.text(f, "/", "swept", false));

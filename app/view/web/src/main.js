@@ -37,7 +37,8 @@ function setSample(i) {
   i = Math.max(0, Math.min(lead.length - 1, Math.round(i)));
   viewer.sample = i;
   $('slider').value = i;
-  $('slider-label').textContent = `sample ${i} / ${lead.length - 1}`;
+  const t = lead.timeAt ? lead.timeAt(i) : null;
+  $('slider-label').textContent = `sample ${i} / ${lead.length - 1}` + (Number.isFinite(t) ? ` · ${t.toFixed(1)} s` : '');
   for (const p of viewer.panes) p.moveTo(follow(p, i, lead));
 }
 viewer.setSample = setSample;

@@ -1,7 +1,47 @@
 // The 2-D panels of a pane, drawn on canvases: BVC activity per layer as polar heat maps
 // (distance × direction), the place-cell population, a cell's rate map (hexagons as in the
 // figures, or voxel slices) and the SAI map.
-import { viridis, css, viridisTable, entry } from './colormap.js';
+import { viridis, turbo, css, viridisTable, entry } from './colormap.js';
+
+const el = (tag, props = {}, ...children) => {
+  const e = Object.assign(document.createElement(tag), props);
+  e.append(...children);
+  return e;
+};
+
+// A number for a scale's label: no more digits than it needs.
+export const tick = (v) => String(Number(Number(v).toPrecision(3)));
+
+// A color bar: the colormap from `lo` (left) to `hi` (right) with its ends and middle labeled and
+// what the color means; data-lo, data-hi and data-label say it for tests and readers of the page.
+export function colorBar(container, { label, lo = 0, hi = 1, map = 'viridis' }) {
+  const bar = el('div', { className: 'colorbar' });
+  // A CSS gradient, not a canvas: the page's canvases are its panels.
+  const fn = map === 'turbo' ? turbo : viridis, stops = [], rgb = [0, 0, 0];
+  for (let k = 0; k <= 16; k++) stops.push(`${css(fn(k / 16, rgb))} ${(100 * k) / 16}%`);
+  const strip = el('div', { className: 'strip' });
+  strip.style.background = `linear-gradient(to right, ${stops.join(', ')})`;
+  const ticks = el('div', { className: 'ticks' });
+  bar.append(el('span', { className: 'label' }), strip, ticks);
+  container.appendChild(bar);
+  const set = (range) => {
+    const a = range.lo ?? lo, b = range.hi ?? hi;
+    bar.dataset.lo = a;
+    bar.dataset.hi = b;
+    bar.dataset.label = range.label ?? label;
+    bar.querySelector('.label').textContent = `${range.label ?? label}: `;
+    ticks.replaceChildren(...[a, (a + b) / 2, b].map((v) => el('span', { textContent: tick(v) })));
+  };
+  set({});
+  bar.set = set;
+  return bar;
+}
+
+// Round steps for an axis spanning `span`: 1, 2 or 5 × 10^k, about `count` of them.
+export function niceStep(span, count = 5) {
+  const raw = span / count, p = 10 ** Math.floor(Math.log10(raw)), f = raw / p;
+  return p * (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10);
+}
 
 
 function canvas(w, h, cls = 'map') {
@@ -24,12 +64,25 @@ export class BvcMaps {
     this.canvases = [];
     for (let l = 0; l < bvc.n_layers; l++) {
       const fig = document.createElement('figure');
-      const c = canvas(124, 124);
-      const label = bvc.elevations.length ? `elevation ${(bvc.elevations[l] * 180 / Math.PI).toFixed(1)}°` : '2-D (no elevation)';
+      const c = canvas(150, 150);
+      const label = bvc.elevations.length
+        ? `layer ${l + 1}: walls seen ${(bvc.elevations[l] * 180 / Math.PI).toFixed(1)}° above the horizon`
+        : 'walls seen at the height of the scanner (2-D)';
       fig.append(c, Object.assign(document.createElement('figcaption'), { textContent: label }));
       this.el.appendChild(fig);
       this.canvases.push(c);
     }
+    // The rings' labels (m) as drawn, for readers and tests.
+    this.rings = [2, 4, 6, 8, 10, 12, 14, 16, 18, 20].filter((v) => v < bvc.max_dist);
+    this.el.dataset.rings = JSON.stringify(this.rings);
+    this.el.dataset.maxDist = bvc.max_dist;
+    const key = el('div', { className: 'key' });
+    key.textContent = `Seen from above, centered on the agent: each cell's preferred distance from the center outward ` +
+      `(white rings every 2 m, labeled; the rim is ${tick(bvc.max_dist)} m), its direction as on a map (east = +x to the ` +
+      `right, north = +y up); red line: the agent's heading. ${bvc.n_dir} directions × ${bvc.n_per_axis} distances ` +
+      `per layer.`;
+    container.appendChild(key);
+    this.colorBar = colorBar(container, { label: 'BVC rate (0.5 is the most a cell fires)', lo: 0, hi: 0.5 });
   }
 
   // Which BVC each pixel shows, computed once: its distance picks the ring (nearest preferred
@@ -71,10 +124,18 @@ export class BvcMaps {
       g.putImageData(image, 0, 0);
       g.strokeStyle = 'rgba(255,255,255,0.5)';
       g.lineWidth = 1;
-      for (const d of [2, 4, 6, 8, 10, 12].filter((v) => v < maxDist)) {
+      g.font = '9px "DejaVu Sans", sans-serif';
+      g.textAlign = 'center';
+      for (const d of this.rings) {
         g.beginPath();
         g.arc(cx, cy, (d / maxDist) * R, 0, 2 * Math.PI);
         g.stroke();
+      }
+      // Every other ring labeled along the south-east diagonal, and the rim.
+      g.fillStyle = 'rgba(255,255,255,0.9)';
+      for (const d of [...this.rings.filter((v, k) => k % 2 === 1), maxDist]) {
+        const r = (d / maxDist) * R - (d === maxDist ? 6 : 0), a = -Math.PI / 4;
+        g.fillText(`${tick(d)} m`, cx + r * Math.cos(a), cy - r * Math.sin(a) + 3);
       }
       if (Number.isFinite(heading)) {
         g.strokeStyle = '#c0392b';
@@ -98,6 +159,7 @@ export class Population {
     this.size = Math.max(6, Math.min(16, Math.floor(380 / this.cols)));
     this.canvas = canvas(this.cols * this.size, this.rows * this.size, 'map population');
     container.appendChild(this.canvas);
+    this.colorBar = colorBar(container, { label: 'place-cell rate (the largest in the trial is the top)', lo: 0, hi: this.rateMax });
     this.selected = -1;
     this.canvas.addEventListener('click', (e) => {
       const r = this.canvas.getBoundingClientRect();
@@ -132,13 +194,15 @@ export class Population {
 // A map over the trial's bins. Hexagons: matplotlib's hexbin polygon, sx wide with vertices at
 // ±sy/3 (pointy top). Voxels: the slice at one height, squares of the grid step.
 export class BinMap {
-  constructor(container, title) {
+  constructor(container, title, scale) {
     this.title = Object.assign(document.createElement('h3'), { textContent: title });
-    this.canvas = canvas(360, 280);
-    this.base = canvas(360, 280);
+    this.canvas = canvas(380, 300);
+    this.base = canvas(380, 300);
     this.key = null;
     this.info = Object.assign(document.createElement('div'), { className: 'cell-info' });
-    container.append(this.title, this.canvas, this.info);
+    container.append(this.title, this.canvas);
+    this.colorBar = colorBar(container, { label: scale, lo: 0, hi: 1 });
+    container.append(this.info);
   }
 
   // centers: B × D; values: B (NaN: no value); bounds: [x0, x1, y0, y1]. The map is drawn again
@@ -164,12 +228,16 @@ export class BinMap {
     g.fillStyle = '#fff';
     g.fillRect(0, 0, c.width, c.height);
     if (!centers || !values) return;
-    const [x0, x1, y0, y1] = bounds, pad = 8;
-    const scale = Math.min((c.width - 2 * pad) / (x1 - x0), (c.height - 2 * pad) / (y1 - y0));
-    const ox = (c.width - scale * (x1 - x0)) / 2, oy = (c.height - scale * (y1 - y0)) / 2;
+    // Room on the left and below for the axes (metres).
+    const [x0, x1, y0, y1] = bounds, pad = 8, left = 40, bottom = 30;
+    const scale = Math.min((c.width - left - pad) / (x1 - x0), (c.height - bottom - pad) / (y1 - y0));
+    const ox = left + (c.width - left - pad - scale * (x1 - x0)) / 2;
+    const oy = bottom + (c.height - bottom - pad - scale * (y1 - y0)) / 2;
     const px = (x) => ox + (x - x0) * scale, py = (y) => c.height - oy - (y - y0) * scale;
     this.project = (x, y) => [px(x), py(y)];
     const top = vmax > 0 ? vmax : 1;
+    this.colorBar.set({ lo: 0, hi: top });
+    this.axes(g, { x0, x1, y0, y1, px, py, left: ox, bottom: c.height - oy });
     const B = values.length;
     const hex = grid && grid.kind === 'hex' ? [[0.5, -0.5], [0.5, 0.5], [0, 1], [-0.5, 0.5], [-0.5, -0.5], [0, -1]]
       .map(([a, b]) => [a * grid.sx, (b * grid.sy) / 3]) : null;
@@ -190,5 +258,45 @@ export class BinMap {
         g.fillRect(px(x) - s / 2, py(y) - s / 2, s, s);
       }
     }
+  }
+
+  // Axes in metres below and left of the map, ticks at round values; the ticks drawn (value and
+  // pixel) are kept in data-axes for readers and tests.
+  axes(g, { x0, x1, y0, y1, px, py, left, bottom }) {
+    const step = niceStep(Math.max(x1 - x0, y1 - y0));
+    const ticks = (lo, hi) => {
+      const out = [];
+      for (let v = Math.ceil(lo / step) * step; v <= hi + 1e-9; v += step) out.push(Math.round(v / step) * step);
+      return out;
+    };
+    const drawn = { unit: 'm', x: [], y: [] };
+    g.strokeStyle = '#555';
+    g.fillStyle = '#333';
+    g.lineWidth = 1;
+    g.font = '10px "DejaVu Sans", sans-serif';
+    g.beginPath();
+    g.moveTo(px(x0), bottom + 3); g.lineTo(px(x1), bottom + 3);
+    g.moveTo(left - 3, py(y0)); g.lineTo(left - 3, py(y1));
+    g.stroke();
+    g.textAlign = 'center';
+    for (const v of ticks(x0, x1)) {
+      g.beginPath(); g.moveTo(px(v), bottom + 3); g.lineTo(px(v), bottom + 7); g.stroke();
+      g.fillText(tick(v), px(v), bottom + 17);
+      drawn.x.push([v, px(v)]);
+    }
+    g.textAlign = 'right';
+    for (const v of ticks(y0, y1)) {
+      g.beginPath(); g.moveTo(left - 3, py(v)); g.lineTo(left - 7, py(v)); g.stroke();
+      g.fillText(tick(v), left - 9, py(v) + 3);
+      drawn.y.push([v, py(v)]);
+    }
+    g.textAlign = 'left';
+    g.fillText('x (m)', px(x1) - 28, bottom + 27);
+    g.save();
+    g.translate(10, py(y1) + 30);
+    g.rotate(-Math.PI / 2);
+    g.fillText('y (m)', 0, 0);
+    g.restore();
+    this.canvas.dataset.axes = JSON.stringify(drawn);
   }
 }

@@ -2,7 +2,7 @@
 // its own, or a recording (scans with their poses). Two trial panes side by side share the slider.
 import { get, exportedSteps } from './api.js';
 import { View3D } from './view3d.js';
-import { BvcMaps, Population, BinMap } from './panels.js';
+import { BvcMaps, Population, BinMap, colorBar } from './panels.js';
 
 const el = (tag, props = {}, ...children) => {
   const e = Object.assign(document.createElement(tag), props);
@@ -10,6 +10,16 @@ const el = (tag, props = {}, ...children) => {
   return e;
 };
 const fmt = (v, digits = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '—' : Number(v).toFixed(digits));
+const pct = (v) => (Number.isFinite(v) ? `${Math.round(100 * v)} %` : '—');
+const degrees = (rad) => `${(rad * 180 / Math.PI).toFixed(1)}°`;
+
+// What a model reads of a recorded scan, in words.
+function readingWords(r) {
+  if (!r) return '';
+  const which = { upper_half: 'at or above the horizon', all: 'at every elevation',
+    horizontal_slice: `within ±${degrees(r.slice_half_width)} of the horizontal` }[r.selection] || r.selection;
+  return `points ${fmt(r.min_range, 1)}–${fmt(r.max_range, 1)} m away, ${which}`;
+}
 
 function showError(container, message) {
   container.appendChild(el('div', { className: 'error', textContent: message }));
@@ -71,11 +81,20 @@ class Pane {
   addView() {
     this.viewBox = el('div', { className: 'view3d' });
     this.legend = el('div', { className: 'legend' });
+    this.legendText = el('div');
+    this.legend.appendChild(this.legendText);
     this.viewBox.appendChild(this.legend);
     this.root.appendChild(this.viewBox);
     this.view = new View3D(this.viewBox);
     this.readout = el('div', { className: 'readout' });
     this.root.appendChild(this.readout);
+  }
+
+  // The 3-D view's legend: what the points are, and a color bar of their distance from the scanner.
+  setLegend(text, maxRange) {
+    this.legendText.textContent = text;
+    if (!this.rangeBar) this.rangeBar = colorBar(this.legend, { label: 'distance from the scanner (m)', map: 'turbo' });
+    this.rangeBar.set({ lo: 0, hi: maxRange });
   }
 
   error(message) {
@@ -103,25 +122,41 @@ export class TrialPane extends Pane {
     const h = trial.header, a = trial.arrays;
     this.length = h.samples;
     this.heading.textContent = h.name;
-    const m = h.metrics;
-    this.sub.textContent = `${h.world} · model ${h.model_name} · seed ${h.seed} · ${h.samples} samples · ${h.n_place} cells · ` +
-      `MSAI ${fmt(m.msai)} · multimodal ${fmt(m.frac_multimodal)} · decoding median ${fmt(m.decode_median_m, 2)} m`;
+    const m = h.metrics, rec = h.recording;
+    const where = rec ? `replay of recording '${rec.name}'${rec.scans ? ` (${rec.scans} scans)` : ''}` : `world ${h.world}`;
+    this.sub.textContent = `${where} · model ${h.model_name} · seed ${h.seed} · ${h.samples} samples · ${h.n_place} place cells · ` +
+      `mean spatial aliasing (MSAI) ${fmt(m.msai)} · cells with several fields ${pct(m.frac_multimodal)} · ` +
+      `median decoding error ${fmt(m.decode_median_m, 2)} m` +
+      (Number.isFinite(m.frac_undecoded) ? ` (${pct(m.frac_undecoded)} of samples undecoded)` : '');
     this.addView();
     this.view.setTrajectory(a.x, a.y, a.z);
     this.steps = exportedSteps(this.path);
+    // A replay's world is its recording's map: framed on the path and 10 m around it (far returns
+    // would push the camera away).
+    const around = h.recording ? this.around(a) : null;
+    if (around) this.view.frame(around);
     if (h.world_problem) showError(this.root, h.world_problem);
     else {
-      this.loadingWorld = get('world', { trial: this.path }).then((w) => this.view.setWorld(w))
+      this.loadingWorld = get('world', { trial: this.path }).then((w) => { this.view.setWorld(w); if (around) this.view.frame(around); })
         .catch((e) => showError(this.root, e.message)).finally(() => { this.loadingWorld = null; });
     }
     if (h.model_problem) showError(this.root, h.model_problem);
-    this.legend.textContent = h.drawn_sensor
-      ? `returns: ${h.drawn_sensor.name} scanner, ${h.drawn_sensor.rows} rows; colored by range 0–${h.drawn_sensor.max_range} m; large = rows the model keeps`
-      : '';
+    if (rec) {
+      this.maxRange = rec.reading ? rec.reading.max_range : 20;
+      this.setLegend(`LiDAR points of recorded scan (recording '${rec.name}'), all of the scan; large: the points the model ` +
+        `read (${readingWords(rec.reading)}) near a BVC layer's elevation`, this.maxRange);
+    } else if (h.drawn_sensor) {
+      const d = h.drawn_sensor;
+      this.maxRange = d.max_range;
+      this.setLegend(`LiDAR returns of a simulated ${d.name} scanner (${d.rows} rows of beams, ${d.azimuth_count} per row); ` +
+        `large: the rows the model's BVCs read`, d.max_range);
+    }
 
     const row1 = el('div', { className: 'row' });
-    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: 'BVC activity per layer (distance × direction)' }));
-    const popBox = el('div', { className: 'box' }, el('h3', { textContent: 'place cells (click one for its map)' }));
+    const bvcTitle = rec ? 'boundary vector cells (BVCs): their rates as the replay recorded them, one disc per layer'
+      : 'boundary vector cells (BVCs): how strongly each responds to the walls around, one disc per layer';
+    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: bvcTitle }));
+    const popBox = el('div', { className: 'box' }, el('h3', { textContent: 'place cells, one square each (click one for its map)' }));
     row1.append(bvcBox, popBox);
     const row2 = el('div', { className: 'row' });
     const cellBox = el('div', { className: 'box cell-map' });
@@ -130,12 +165,22 @@ export class TrialPane extends Pane {
     this.root.append(row1, row2);
     if (h.model) this.bvcMaps = new BvcMaps(bvcBox, h.model.bvc);
     this.population = new Population(popBox, h.n_place, h.rate_max, (k) => this.pick(k));
-    this.cellMap = new BinMap(cellBox, 'rate map: pick a cell');
-    this.saiMap = new BinMap(saiBox, 'spatial aliasing index per bin');
+    this.cellMap = new BinMap(cellBox, 'rate map: click a place cell above', 'mean rate in each bin');
+    this.saiMap = new BinMap(saiBox, 'spatial aliasing: how alike the population looks here and elsewhere',
+      'spatial aliasing index (0: unique)');
     this.prepareMaps();
     this.drawSai();
     this.loader = new StepLoader((i) => get('step', { path: this.path, i }), (s, e) => this.applyStep(s, e));
     return true;
+  }
+
+  around(a) {
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < a.x.length; i++) {
+      const p = [a.x[i], a.y[i], a.z ? a.z[i] : 0];
+      for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p[k]); hi[k] = Math.max(hi[k], p[k]); }
+    }
+    return [[lo[0] - 10, lo[1] - 10, lo[2] - 2], [hi[0] + 10, hi[1] + 10, hi[2] + 2]];
   }
 
   prepareMaps() {
@@ -182,7 +227,7 @@ export class TrialPane extends Pane {
     }
     const top = this.saiTop;
     this.saiMap.draw(this.mapArgs('sai', sai, top));
-    this.saiMap.info.textContent = `MSAI ${fmt(this.trial.header.metrics.msai)} (mean over bins); color 0 – ${fmt(top)}`;
+    this.saiMap.info.textContent = `mean over the bins (MSAI) ${fmt(this.trial.header.metrics.msai)}; the red dot is the agent`;
   }
 
   pick(k) {
@@ -204,14 +249,19 @@ export class TrialPane extends Pane {
       }
       this.cellValues = { cell: k, values, top };
     }
-    this.cellMap.title.textContent = `rate map of cell ${k}`;
+    this.cellMap.title.textContent = `rate map of place cell ${k}: its mean rate at each place`;
     this.cellMap.draw(this.mapArgs(`cell ${k}`, this.cellValues.values, this.cellValues.top));
     const mi = a.modality ? a.modality[k] : null;
     this.cellMap.info.dataset.cell = k;
     this.cellMap.info.dataset.mi = mi;
-    this.cellMap.info.textContent = `cell ${k} · MI (modality) ${mi ?? '—'} · spatial info ${fmt(a.spatial_info && a.spatial_info[k])} bits · ` +
-      `peak ${fmt(a.peak_rate && a.peak_rate[k])} · rate now ${fmt(this.population.rates && this.population.rates[k])}`;
+    this.cellMap.info.textContent = `cell ${k} · fields (modality index) ${mi ?? '—'} · ` +
+      `spatial information ${fmt(a.spatial_info && a.spatial_info[k])} bits · ` +
+      `peak rate ${fmt(a.peak_rate && a.peak_rate[k])} · rate now ${fmt(this.population.rates && this.population.rates[k])}; ` +
+      'the red dot is the agent';
   }
+
+  // Seconds since the trial's start at sample i (as the trial file has them).
+  timeAt(i) { return this.trial.arrays.t[i]; }
 
   // The sample to show: the agent moves at once; the step's data follows when it arrives.
   moveTo(i) {
@@ -230,8 +280,8 @@ export class TrialPane extends Pane {
       return;
     }
     this.step = step;
-    const h = step.header, a = step.arrays, model = this.trial.header.model;
-    if (a.points.length) this.view.setReturns(a.points, a.range, a.kept, this.trial.header.drawn_sensor.max_range);
+    const h = step.header, a = step.arrays, model = this.trial.header.model, rec = this.trial.header.recording;
+    if (a.points.length) this.view.setReturns(a.points, a.range, a.kept, this.maxRange);
     if (this.bvcMaps) this.bvcMaps.draw(a.bvc, h.heading);
     this.population.draw(a.place);
     let top = 0, best = 0;
@@ -240,10 +290,17 @@ export class TrialPane extends Pane {
     for (const k of a.kept) kept += k;
     this.readout.dataset.sample = h.sample;
     this.readout.dataset.returns = h.returns ?? 0;
+    const seen = rec
+      ? `scan ${h.scan} (${h.scan_name}): ${h.points} points, of which the model read ${h.returns} ` +
+        `(${readingWords(rec.reading)}); ${kept} near a BVC layer's elevation, drawn large`
+      : h.returns !== undefined
+        ? `${h.returns} LiDAR returns drawn, ${kept} of them in the rows the model's BVCs read (drawn large); ` +
+          `the model's own scanner gets ${h.model_returns}`
+        : 'no returns: the trial\'s world is not shown';
     this.readout.textContent =
-      `sample ${h.sample}  t ${h.t.toFixed(3)} s  x ${h.x.toFixed(4)}  y ${h.y.toFixed(4)}  z ${h.z.toFixed(3)}  heading ${h.heading.toFixed(4)} rad\n` +
-      `returns ${h.returns ?? 0} (${kept} in rows the model keeps; the model saw ${h.model_returns ?? 0})  ` +
-      `most active cell ${best} at ${top.toFixed(4)}` + (this.steps ? `  [exported step nearest to sample ${this.target}]` : '');
+      `sample ${h.sample}  t ${h.t.toFixed(3)} s since the trial's start  x ${h.x.toFixed(4)} m  y ${h.y.toFixed(4)} m  ` +
+      `z ${h.z.toFixed(3)} m  heading ${h.heading.toFixed(4)} rad (${degrees(h.heading)})\n` + seen + '\n' +
+      `most active place cell ${best}, rate ${top.toFixed(4)}` + (this.steps ? `  [exported step nearest to sample ${this.target}]` : '');
     if (model) this.readout.title = `${model.bvc.n_cells} BVCs in ${model.bvc.n_layers} layers`;
     if (this.selected >= 0) this.drawCell();
     else this.cellMap.draw(this.mapArgs('none', null, 1));
@@ -277,7 +334,7 @@ export class WorldPane extends Pane {
     this.readout.textContent = 'orbit: drag · zoom: wheel · pan: right-drag';
     if (!w.header.probe) return true;
     const headingInput = el('input', { type: 'number', value: '0', step: '15', className: 'probe-heading', title: 'heading, degrees' });
-    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: 'BVC activity per layer at the probe (distance × direction)' }),
+    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: 'boundary vector cells (BVCs) at the probe: how strongly each responds to the walls around, one disc per layer' }),
       el('label', { textContent: 'heading ° ' }, headingInput));
     this.root.appendChild(el('div', { className: 'row' }, bvcBox));
     this.bvcBox = bvcBox;
@@ -304,8 +361,9 @@ export class WorldPane extends Pane {
     const h = probe.header, a = probe.arrays;
     if (!this.bvcMaps) {
       this.bvcMaps = new BvcMaps(this.bvcBox, h.model.bvc);
-      this.legend.textContent = `probe: model ${h.model.name}, ${h.drawn_sensor.name} scanner, ${h.drawn_sensor.rows} rows; ` +
-        `colored by range 0–${h.drawn_sensor.max_range} m; large = rows the model keeps`;
+      const d = h.drawn_sensor;
+      this.setLegend(`LiDAR returns at the probe: model ${h.model.name}'s simulated ${d.name} scanner (${d.rows} rows of ` +
+        `beams, ${d.azimuth_count} per row); large: the rows the model's BVCs read`, d.max_range);
     }
     this.maxRange = h.drawn_sensor.max_range;
     this.view.setAgent(h.x, h.y, h.z, h.heading);
@@ -316,8 +374,9 @@ export class WorldPane extends Pane {
     this.readout.dataset.x = h.x;
     this.readout.dataset.y = h.y;
     this.readout.dataset.returns = h.returns;
-    this.readout.textContent = `probe at x ${h.x.toFixed(3)}  y ${h.y.toFixed(3)}  heading ${h.heading.toFixed(4)} rad: ` +
-      `returns ${h.returns} (${kept} in rows the model keeps; the model saw ${h.model_returns})`;
+    this.readout.textContent = `probe at x ${h.x.toFixed(3)} m  y ${h.y.toFixed(3)} m  heading ${h.heading.toFixed(4)} rad ` +
+      `(${degrees(h.heading)}): ${h.returns} LiDAR returns drawn, ${kept} of them in the rows the model's BVCs read ` +
+      `(drawn large); the model's own scanner gets ${h.model_returns}`;
   }
 
   moveTo() {}
@@ -355,13 +414,23 @@ export class RecordingPane extends Pane {
       this.view.setWorld(w);
       this.view.frame(around);
     }).catch((e) => showError(this.root, e.message)).finally(() => { this.loadingWorld = null; });
-    this.legend.textContent = 'returns colored by range; large = near a BVC layer\'s elevation';
-    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: `BVC activity per layer (model ${h.model.name})` }));
+    this.setLegend(`LiDAR points of each recorded scan, all of the scan; large: the points model ${h.model.name} reads ` +
+      `(${readingWords(h.reading)}) near a BVC layer's elevation`, 20);
+    const times = h.times.filter((t) => t !== null);
+    this.t0 = times.length ? times[0] : null;
+    const bvcBox = el('div', { className: 'box' }, el('h3', { textContent:
+      `boundary vector cells (BVCs) of model ${h.model.name}: their rates for this scan, one disc per layer` }));
     this.root.appendChild(el('div', { className: 'row' }, bvcBox));
     this.bvcMaps = new BvcMaps(bvcBox, h.model.bvc);
     this.steps = exportedSteps('#recording');
     this.loader = new StepLoader((i) => get('scan', { i }), (s, e) => this.applyStep(s, e));
     return true;
+  }
+
+  // Seconds since the first scan (null for a recording without times).
+  timeAt(i) {
+    const t = this.rec.header.times[i];
+    return t === null || this.t0 === null ? null : t - this.t0;
   }
 
   heading_of(i) {
@@ -387,11 +456,19 @@ export class RecordingPane extends Pane {
     const h = step.header, a = step.arrays;
     let far = 1;
     for (const r of a.range) far = Math.max(far, r);
-    this.view.setReturns(a.points, a.range, a.kept, Math.min(far, 60));
+    far = Math.min(far, 60);
+    this.view.setReturns(a.points, a.range, a.kept, far);
+    this.rangeBar.set({ hi: far });
     this.bvcMaps.draw(a.bvc, this.heading_of(h.scan));
+    let kept = 0;
+    for (const k of a.kept) kept += k;
     this.readout.dataset.sample = h.scan;
     this.readout.dataset.returns = h.returns;
-    this.readout.textContent = `scan ${h.scan} (${h.name})${h.t !== undefined ? `  t ${h.t.toFixed(3)} s` : ''}  ` +
-      `sensor at ${h.sensor_origin.map((v) => v.toFixed(3)).join(', ')}  returns ${h.returns}`;
+    // Times since the first scan (a recording's own times are often seconds since 1970: in the tooltip).
+    const since = h.t !== undefined && this.t0 !== null ? `  t ${(h.t - this.t0).toFixed(3)} s since the first scan` : '';
+    this.readout.title = h.t !== undefined ? `recorded time ${h.t} s` : '';
+    this.readout.textContent = `scan ${h.scan} (${h.name})${since}  ` +
+      `sensor at x ${h.sensor_origin[0].toFixed(3)} m  y ${h.sensor_origin[1].toFixed(3)} m  z ${h.sensor_origin[2].toFixed(3)} m\n` +
+      `${h.points} points, of which the model reads ${h.returns}; ${kept} near a BVC layer's elevation, drawn large`;
   }
 }
