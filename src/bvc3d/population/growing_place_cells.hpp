@@ -32,10 +32,10 @@
 namespace bvc3d {
 
 struct GrowingParams {
-    int budget = 2000;        // most cells: ~1 per 0.3 m² of a 600 m² floor (the hall: 632 m² of templates)
-    int n_initial = 0;        // cells at the start, the paper's random ones
-    double threshold = 0.05;  // recruit where the largest rate is below this
-    int sample_every = 10;    // learning steps between sampled places (the walk moves ~0.5 m in 10 steps)
+    int budget = 2000;       // most cells: ~1 per 0.3 m² of a 600 m² floor (the hall: 632 m² of templates)
+    int n_initial = 0;       // cells at the start, the paper's random ones
+    double threshold = 0.5;  // recruit where no cell fires at half its largest rate (tanh: 1)
+    int sample_every = 3;    // learning steps between sampled places: 0.43 m of the paper's walk (0.144 m a step)
     static const params::Table<GrowingParams>& table();
     void validate() const;  // the table's checks, and n_initial <= budget
 };
