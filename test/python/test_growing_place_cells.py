@@ -65,19 +65,23 @@ def run(net, inputs, learn):
     return np.array([net.step(b, bool(on)) for b, on in zip(inputs, learn)])
 
 
-def test_matches_numpy_transcription():
-    inputs = tour(12, 15)
+@pytest.mark.parametrize("places_, dwell, budget, threshold, every", [
+    (12, 15, 8, 0.3, 6),  # the budget is reached: the test sees recruitment stop
+    (90, 4, 70, 1.0, 4),  # past the rows the network holds at first (64): it regrows with its state
+])
+def test_matches_numpy_transcription(places_, dwell, budget, threshold, every):
+    inputs = tour(places_, dwell)
     learn = np.ones(len(inputs), bool)
     learn[40:50] = False  # a frozen stretch: no step there counts toward sampling
-    expect_rates, expect_W, expect_at, rows = numpy_growing(inputs, learn, budget=8, threshold=0.3, sample_every=6)
-    net = bvc3d.GrowingPlaceCells(inputs.shape[1], budget=8, threshold=0.3, sample_every=6)
+    expect_rates, expect_W, expect_at, rows = numpy_growing(inputs, learn, budget, threshold, every)
+    net = bvc3d.GrowingPlaceCells(inputs.shape[1], budget=budget, threshold=threshold, sample_every=every)
     got = run(net, inputs, learn)
-    assert len(expect_at) == 8  # the budget is reached: the test sees recruitment stop
+    assert len(expect_at) == budget
     np.testing.assert_array_equal(net.recruited_at, expect_at)
-    assert all(at % 6 == 0 for at in expect_at)
+    assert all(at % every == 0 for at in expect_at)
     np.testing.assert_allclose(got, expect_rates, rtol=2e-4, atol=2e-5)
     np.testing.assert_allclose(net.weights, expect_W, rtol=2e-4, atol=1e-5)
-    assert got.shape == (len(inputs), 8)
+    assert got.shape == (len(inputs), budget)
 
 
 def test_recruited_weights_are_the_bvc_vector():
