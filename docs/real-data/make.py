@@ -184,7 +184,9 @@ def write_sensor(path, rings, columns):
     pathlib.Path(path).write_text(text)
 
 
-def scan_to_map(rec, work):
+def hall_map(rec, work):
+    """The hall's point map (work/hall-map.ply), the sensor's beam pattern (hall-os64.yaml), the floor
+    and the template grid (work/grid.csv, work/hall-map.yaml, scan-to-map-setup.csv)."""
     poses, _ = read_poses(rec / "poses.csv")
     map_file = work / "hall-map.ply"
     if not map_file.exists():
@@ -218,6 +220,10 @@ def scan_to_map(rec, work):
         for k, v in facts.items():
             w.writerow([k, f"{v:.6g}" if isinstance(v, float) else v])
     log("setup:", facts)
+
+
+def scan_to_map(rec, work):
+    hall_map(rec, work)
     for model, name in zip(MODELS, MODEL_NAMES):
         out = work / f"templates_{name}.h5"
         if not out.exists():
@@ -350,7 +356,7 @@ def settled_place_rates(bvc, weights):
     vector for SETTLE steps (frozen); the response is the mean rate over the last SETTLE // 2 steps,
     which smooths the period-2 swing that recurrent inhibition gives some inputs."""
     import bvc3d
-    net = bvc3d.PlaceCellNetwork(bvc.shape[1])
+    net = bvc3d.PlaceCellNetwork(bvc.shape[1], n_place=weights.shape[0])
     net.weights = weights
     out = np.empty((len(bvc), weights.shape[0]), np.float32)
     for i, v in enumerate(np.asarray(bvc, np.float64)):
@@ -366,7 +372,10 @@ def summary_row(label, model, rates, result):
             ch["median_m"], ch["within_2m"], ne["median_m"], ne["within_1m"]]
 
 
-def place_cells(rec, work):
+def floor_setup(rec, work):
+    """The map, the template grid and the recording's poses in the floor frame (under work/floor), as a dict:
+    floor (the folder), world, grid (templates, n x 3), queries (the Recording), qxyz, sensor, height (the
+    sensor's), grid_path and query_path (trajectories for replay_simulated). Needs hall_map's outputs."""
     import bvc3d
     from scipy.spatial import ConvexHull
     points = read_ply(work / "hall-map.ply")
@@ -397,6 +406,29 @@ def place_cells(rec, work):
     heading = np.arctan2(queries.poses[:, 1, 0], queries.poses[:, 0, 0])
     query_path = {"t": np.arange(len(qxyz), dtype=float), "x": qxyz[:, 0], "y": qxyz[:, 1], "z": qxyz[:, 2],
                   "heading": heading}
+    return dict(floor=floor, world=world, grid=grid, queries=queries, qxyz=qxyz, sensor=sensor, height=height,
+                grid_path=grid_path, query_path=query_path)
+
+
+def template_query_rates(setup, name):
+    """Model `name`'s BVC rates of the templates and of the real queries, cached in floor/NAME-bvc.npz (they do
+    not depend on the walk)."""
+    import bvc3d
+    floor = setup["floor"]
+    bvc_file = floor / f"{name}-bvc.npz"
+    if not bvc_file.exists():
+        np.savez(bvc_file,
+                 templates=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), setup["grid_path"], setup["sensor"],
+                                                  model_arg(name))["bvc_rates"],
+                 queries=setup["queries"].replay(model_arg(name))["bvc_rates"])
+    return np.load(bvc_file)
+
+
+def place_cells(rec, work):
+    import bvc3d
+    setup = floor_setup(rec, work)
+    floor, world, grid, queries, qxyz = (setup[k] for k in ("floor", "world", "grid", "queries", "qxyz"))
+    sensor, height, query_path = setup["sensor"], setup["height"], setup["query_path"]
     rows, per_query, walks = [], [], []
     for name, hours in PLACE_RUNS:
         walk = bvc3d.random_walk(world, hours, 0, height=BODY_HEIGHT)
@@ -410,19 +442,13 @@ def place_cells(rec, work):
         if not cache.exists():
             start = time.time()
             learned = bvc3d.replay_simulated(str(floor / "hall-map.yaml"), path, sensor, model_arg(name), learn=True)
-            bvc_file = floor / f"{name}-bvc.npz"  # the BVC rates do not depend on the walk
-            if not bvc_file.exists():
-                np.savez(bvc_file,
-                         templates=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), grid_path, sensor,
-                                                          model_arg(name))["bvc_rates"],
-                         queries=queries.replay(model_arg(name))["bvc_rates"])
             np.savez(cache, weights=learned["weights"])
             log(f"{name}, {hours:g} h: learned in {time.time() - start:.0f} s")
         sim_file = floor / f"{name}-simulated-queries.npz"
         if not sim_file.exists():
             np.savez(sim_file, queries=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), query_path, sensor,
                                                               model_arg(name))["bvc_rates"])
-        bvc = np.load(floor / f"{name}-bvc.npz")
+        bvc = template_query_rates(setup, name)
         W = np.load(cache)["weights"]
         simulated = np.load(sim_file)["queries"]
         place_t = settled_place_rates(bvc["templates"], W)

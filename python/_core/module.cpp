@@ -114,4 +114,5 @@ PYBIND11_MODULE(_core, m) {
     bvc3d::py::bind_buildings(m);
     bvc3d::py::bind_navigation(m);
     bvc3d::py::bind_populations(m);
+    bvc3d::py::bind_growing(m);
 }

@@ -24,3 +24,5 @@ __all__ += ["lidar_models", "route", "tour", "write_trajectory"]
 from ._core import HdAdjacency, navigate, reward_readout, shortest_path
 __all__ += ["HdAdjacency", "navigate", "reward_readout", "shortest_path"]
 __all__ += ["GridCells", "HeadDirectionCells"]
+from ._core import GrowingPlaceCells
+__all__ += ["GrowingPlaceCells"]

@@ -44,6 +44,46 @@ PopulationSpec grid_spec(const std::string& name, const GridParams& p) {
     return s;
 }
 
+PopulationSpec growing_place_spec(const std::string& name, const PlaceParams& place, const GrowingParams& growing) {
+    GrowingPlaceCells::check(place, growing);
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "growing-place";
+    s.key = key_of(s.kind, growing) + key_of("", place);
+    s.make = [place, growing](const PopulationContext& c) {
+        if (c.input_sizes.size() != 1) throw InputError("a growing place-cell network reads one BVC population");
+        return std::make_unique<GrowingPlaceCells>(static_cast<int>(c.input_sizes[0]), place, growing, c.seed);
+    };
+    return s;
+}
+
+namespace {
+
+// A growing network's keys: its own and the place cells' dynamics (n_place aside: its cells are budget, n_initial).
+PopulationSpec read_growing_place(const YamlView& v, const std::string& name) {
+    if (v.has("n_place")) v["n_place"].fail("a growing network's cells are set by budget and n_initial");
+    std::vector<std::string> item(item_keys.begin(), item_keys.end());
+    auto with = [&item](std::vector<std::string> keys) {
+        keys.insert(keys.end(), item.begin(), item.end());
+        return keys;
+    };
+    GrowingParams growing;
+    PlaceParams place;
+    read_table(v, growing, GrowingParams::table(), with(keys_of<PlaceParams>()));
+    read_table(v, place, PlaceParams::table(), with(keys_of<GrowingParams>()));
+    check_at(v, [&] { GrowingPlaceCells::check(place, growing); });
+    return growing_place_spec(name, place, growing);
+}
+
+std::vector<std::string> growing_place_keys() {
+    auto keys = keys_of<GrowingParams>();
+    for (const auto& k : keys_of<PlaceParams>())
+        if (k != "n_place") keys.push_back(k);
+    return keys;
+}
+
+}  // namespace
+
 const std::vector<PopulationKind>& population_kinds() {
     static const std::vector<PopulationKind> kinds = {
         {"head-direction", "head-direction cells: cos(θ − θ_k), or the icosahedron's 20 for flying",
@@ -59,6 +99,12 @@ const std::vector<PopulationKind>& population_kinds() {
              GridParams p;
              read_table(v, p, GridParams::table(), item_keys);
              return grid_spec(name, p);
+         }},
+        {"growing-place",
+         "place cells that recruit a cell where none fires (weights from the BVC vector), up to a budget; Oja as §6",
+         growing_place_keys(), 1,
+         [](const YamlView& v, const std::string& name, std::vector<std::string>) {
+             return read_growing_place(v, name);
          }},
     };
     return kinds;

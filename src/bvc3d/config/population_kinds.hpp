@@ -11,6 +11,7 @@
 #include "bvc3d/config/population_spec.hpp"
 #include "bvc3d/config/yaml_reader.hpp"
 #include "bvc3d/population/grid_cells.hpp"
+#include "bvc3d/population/growing_place_cells.hpp"
 #include "bvc3d/population/head_direction_cells.hpp"
 
 namespace bvc3d::config {
@@ -31,6 +32,7 @@ const PopulationKind* find_population_kind(const std::string& name);
 // The specs of the kinds, for C++ callers.
 PopulationSpec head_direction_spec(const std::string& name, const HeadDirectionParams& p);
 PopulationSpec grid_spec(const std::string& name, const GridParams& p);
+PopulationSpec growing_place_spec(const std::string& name, const PlaceParams& place, const GrowingParams& growing);
 
 }  // namespace bvc3d::config
 

@@ -107,13 +107,13 @@ void check_at(const YamlView& v, F&& check) {
 // field's kind and limits; angles also as `<key>_deg`), then validates the whole struct. Keys in
 // `also` are the caller's to read; any other key is an error.
 template <class S>
-void read_table(const YamlView& v, S& s, const params::Table<S>& table, std::initializer_list<const char*> also = {}) {
+void read_table(const YamlView& v, S& s, const params::Table<S>& table, const std::vector<std::string>& also) {
     std::vector<std::string> allowed;
     for (const auto& f : table.fields()) {
         allowed.push_back(f.key);
         if (f.radians) allowed.push_back(f.key + "_deg");
     }
-    for (const char* k : also) allowed.emplace_back(k);
+    allowed.insert(allowed.end(), also.begin(), also.end());
     v.expect_map(allowed);
     for (const auto& f : table.fields()) {
         const std::string deg = f.key + "_deg";
@@ -128,6 +128,10 @@ void read_table(const YamlView& v, S& s, const params::Table<S>& table, std::ini
         }
     }
     check_at(v, [&] { s.validate(); });
+}
+template <class S>
+void read_table(const YamlView& v, S& s, const params::Table<S>& table, std::initializer_list<const char*> also = {}) {
+    read_table(v, s, table, std::vector<std::string>(also.begin(), also.end()));
 }
 
 }  // namespace bvc3d::config

@@ -160,4 +160,15 @@ void PlaceCellNetwork::set_state(std::span<const float> membrane, std::span<cons
         if (v_[i] != 0.0f) active_.push_back(static_cast<int>(i));
 }
 
+void PlaceCellNetwork::set_cell(int i, std::span<const float> w, float membrane) {
+    if (i < 0 || i >= p_.n_place) throw InputError("place cells: no cell " + std::to_string(i));
+    if (w.size() != static_cast<std::size_t>(n_bvc_))
+        throw InputError("place cells: a row of weights must have " + std::to_string(n_bvc_) + " values");
+    for (float x : w)
+        if (!std::isfinite(x)) throw InputError("place cells: weights must be finite");
+    if (!std::isfinite(membrane)) throw InputError("place cells: the membrane potential must be finite");
+    for (int j = 0; j < n_bvc_; ++j) row(i)[kernels::paired_column(j)] = flush_tiny(w[j]);
+    s_[i] = membrane;
+}
+
 }  // namespace bvc3d

@@ -56,6 +56,8 @@ public:
     void reset();
     // Restore the dynamic state (checkpoints).
     void set_state(std::span<const float> membrane, std::span<const float> rates);
+    // Row i's weights (n_bvc) and membrane set, its rate kept (a growing network recruits cell i this way).
+    void set_cell(int i, std::span<const float> w, float membrane);
 
 private:
     // Weights in the kernels' paired layout (place_kernels.hpp): rows 2p and 2p+1 interleaved by
