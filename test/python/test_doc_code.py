@@ -24,6 +24,7 @@ SHORTER = {  # page -> [(text in the block, text the test runs)]
                   ('run_trial(model="3d-3l", tilt_deg=60)',
                    'run_trial(model="3d-3l", tilt_deg=60, explore_hours=0.005, sample_hours=0.005)')],
     "python.md": [("explore_hours=4, sample_hours=4", "explore_hours=0.005, sample_hours=0.005")],
+    "place-recognition.md": [("database=(0, 3000), queries=(3200, 4540)", "database=(0, 60), queries=(80, 106)")],
     "adaptive.md": [("explore_minutes=30", "explore_minutes=0.5"),
                     ('agent="flying", seed=7)', 'agent="flying", seed=7, explore_minutes=0.5)')],
 }
@@ -32,6 +33,7 @@ SETUP = {
     "trial-files.md": [["run", "--world", "cross", "--tilt", "45", "--model", "3d-0.2", "--hours", "0.01",
                         "--out", "results/paper/cross-45_3d-0.2_seed0.h5", "--checkpoint-minutes", "0"]],
     "ros.md": [["export-scans", "--hours", "0.002", "--format", "ros1", "--out", "run.bag"]],
+    "place-recognition.md": [["export-scans", "--hours", "0.01", "--format", "pcd", "--out", "run/"]],
 }
 NEEDS = {  # page -> (what the block reads, where it can come from) for blocks the test cannot feed
     "adaptive.md": "a recording in hall/ (the user's own)",
