@@ -18,6 +18,7 @@
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 #include "bvc3d/core/output_lock.hpp"
 #include "bvc3d/experiment/experiment.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
@@ -35,29 +36,9 @@ struct TrialOptions {
     std::string config, world, lean, model, protocol, extent, trajectory, agent;
     std::optional<double> tilt, explore_hours, sample_hours, hours;
     std::optional<std::uint64_t> seed;
-    bool record_bvc = false;
+    bool record_bvc = false, step_per_row = false;
     RunOptions run;  // --out: the trial file; --checkpoint-minutes; --no-memory-check
 };
-
-// A trajectory steps the model once per row, and the place cells' time constant and Oja's rate are
-// per step: rows much closer (or farther) than the robot's model step change the dynamics per second.
-// Until trajectories are resampled to the model step (issue 32), say so.
-void warn_if_off_the_model_step(const TrajectorySpec& path) {
-    const auto& steps = path.steps();
-    if (steps.size() < 3) return;
-    std::vector<double> dt;
-    for (std::size_t i = 1; i < steps.size(); ++i) dt.push_back(steps[i].t - steps[i - 1].t);
-    std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-    const double median = dt[dt.size() / 2], model = RobotParams{}.model_dt;
-    if (std::abs(median / model - 1) <= 0.1) return;
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "has a row every %.3g s (median), the model one step per row: the place cells' time constant and "
-                  "Oja's rate are per step, so the dynamics run %.3g times as fast per second as at the robot's model "
-                  "step of %g s; resample the rows to %g s for the paper's dynamics",
-                  median, model / median, model, model);
-    std::cerr << "bvc3d: warning: trajectory '" << path.source() << "' " << text << "\n";
-}
 
 // The trial `bvc3d run` runs: the YAML file's, with the flags on top.
 TrialConfig run_config(const TrialOptions& o) {
@@ -70,10 +51,14 @@ TrialConfig run_config(const TrialOptions& o) {
         t.set_agent(agent_by_name(o.agent));
         if (!o.trajectory.empty()) throw InputError("give --agent or --trajectory, not both");
     }
+    if (o.step_per_row && o.trajectory.empty())
+        throw InputError(
+            "--step-per-row goes with --trajectory (in a trial YAML: trajectory: {file: FILE, "
+            "step_per_row: true})");
     if (!o.trajectory.empty()) {
-        auto path = std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory));
-        warn_if_off_the_model_step(*path);
-        t.set_agent(path);
+        TrajectoryParams params;
+        params.step_per_row = o.step_per_row;
+        t.set_agent(std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(o.trajectory, params)));
     }
     if (o.seed) t.seed = *o.seed;
     if (!o.protocol.empty()) t.protocol.kind = parse_protocol(o.protocol);
@@ -95,6 +80,7 @@ TrialConfig run_config(const TrialOptions& o) {
 void run_one(const TrialConfig& t, const std::filesystem::path& out, double checkpoint_minutes) {
     const ProgressStyle style = progress_style();
     const double total = t.protocol.seconds();
+    if (const std::string note = t.agent->note(); !note.empty()) std::cerr << "bvc3d: note: " << note << "\n";
     InterruptGuard guard;
     RunControl control;
     control.stop = &stop_flag();
@@ -124,8 +110,14 @@ void run_one(const TrialConfig& t, const std::filesystem::path& out, double chec
     const auto& r = done.result;
     std::printf("wrote %s: %zu samples, %.0f steps/s\n", out.c_str(), r.t.size(),
                 (r.stats.explore_steps + r.stats.sample_steps) / wall);
-    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics))
-        std::printf("  %-16s %g\n", name.c_str(), v);
+    if (const std::string note = t.agent->note(); !note.empty()) std::printf("  %s\n", note.c_str());
+    if (t.place_cells_untrained())
+        std::printf(
+            "  no place-cell metrics: the place cells never learned (explore_hours 0, no weights given), "
+            "their weights are the seed's random draw\n");
+    else
+        for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics))
+            std::printf("  %-16s %g\n", name.c_str(), v);
 }
 
 void add_run(CLI::App& app) {
@@ -138,7 +130,11 @@ void add_run(CLI::App& app) {
     cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward (default +x+y)");
     cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
     cmd->add_option("--trajectory", o->trajectory,
-                    "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows");
+                    "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows, "
+                    "resampled to the model step (" +
+                        format_number(TrajectoryParams{}.model_dt) + " s) unless they are at it");
+    cmd->add_flag("--step-per-row", o->step_per_row,
+                  "With --trajectory: one model step per row, whatever their interval (no resampling)");
     cmd->add_option("--agent", o->agent,
                     "The agent, by name: " + agent_names_text() + "; default " + agent_kinds().front().name);
     cmd->add_option("--seed", o->seed, "Random seed, 0 .. 2^64 - 1 (default 0)")->check(seed_check);
@@ -341,10 +337,14 @@ void add_analyze(CLI::App& app) {
                 positions(static_cast<Eigen::Index>(k), 1) = d.y[k];
                 if (d.dims == 3) positions(static_cast<Eigen::Index>(k), 2) = d.z[k];
             }
-            const auto m = analysis::analyze_trial<float>(positions, rates, params[i]);
             // A block per trial, two metrics a line: it fits a terminal of 80 columns (--out has them all).
             std::printf("%s (%s)\n", printable(d.name).c_str(), printable(o->files[i]).c_str());
-            const auto values = analysis::scalar_metrics(m);
+            // Untrained place cells (the seed's random weights, never learned): their metrics mean nothing.
+            const bool untrained = d.place_weights == "untrained";
+            if (untrained)
+                std::printf("  no place-cell metrics: its place cells never learned (place_weights untrained)\n");
+            const auto m = analysis::analyze_trial<float>(positions, rates, params[i]);
+            const auto values = untrained ? std::vector<std::pair<std::string, double>>{} : analysis::scalar_metrics(m);
             csv += csv_field(o->files[i]);
             csv += ',';
             csv += csv_field(d.name);
@@ -352,9 +352,11 @@ void add_analyze(CLI::App& app) {
                 const auto it =
                     std::find_if(values.begin(), values.end(), [&](const auto& v) { return v.first == columns[c]; });
                 const bool has = it != values.end();
-                if (has) std::printf("  %-22s %12.6g", columns[c].c_str(), it->second);
-                else std::printf("  %-22s %12s", columns[c].c_str(), "-");
-                std::printf("%s", c % 2 == 1 || c + 1 == columns.size() ? "\n" : "  ");
+                if (!untrained) {
+                    if (has) std::printf("  %-22s %12.6g", columns[c].c_str(), it->second);
+                    else std::printf("  %-22s %12s", columns[c].c_str(), "-");
+                    std::printf("%s", c % 2 == 1 || c + 1 == columns.size() ? "\n" : "  ");
+                }
                 csv += ',';
                 if (has) csv += num(it->second);
             }

@@ -64,6 +64,7 @@ private:
 // Scans to replay: a recording (--scans, --poses), or a simulated sensor along a path in a world.
 struct SourceOptions {
     std::string scans, poses, world, trajectory, sensor;
+    bool step_per_row = false;
     RecordingOptions recording;
     PreprocessOptions preprocess;
 
@@ -74,14 +75,17 @@ struct SourceOptions {
         cmd.add_option("--world", world, "Instead of a recording: a world (preset or YAML) to simulate a sensor in");
         cmd.add_option(
             "--trajectory", trajectory,
-            "With --world: the sensor's path, rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
+            "With --world: the sensor's path, rows t, x, y, [z], heading[, pitch, roll] (a header names them), "
+            "resampled to the model step unless they are at it");
+        cmd.add_flag("--step-per-row", step_per_row,
+                     "With --trajectory: one model step (one scan) per row, whatever their interval");
         cmd.add_option("--sensor", sensor,
                        "With --world: the simulated sensor (horizontal, spherical or a sensor YAML)");
         preprocess.add_to(cmd);
     }
     ReplaySource get() const {
         const bool recorded = !scans.empty() || !poses.empty() || recording.has_bag();
-        const bool simulated = !world.empty() || !trajectory.empty() || !sensor.empty();
+        const bool simulated = !world.empty() || !trajectory.empty() || !sensor.empty() || step_per_row;
         if (recorded == simulated)
             throw InputError(
                 "give either a recording (--scans and --poses, or --bag) or a simulation (--world, --trajectory, "
@@ -94,20 +98,17 @@ struct SourceOptions {
             throw InputError("a simulated replay needs --world, --trajectory and --sensor");
         WorldSpec w{world, std::nullopt, "+x+y"};
         w.resolve();  // fail early on bad worlds
-        auto path = std::make_shared<const TrajectorySpec>(TrajectorySpec::from_file(trajectory));
+        TrajectoryParams params;
+        params.step_per_row = step_per_row;
+        auto path = std::make_shared<const TrajectorySpec>(TrajectorySpec::from_file(trajectory, params));
+        if (const std::string note = path->note(); !note.empty()) std::cerr << "bvc3d: note: " << note << "\n";
         return simulated_source(w, path, config::resolve_sensor(sensor), preprocess.get());
     }
 };
 
 std::shared_ptr<const InitialWeights> weights_from(const std::string& file) {
     if (file.empty()) return nullptr;
-    const TrialWeights w = read_trial_weights(file);
-    auto out = std::make_shared<InitialWeights>();
-    out->source = file;
-    out->values = w.values;
-    out->n_place = static_cast<int>(w.n_place);
-    out->n_bvc = static_cast<int>(w.n_bvc);
-    return out;
+    return weights_from_trial_file(file);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -155,6 +156,10 @@ void add_replay(CLI::App& app) {
         const double wall = seconds_since(start);
         std::printf("replayed %zu scans of %s through %s in %.2f s (%.1f scans/s): %s\n", done.result.t.size(),
                     t.world_label().c_str(), t.model.name.c_str(), wall, static_cast<double>(n) / wall, out.c_str());
+        if (t.place_cells_untrained())
+            std::printf(
+                "  place cells frozen at the seed's random weights (no --weights, no --learn): their rates are "
+                "recorded, their metrics are not (place_weights: untrained)\n");
     });
 }
 
@@ -525,7 +530,9 @@ void add_export_scans(CLI::App& app) {
         if (o->hours) {
             steps = random_walk(world, *o->hours, o->seed);
         } else {
-            const TrajectorySpec path = TrajectorySpec::from_file(o->trajectory);
+            TrajectoryParams per_row;  // a scan at each row, as a scanner along the path takes them
+            per_row.step_per_row = true;
+            const TrajectorySpec path = TrajectorySpec::from_file(o->trajectory, per_row);
             path.check_world(world.description());  // a row outside the world, named as `run` names it
             steps = path.steps();
         }

@@ -66,13 +66,15 @@ struct NodeModel::State {
         preprocess.slice_half_width = deg_to_rad(params.slice_half_width_deg);
         preprocess.validate();
         if (!params.weights.empty()) {
-            const TrialWeights w = read_trial_weights(params.weights);
-            if (w.n_place != static_cast<std::size_t>(model.place.n_place) ||
-                w.n_bvc != static_cast<std::size_t>(model.bvc.n_cells()))
-                throw InputError("~weights: '" + params.weights + "' holds " + std::to_string(w.n_place) + " × " +
-                                 std::to_string(w.n_bvc) + " weights; model '" + model.name + "' has " +
+            const auto w = weights_from_trial_file(params.weights);
+            if (w->n_place != model.place.n_place || w->n_bvc != model.bvc.n_cells())
+                throw InputError("~weights: '" + params.weights + "' holds " + std::to_string(w->n_place) + " × " +
+                                 std::to_string(w->n_bvc) + " weights; model '" + model.name + "' has " +
                                  std::to_string(model.place.n_place) + " × " + std::to_string(model.bvc.n_cells()));
-            net.set_weights(w.values);
+            if (const std::string why = weights_model_mismatch(w->model_config, model); !why.empty())
+                throw InputError("~weights: '" + params.weights + "' were trained by model '" + w->model +
+                                 "', whose BVCs are not model '" + model.name + "''s: " + why);
+            net.set_weights(w->values);
         }
         if (p.revisit_window_scans < 0 || !(p.revisit_window_s >= 0) || !(p.revisit_threshold >= 0))
             throw InputError("~revisit_window_scans, ~revisit_window_s and ~revisit_threshold must be >= 0");
@@ -103,15 +105,7 @@ struct NodeModel::State {
         }
         // The templates' rates as `bvc3d localize` makes them: a frozen replay (with ~weights if given).
         std::shared_ptr<const InitialWeights> weights;
-        if (!p.weights.empty()) {
-            const TrialWeights w = read_trial_weights(p.weights);
-            auto iw = std::make_shared<InitialWeights>();
-            iw->source = p.weights;
-            iw->values = w.values;
-            iw->n_place = static_cast<int>(w.n_place);
-            iw->n_bvc = static_cast<int>(w.n_bvc);
-            weights = iw;
-        }
+        if (!p.weights.empty()) weights = weights_from_trial_file(p.weights);
         const ReplaySource source = recorded_source(rec, preprocess);
         const GroupResult r = run_replay({replay_trial(source, model, false, weights, p.seed)});
         const ReplayRates rates = replay_rates(r, 0, !decode_place);

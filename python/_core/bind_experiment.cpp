@@ -15,14 +15,23 @@
 
 namespace bvc3d::py {
 
-namespace {
+std::vector<std::string> trajectory_keywords() {
+    std::vector<std::string> keys;
+    for (const auto& f : TrajectoryParams::table().fields()) keys.push_back(f.key);
+    return keys;
+}
 
-// A trajectory from a file path or from a mapping of arrays t, x, y, heading (and optionally z).
-std::shared_ptr<const AgentSpec> trajectory_of(const pyb::object& obj) {
+std::shared_ptr<const TrajectorySpec> trajectory_of(const pyb::object& obj, const pyb::kwargs& kwargs) {
+    TrajectoryParams params;
+    pyb::kwargs given;
+    for (const auto& key : trajectory_keywords())
+        if (kwargs.contains(key.c_str())) given[key.c_str()] = kwargs[key.c_str()];
+    apply_kwargs(params, TrajectoryParams::table(), given);
     if (pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__"))
-        return std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(pyb::str(obj).cast<std::string>()));
+        return std::make_shared<TrajectorySpec>(TrajectorySpec::from_file(pyb::str(obj).cast<std::string>(), params));
     if (!pyb::isinstance<pyb::dict>(obj))
-        throw InputError("trajectory must be a file path or a dict of arrays t, x, y, heading (and optionally z)");
+        throw InputError(
+            "trajectory must be a file path or a dict of arrays t, x, y, heading (and optionally z, pitch, roll)");
     const auto d = obj.cast<pyb::dict>();
     auto column = [&](const char* key) {
         if (!d.contains(key)) return std::vector<double>{};
@@ -33,9 +42,12 @@ std::shared_ptr<const AgentSpec> trajectory_of(const pyb::object& obj) {
     for (const char* key : {"t", "x", "y", "heading"})
         if (!d.contains(key)) throw InputError(std::string("trajectory: the dict lacks '") + key + "'");
     return std::make_shared<TrajectorySpec>(
-        trajectory_steps(column("t"), column("x"), column("y"), column("z"), column("heading"), "trajectory arrays"),
-        "arrays");
+        trajectory_steps(column("t"), column("x"), column("y"), column("z"), column("heading"), "trajectory arrays",
+                         column("pitch"), column("roll")),
+        "arrays", params);
 }
+
+namespace {
 
 // A keyword that must be a dict of a table's keys (flight=, analysis=, bvc=, place=).
 pyb::kwargs dict_argument(const pyb::object& obj, const std::string& key, const std::string& example) {
@@ -56,8 +68,8 @@ std::string text_argument(const pyb::object& obj, const std::string& key, const 
 }
 
 // The keywords run_trial takes besides the protocol's, and their hint for keys of other places.
-const std::vector<std::string> trial_keywords = {"trajectory",      "protocol", "agent", "flight",
-                                                 "authors_choices", "analysis", "bvc",   "place"};
+const std::vector<std::string> trial_keywords = {"trajectory", "protocol", "agent", "flight",       "authors_choices",
+                                                 "analysis",   "bvc",      "place", "step_per_row", "model_dt"};
 
 void check_trial_keywords(const pyb::kwargs& kwargs) {
     for (const auto& [k, v] : kwargs) {
@@ -116,7 +128,11 @@ TrialConfig trial_of(const pyb::object& model, const pyb::object& world, const p
     }
     if (kwargs.contains("trajectory") && !kwargs["trajectory"].is_none()) {
         if (agent) throw InputError("give agent= or trajectory=, not both");
-        t.set_agent(trajectory_of(kwargs["trajectory"]));
+        t.set_agent(trajectory_of(kwargs["trajectory"], kwargs));
+    } else {
+        for (const auto& key : trajectory_keywords())
+            if (kwargs.contains(key.c_str()))
+                throw InputError("run_trial: " + key + "= goes with trajectory= (how a given path steps the model)");
     }
     if (kwargs.contains("authors_choices")) {
         const auto choices = kwargs["authors_choices"];
@@ -142,8 +158,10 @@ TrialConfig trial_of(const pyb::object& model, const pyb::object& world, const p
 pyb::dict outcome_to_dict(const TrialConfig& t, const GroupOutcome& done) {
     pyb::dict out = samples_to_dict(done.result, t.protocol.record_bvc);
     pyb::dict scalars;
-    for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics)) scalars[name.c_str()] = v;
+    if (!t.place_cells_untrained())  // else the metrics of random weights: left out, as in trial files
+        for (const auto& [name, v] : analysis::scalar_metrics(done.trials[0].metrics)) scalars[name.c_str()] = v;
     out["metrics"] = scalars;
+    out["place_weights"] = t.place_weights();
     out["name"] = t.name();
     return out;
 }
@@ -204,8 +222,10 @@ void bind_experiment(pyb::module_& m) {
         (R"doc(One trial at full speed, as `bvc3d run` does it, returned as numpy arrays: t, x, y, z, heading
 (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded, and
 metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset or world YAML;
-tilt_deg: for world="cross" or "cross-webots"; trajectory: a file path or a dict of arrays t, x, y, heading[, z] to
-follow instead of the random walk; agent: the agent by name, )doc" +
+tilt_deg: for world="cross" or "cross-webots"; trajectory: a file path or a dict of arrays t, x, y, heading[, z,
+pitch, roll] to follow instead of the random walk, its rows resampled to model steps model_dt=0.288 s apart
+(positions linearly, headings along the shorter arc) unless they are at that step already (step_per_row=True:
+one model step per row); agent: the agent by name, )doc" +
          agent_names_text() + R"doc(; agent="flight" is the flying agent (docs/flying.md: a fly-* model,
 a world with a flight volume, )doc" +
          protocol_hours_text(protocol_preset(agent_kind("flight").protocol)) +

@@ -39,13 +39,7 @@ std::shared_ptr<const InitialWeights> weights_of(const pyb::object& obj) {
     if (obj.is_none()) return nullptr;
     auto w = std::make_shared<InitialWeights>();
     if (pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__")) {
-        const std::string file = pyb::str(obj);
-        const TrialWeights t = read_trial_weights(file);
-        w->source = file;
-        w->values = t.values;
-        w->n_place = static_cast<int>(t.n_place);
-        w->n_bvc = static_cast<int>(t.n_bvc);
-        return w;
+        return weights_from_trial_file(pyb::str(obj).cast<std::string>());
     }
     const auto a = obj.cast<ArrayF>();
     if (a.ndim() != 2) throw InputError("weights must be a trial file or an (n_place, n_bvc) array");
@@ -244,39 +238,20 @@ void bind_recording(pyb::module_& m) {
         "replay_simulated",
         [](const std::string& world, const pyb::object& trajectory, const pyb::object& sensor, const std::string& model,
            bool learn, const pyb::object& weights, std::uint64_t seed, const pyb::kwargs& kwargs) {
-            std::shared_ptr<const TrajectorySpec> path;
-            if (pyb::isinstance<pyb::str>(trajectory) || pyb::hasattr(trajectory, "__fspath__")) {
-                path = std::make_shared<const TrajectorySpec>(
-                    TrajectorySpec::from_file(pyb::str(trajectory).cast<std::string>()));
-            } else {
-                if (!pyb::isinstance<pyb::dict>(trajectory))
-                    throw InputError(
-                        "trajectory must be a file path or a dict of arrays t, x, y, heading "
-                        "(and optionally z, pitch, roll)");
-                const auto d = trajectory.cast<pyb::dict>();
-                auto column = [&](const char* key) {
-                    if (!d.contains(key)) return std::vector<double>{};
-                    const auto a = real_array(d[key], std::string("trajectory['") + key + "']");
-                    if (a.ndim() > 1) throw InputError(std::string("trajectory['") + key + "'] must be 1-D");
-                    return std::vector<double>(a.data(), a.data() + a.size());
-                };
-                for (const char* key : {"t", "x", "y", "heading"})
-                    if (!d.contains(key)) throw InputError(std::string("trajectory: the dict lacks '") + key + "'");
-                path = std::make_shared<const TrajectorySpec>(
-                    trajectory_steps(column("t"), column("x"), column("y"), column("z"), column("heading"),
-                                     "trajectory arrays", column("pitch"), column("roll")),
-                    "arrays");
-            }
+            const auto path = trajectory_of(trajectory, kwargs);
             const LidarSpec s = pyb::isinstance<pyb::str>(sensor) ? config::resolve_sensor(sensor.cast<std::string>())
                                                                   : sensor.cast<LidarSpec>();
-            return run(simulated_source(WorldSpec{world, std::nullopt, "+x+y"}, path, s, preprocess_of(kwargs, {})),
+            return run(simulated_source(WorldSpec{world, std::nullopt, "+x+y"}, path, s,
+                                        preprocess_of(kwargs, trajectory_keywords())),
                        model, learn, weights, seed);
         },
         pyb::arg("world"), pyb::arg("trajectory"), pyb::arg("sensor"), pyb::arg("model") = "3d-0.2",
         pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(), pyb::arg("seed") = 0,
         R"doc(A simulated sensor along a path in a world, its scans preprocessed as a recording's, through `model`
 (as `bvc3d replay --world --trajectory --sensor`): the dict Recording.replay gives. trajectory: a
-file or a dict of arrays t, x, y, heading[, z, pitch, roll]; sensor: a name, a YAML file or a
+file or a dict of arrays t, x, y, heading[, z, pitch, roll], resampled to the model step (model_dt=0.288 s:
+positions linearly, headings and roll along the shorter arc) unless its rows are at that step already;
+step_per_row=True takes one scan and model step per row instead. sensor: a name, a YAML file or a
 Sensor. Preprocessing keywords as Recording.replay.)doc");
     m.def(
         "localize",

@@ -19,6 +19,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/params.hpp"
@@ -42,6 +43,11 @@ pyb::array_t<T> to_numpy(const T* data, std::vector<pyb::ssize_t> shape) {
 // A run's samples of its first model as arrays: t, x, y, z, heading, rates, weights, and bvc_rates
 // when `with_bvc` (run_trial's and replay's dicts start from this).
 pyb::dict samples_to_dict(const GroupResult& r, bool with_bvc);
+
+// A user's path from a file path or a dict of arrays t, x, y, heading[, z, pitch, roll], its rows made
+// model steps as the keywords of TrajectoryParams among `kwargs` say (step_per_row=, model_dt=).
+std::shared_ptr<const TrajectorySpec> trajectory_of(const pyb::object& obj, const pyb::kwargs& kwargs);
+std::vector<std::string> trajectory_keywords();  // those keywords
 
 // An array of real numbers as float64, C order. Integers and floats convert; complex, object, text
 // and boolean arrays are refused (a cast would drop imaginary parts or invent numbers).

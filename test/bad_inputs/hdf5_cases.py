@@ -219,5 +219,12 @@ def summarize_mixed_analysis(path):
     (folder / path.name).write_bytes(path.read_bytes())
 
 
+@case("replay --world cross --trajectory {dir}/track.csv --sensor spherical --model 3d-0.1 --weights {} "
+      "--out {dir}/out.h5", "weights-of-another-model.h5", "trained by model '3d-0.2'", "bvc.elevations")
+def weights_of_another_model(path):
+    """The good file's weights are 3d-0.2's, 250 × 960 as 3d-0.1's: the shapes agree, the BVCs do not."""
+    (path.parent / "track.csv").write_text("t,x,y,heading\n0,-4,-4,0\n0.288,-3.856,-4,0\n")
+
+
 def cases():
     return CASES

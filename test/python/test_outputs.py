@@ -155,7 +155,8 @@ def test_readme_states_the_decoding_coverage_of_its_trials(source_dir):
 
 
 def test_a_trajectory_off_the_model_step_is_warned_about(tmp_path):
-    """Rows every 0.05 s step the model 5.76 times as often per second as the robot's 0.288 s step."""
+    """Rows every 0.05 s stepped once per row (--step-per-row) step the model 5.76 times as often per
+    second as the robot's 0.288 s step (by default they are resampled: test_trajectory_steps.py)."""
     fast, model = tmp_path / "fast.csv", tmp_path / "model.csv"
     t = np.arange(200) * 0.05
     fast.write_text("t,x,y,heading\n" + "".join(f"{a},{-4 + 0.02 * i},-4,0\n" for i, a in enumerate(t)))
@@ -163,6 +164,6 @@ def test_a_trajectory_off_the_model_step_is_warned_about(tmp_path):
     model.write_text("t,x,y,heading\n" + "".join(f"{a},{-4 + 0.02 * i},-4,0\n" for i, a in enumerate(t)))
     for path, warned in ((fast, True), (model, False)):
         proc = run_cli("run", "--trajectory", path, "--protocol", "online", "--sample-hours", "0.001",
-                       "--out", tmp_path / f"{path.stem}.h5", "--checkpoint-minutes", "0")
+                       "--out", tmp_path / f"{path.stem}.h5", "--checkpoint-minutes", "0", "--step-per-row")
         assert proc.returncode == 0, proc.stderr
         assert ("every 0.05 s" in proc.stderr and "5.76 times as fast" in proc.stderr) == warned, proc.stderr

@@ -73,14 +73,14 @@ def box_walk(side, steps=3000, seed=0):
 def test_metres_that_cannot_work_in_a_small_box_are_warned_about():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        r = bvc3d.run_trial(trajectory=box_walk(1.0), explore_hours=0, sample_hours=0.2)
+        r = bvc3d.run_trial(trajectory=box_walk(1.0), protocol="online", sample_hours=0.2)
     messages = [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
     assert any("d_th = 2 m" in m and "span only" in m and "MSAI mean nothing" in m for m in messages), messages
     assert any("eps = 1 m" in m and "no cell can be multimodal" in m for m in messages), messages
     assert abs(r["metrics"]["msai"]) < 1e-12  # what the warning is about: no pair of bins is compared
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        bvc3d.run_trial(trajectory=box_walk(1.0), analysis=dict(eps=0.1, d_th=0.2), explore_hours=0, sample_hours=0.2)
+        bvc3d.run_trial(trajectory=box_walk(1.0), analysis=dict(eps=0.1, d_th=0.2), protocol="online", sample_hours=0.2)
     assert not [w for w in caught if "span only" in str(w.message)]
 
 

@@ -5,11 +5,13 @@
 #include <hdf5.h>
 #include <sys/resource.h>
 
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/sweep_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
@@ -264,4 +266,40 @@ TEST(Outputs, AFailedAtomicFileRemovesTheFoldersMadeForIt) {
     }
     EXPECT_TRUE(fs::is_regular_file(dir / "a" / "out.csv"));
     fs::remove_all(dir);
+}
+
+// Issue 32: a trajectory's rows resampled to the model step. Two rows 1 s apart: the steps at 0, 0.288,
+// 0.576, 0.864 s lie at fractions 0, 0.288, 0.576, 0.864 of the way; heading and roll cross ±π along the
+// shorter arc (3 rad to −3 rad is 0.283 rad through π), pitch and positions move linearly.
+TEST(TrajectoryResampling, InterpolatesPosesBetweenRows) {
+    const double h0 = 3.0, h1 = -3.0, arc = 2 * std::acos(-1.0) - 6.0;  // from h0 to h1 the short way
+    std::vector<ModelStep> rows(2);
+    rows[0].t = 10.0;
+    rows[0].pose = Pose{0.0, 1.0, 0.5, h0, -0.2, h0};
+    rows[1].t = 11.0;
+    rows[1].pose = Pose{2.0, -1.0, 1.5, h1, 0.4, h1};
+    const auto steps = resample_steps(rows, 0.288, "two rows");
+    ASSERT_EQ(steps.size(), 4u);
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+        const double f = 0.288 * static_cast<double>(k);
+        EXPECT_NEAR(steps[k].t, f, 1e-12);
+        EXPECT_NEAR(steps[k].pose.x, 2 * f, 1e-12);
+        EXPECT_NEAR(steps[k].pose.y, 1 - 2 * f, 1e-12);
+        EXPECT_NEAR(steps[k].pose.z, 0.5 + f, 1e-12);
+        EXPECT_NEAR(steps[k].pose.pitch, -0.2 + 0.6 * f, 1e-12);
+        const double expected = std::remainder(h0 + f * arc, 2 * std::acos(-1.0));
+        EXPECT_NEAR(std::remainder(steps[k].pose.heading - expected, 2 * std::acos(-1.0)), 0, 1e-12);
+        EXPECT_NEAR(std::remainder(steps[k].pose.roll - expected, 2 * std::acos(-1.0)), 0, 1e-12);
+    }
+    EXPECT_FALSE(rows_at_model_step(rows, 0.288));
+    EXPECT_TRUE(rows_at_model_step(rows, 1.0));
+    // Rows at the model step are the steps, unchanged.
+    const TrajectorySpec at_step(steps, "steps", TrajectoryParams{});
+    EXPECT_FALSE(at_step.resampled());
+    const TrajectorySpec off_step(rows, "rows", TrajectoryParams{});
+    EXPECT_TRUE(off_step.resampled());
+    EXPECT_EQ(off_step.steps().size(), 4u);
+    TrajectoryParams per_row;
+    per_row.step_per_row = true;
+    EXPECT_FALSE(TrajectorySpec(rows, "rows", per_row).resampled());
 }

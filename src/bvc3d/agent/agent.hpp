@@ -76,6 +76,9 @@ public:
     // Coordinates of the positions the analysis bins: 2 (x, y) for agents on the floor, 3 (x, y, z)
     // for flying ones.
     virtual int dims() const { return 2; }
+    // What a reader of a run's output must know about how this agent steps the model (a trajectory
+    // resampled to the model step); empty when there is nothing to say.
+    virtual std::string note() const { return {}; }
 };
 
 }  // namespace bvc3d

@@ -1,6 +1,8 @@
 #include "bvc3d/agent/trajectory.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -12,6 +14,60 @@
 #include "bvc3d/core/random.hpp"
 
 namespace bvc3d {
+
+const params::Table<TrajectoryParams>& TrajectoryParams::table() {
+    using namespace params;
+    static const Table<TrajectoryParams> t(
+        "trajectory", {flag("step_per_row", &TrajectoryParams::step_per_row,
+                            "one model step per row, whatever their interval (default: rows resampled to model_dt)"),
+                       real("model_dt", &TrajectoryParams::model_dt, closed(1e-3, 3600),
+                            "s between model steps when the rows are resampled (the robot's model step)")});
+    return t;
+}
+
+double median_row_interval(const std::vector<ModelStep>& rows) {
+    if (rows.size() < 2) return 0.0;
+    std::vector<double> dt(rows.size() - 1);
+    for (std::size_t i = 1; i < rows.size(); ++i) dt[i - 1] = rows[i].t - rows[i - 1].t;
+    const auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
+    std::nth_element(dt.begin(), mid, dt.end());
+    return *mid;
+}
+
+bool rows_at_model_step(const std::vector<ModelStep>& rows, double model_dt) {
+    return rows.size() < 2 || std::abs(median_row_interval(rows) / model_dt - 1) <= 1e-6;
+}
+
+std::vector<ModelStep> resample_steps(const std::vector<ModelStep>& rows, double dt, const std::string& source) {
+    if (rows.empty()) throw InputError(source + ": the trajectory has no rows");
+    const double span = rows.back().t - rows.front().t;
+    // As many steps as the longest random walk takes at the robot's step, and no more.
+    const double limit = max_agent_hours * 3600 / TrajectoryParams{}.model_dt;
+    const double count = std::floor(span / dt + 1e-9) + 1;
+    if (count > limit)
+        throw InputError(source + ": resampled to model steps of " + format_number(dt) + " s, its " +
+                         format_number(span / 3600) + " h would be " + format_number(count) +
+                         " steps, more than the limit of " + format_number(limit) +
+                         " (the longest walk); step once per row (step_per_row) or cut the rows");
+    std::vector<ModelStep> steps(static_cast<std::size_t>(count));
+    std::size_t i = 0;  // the row at or before the step
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+        const double t = rows.front().t + static_cast<double>(k) * dt;
+        while (i + 1 < rows.size() && rows[i + 1].t <= t) ++i;
+        steps[k].t = t - rows.front().t;
+        if (i + 1 == rows.size()) {  // at the last row (within the rounding of k·dt)
+            steps[k].pose = rows.back().pose;
+            continue;
+        }
+        const Pose &a = rows[i].pose, &b = rows[i + 1].pose;
+        const double f = (t - rows[i].t) / (rows[i + 1].t - rows[i].t);
+        const auto line = [f](double u, double v) { return u + f * (v - u); };
+        const auto arc = [f](double u, double v) { return wrap_pi(u + f * wrap_pi(v - u)); };
+        steps[k].pose = Pose{line(a.x, b.x),         line(a.y, b.y),     line(a.z, b.z), arc(a.heading, b.heading),
+                             line(a.pitch, b.pitch), arc(a.roll, b.roll)};
+    }
+    return steps;
+}
 
 Trajectory::Trajectory(std::shared_ptr<const std::vector<ModelStep>> steps) : steps_(std::move(steps)) {}
 
@@ -204,7 +260,8 @@ std::uint64_t hash_steps(const std::vector<ModelStep>& steps) {
 }  // namespace
 
 TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source, int dims)
-    : steps_(std::make_shared<const std::vector<ModelStep>>(std::move(steps))),
+    : rows_(std::make_shared<const std::vector<ModelStep>>(std::move(steps))),
+      steps_(rows_),
       source_(std::move(source)),
       hash_(hash_steps(*steps_)),
       dims_(dims) {
@@ -212,18 +269,64 @@ TrajectorySpec::TrajectorySpec(std::vector<ModelStep> steps, std::string source,
         throw InputError("a trajectory's positions are analyzed in 2 or 3 dimensions, not " + std::to_string(dims));
 }
 
-TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path) {
-    TrajectorySpec spec(read_trajectory_file(path), path.string());
+TrajectorySpec::TrajectorySpec(std::vector<ModelStep> rows, std::string source, const TrajectoryParams& params)
+    : rows_(std::make_shared<const std::vector<ModelStep>>(std::move(rows))),
+      source_(std::move(source)),
+      params_(params),
+      user_(true) {
+    try {
+        params_.validate();
+    } catch (const params::ParamError& e) {
+        throw InputError("trajectory '" + source_ + "': " + e.what());
+    }
+    steps_ = params_.step_per_row || rows_at_model_step(*rows_, params_.model_dt)
+                 ? rows_
+                 : std::make_shared<const std::vector<ModelStep>>(
+                       resample_steps(*rows_, params_.model_dt, "trajectory '" + source_ + "'"));
+    hash_ = hash_steps(*steps_);
+}
+
+TrajectorySpec TrajectorySpec::from_file(const std::filesystem::path& path, const TrajectoryParams& params) {
+    TrajectorySpec spec(read_trajectory_file(path), path.string(), params);
     spec.file_ = std::filesystem::absolute(path);
     return spec;
+}
+
+namespace {
+
+std::string three_digits(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", v);
+    return text;
+}
+
+}  // namespace
+
+std::string TrajectorySpec::note() const {
+    if (!user_ || rows_at_model_step(*rows_, params_.model_dt)) return {};
+    const std::string rows = "trajectory '" + source_ + "': " + std::to_string(rows_->size()) + " rows every " +
+                             three_digits(median_row_interval(*rows_)) + " s (median), ";
+    if (resampled())
+        return rows + "resampled to " + std::to_string(steps_->size()) + " model steps of " +
+               format_number(params_.model_dt) +
+               " s (positions linearly, headings along the shorter arc); step_per_row steps once per row";
+    return rows + "one model step per row (step_per_row): the place cells' time constant and Oja's rate are per " +
+           "step, so their dynamics run " + three_digits(params_.model_dt / median_row_interval(*rows_)) +
+           " times as fast per second as at the model step of " + format_number(params_.model_dt) + " s";
 }
 
 void TrajectorySpec::write_yaml(params::CommentedYaml& out) const {
     if (file_.empty())
         throw InputError("trajectory '" + source_ +
                          "' was given as arrays: write it to a file to describe the trial in YAML");
-    out.line("", "trajectory", params::CommentedYaml::scalar(file_.string()),
-             "a given path instead of the random walk: a file of t, x, y, [z], heading rows");
+    const char* doc = "a given path instead of the random walk: a file of t, x, y, [z], heading rows";
+    if (params_ == TrajectoryParams{}) {
+        out.line("", "trajectory", params::CommentedYaml::scalar(file_.string()), doc);
+        return;
+    }
+    out.section("", "trajectory", doc);
+    out.line("  ", "file", params::CommentedYaml::scalar(file_.string()), "t, x, y, [z], heading rows");
+    out.fields(TrajectoryParams::table(), params_, "  ");
 }
 
 std::unique_ptr<Agent> TrajectorySpec::make(const World* world, std::uint64_t) const {
@@ -232,9 +335,9 @@ std::unique_ptr<Agent> TrajectorySpec::make(const World* world, std::uint64_t) c
 }
 
 void TrajectorySpec::check_world(const WorldDescription& world) const {
-    const Eigen::AlignedBox3d box = world.bounds();  // triangles and point clouds
-    for (std::size_t i = 0; i < steps_->size(); ++i) {
-        const Pose& p = (*steps_)[i].pose;
+    const Eigen::AlignedBox3d box = world.bounds();    // triangles and point clouds
+    for (std::size_t i = 0; i < rows_->size(); ++i) {  // resampled steps lie between rows, inside the box too
+        const Pose& p = (*rows_)[i].pose;
         if (!box.contains(p.position()))
             throw InputError("trajectory '" + source_ + "', row " + std::to_string(i) + ": (" + format_number(p.x) +
                              ", " + format_number(p.y) + ", " + format_number(p.z) + ") lies outside world '" +
@@ -245,8 +348,11 @@ void TrajectorySpec::check_world(const WorldDescription& world) const {
 std::string TrajectorySpec::key() const {
     std::ostringstream os;
     os << "trajectory:\n  source: " << std::filesystem::path(source_).filename().string()
-       << "\n  rows: " << steps_->size() << "\n  hash: " << std::hex << hash_ << "\n";
+       << "\n  rows: " << rows_->size() << "\n  hash: " << std::hex << hash_ << "\n";
     if (dims_ == 3) os << "  dims: 3\n";  // 2-D keys stay as they were
+    if (resampled())                      // paths stepped once per row keep the keys they always had
+        os << "  resampled_to: " << format_number(params_.model_dt) << "\n  steps: " << std::dec << steps_->size()
+           << "\n";
     return os.str();
 }
 

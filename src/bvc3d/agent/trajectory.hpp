@@ -1,8 +1,8 @@
 #pragma once
 // A given path as the agent: model steps at given times and poses, e.g. a real robot's or animal's
 // track, in place of the random walk (docs/experiments.md#user-trajectories).
-// Takes: rows (t, x, y, [z], heading, [pitch, roll]), from arrays or a text file. Gives: one model
-// step per row.
+// Takes: rows (t, x, y, [z], heading, [pitch, roll]), from arrays or a text file. Gives: model steps:
+// the rows resampled to the model step (0.288 s, the robot's), or one per row (`step_per_row`).
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -11,6 +11,30 @@
 #include "bvc3d/agent/agent.hpp"
 
 namespace bvc3d {
+
+// How a user's rows become model steps. The place cells' time constant and Oja's rate are per model
+// step, so rows every 0.01 s would run the dynamics 29 times as fast per second as the paper's step:
+// by default the rows are resampled to steps `model_dt` apart (resample_steps()), unless they are at
+// that step already (rows_at_model_step(): then they are the steps, bit for bit).
+struct TrajectoryParams {
+    bool step_per_row = false;  // one model step per row, whatever their interval (as before issue 32)
+    double model_dt = 0.288;    // s between model steps when the rows are resampled (the robot's step)
+
+    static const params::Table<TrajectoryParams>& table();
+    void validate() const { table().check(*this); }
+    bool operator==(const TrajectoryParams&) const = default;
+};
+
+// Whether rows are model steps already: their median interval is `model_dt` within 1e-6 (relative),
+// as `bvc3d walk` and `bvc3d route` write them (turns in place add time between rows, a bump
+// shortens a step; such intervals are kept as they are). Fewer than 2 rows: yes.
+bool rows_at_model_step(const std::vector<ModelStep>& rows, double model_dt);
+// The median interval between rows (0 for fewer than 2).
+double median_row_interval(const std::vector<ModelStep>& rows);
+// Steps at t = 0, dt, 2·dt, ... up to the last row's time, each pose interpolated between the rows
+// around it: x, y, z and pitch linearly, heading and roll along the shorter arc. `source` names the
+// rows when the span is refused (more than max_agent_hours).
+std::vector<ModelStep> resample_steps(const std::vector<ModelStep>& rows, double dt, const std::string& source);
 
 // The rows' times are shifted so that the first row is at t = 0; they must increase strictly.
 // Positions are in the world frame (z: the agent's base above the floor, 0 if not given); headings
@@ -51,12 +75,20 @@ void write_trajectory_file(const std::filesystem::path& path, const std::vector<
 // A trajectory as a trial's agent: from a file (its name and contents fix the key) or from arrays.
 class TrajectorySpec : public AgentSpec {
 public:
-    static TrajectorySpec from_file(const std::filesystem::path& path);
+    // A user's path: its rows made model steps as `params` says (resampled by default).
+    static TrajectorySpec from_file(const std::filesystem::path& path, const TrajectoryParams& params = {});
+    TrajectorySpec(std::vector<ModelStep> rows, std::string source, const TrajectoryParams& params);
+    // Steps as they are, one per row (a recording's scans, a walk the program made).
     // dims 3: positions are analyzed in 3-D (voxels), as a flying agent's; 2 (the default): in the plane.
     TrajectorySpec(std::vector<ModelStep> steps, std::string source, int dims = 2);
 
     const std::string& source() const { return source_; }
     const std::vector<ModelStep>& steps() const { return *steps_; }
+    const std::vector<ModelStep>& rows() const { return *rows_; }  // as given (the steps unless resampled)
+    bool resampled() const { return steps_ != rows_; }
+    const TrajectoryParams& params() const { return params_; }
+    // "N rows every X s (median), resampled to M model steps of 0.288 s", or how they are stepped per row.
+    std::string note() const override;
     std::string kind() const override { return "trajectory"; }
     Locomotion locomotion() const override { return Locomotion::given_path; }
     int dims() const override { return dims_; }
@@ -71,8 +103,10 @@ public:
     void write_yaml(params::CommentedYaml& out) const override;
 
 private:
-    std::shared_ptr<const std::vector<ModelStep>> steps_;
+    std::shared_ptr<const std::vector<ModelStep>> rows_, steps_;
     std::string source_;
+    TrajectoryParams params_;
+    bool user_ = false;           // a user's path (its steps follow params_), not steps as they are
     std::uint64_t hash_ = 0;      // of the rows, for the key
     std::filesystem::path file_;  // the file it was read from (absolute), empty for arrays
     int dims_ = 2;

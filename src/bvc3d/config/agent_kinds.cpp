@@ -27,13 +27,17 @@ const std::vector<AgentKind>& agent_kinds() {
          "paper",
          nullptr,
          [](const config::YamlView& v) -> std::shared_ptr<const AgentSpec> {
+             // `trajectory: FILE`, or a mapping: `file: FILE` and the keys of TrajectoryParams.
+             TrajectoryParams params;
+             const config::YamlView file = v.is_map() ? v["file"] : v;
+             if (v.is_map()) config::read_table(v, params, TrajectoryParams::table(), {"file"});
              try {
                  return std::make_shared<TrajectorySpec>(
-                     TrajectorySpec::from_file(config::path_in_file(v, v.as_string())));
+                     TrajectorySpec::from_file(config::path_in_file(file, file.as_string()), params));
              } catch (const ConfigError&) {
                  throw;
              } catch (const InputError& e) {
-                 v.fail(e.what());
+                 file.fail(e.what());
              }
          }},
         {"flight",

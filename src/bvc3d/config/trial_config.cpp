@@ -1,5 +1,6 @@
 #include "bvc3d/config/trial_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
 
 namespace bvc3d {
 
@@ -109,6 +111,52 @@ std::string InitialWeights::key() const {
     return os.str();
 }
 
+std::shared_ptr<const InitialWeights> weights_from_trial_file(const std::filesystem::path& path) {
+    TrialWeights w = read_trial_weights(path);
+    auto out = std::make_shared<InitialWeights>();
+    out->source = path.string();
+    out->values = std::move(w.values);
+    out->n_place = static_cast<int>(w.n_place);
+    out->n_bvc = static_cast<int>(w.n_bvc);
+    out->model = std::move(w.model);
+    out->model_config = std::move(w.model_config);
+    return out;
+}
+
+namespace {
+
+// The `bvc:` block of a model's canonical text as (key, value) lines, in order.
+std::vector<std::pair<std::string, std::string>> bvc_keys(const std::string& model_text) {
+    std::vector<std::pair<std::string, std::string>> keys;
+    std::istringstream in(model_text);
+    bool inside = false;
+    for (std::string line; std::getline(in, line);) {
+        if (line == "bvc:") {
+            inside = true;
+        } else if (inside && line.rfind("  ", 0) == 0) {
+            const auto colon = line.find(':');
+            if (colon != std::string::npos)
+                keys.emplace_back(line.substr(2, colon - 2), colon + 2 <= line.size() ? line.substr(colon + 2) : "");
+        } else if (inside) {
+            break;
+        }
+    }
+    return keys;
+}
+
+}  // namespace
+
+std::string weights_model_mismatch(const std::string& trained, const ModelSpec& model) {
+    const auto theirs = bvc_keys(trained), ours = bvc_keys(config::model_to_yaml(model));
+    if (theirs.empty()) return "";  // not a model's text: nothing to compare
+    for (const auto& [key, value] : ours) {
+        const auto it = std::find_if(theirs.begin(), theirs.end(), [&](const auto& kv) { return kv.first == key; });
+        const std::string was = it == theirs.end() ? "(absent)" : it->second;
+        if (was != value) return "bvc." + key + " is " + was + " in the model that trained them, " + value + " here";
+    }
+    return "";
+}
+
 void TrialConfig::validate() const {
     model.validate();
     protocol.validate();
@@ -137,6 +185,10 @@ void TrialConfig::validate() const {
         throw InputError("weights from '" + weights->source + "' are " + std::to_string(weights->n_place) + " × " +
                          std::to_string(weights->n_bvc) + "; model '" + model.name + "' needs " +
                          std::to_string(model.place.n_place) + " × " + std::to_string(model.bvc.n_cells()));
+    if (weights && !weights->model_config.empty())
+        if (const std::string why = weights_model_mismatch(weights->model_config, model); !why.empty())
+            throw InputError("weights from '" + weights->source + "' were trained by model '" + weights->model +
+                             "', whose BVCs are not model '" + model.name + "''s: " + why);
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
     if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
         Protocol::table().fail("sample_hours",
@@ -200,6 +252,15 @@ analysis::AnalysisParams TrialConfig::analysis_params(const WorldDescription& w)
         params.extent = analysis::Extent{box.min().x(), box.max().x(), box.min().y(), box.max().y()};
     }
     return params;
+}
+
+bool TrialConfig::place_cells_untrained() const {
+    return !weights && protocol.kind == Protocol::Kind::explore_then_sample && !(protocol.explore_hours > 0);
+}
+
+std::string TrialConfig::place_weights() const {
+    if (protocol.kind == Protocol::Kind::online || protocol.explore_hours > 0) return "learned";
+    return weights ? "trained" : "untrained";
 }
 
 std::string TrialConfig::fingerprint() const {

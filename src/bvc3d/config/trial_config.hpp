@@ -4,6 +4,7 @@
 // recording (docs/recordings.md) is a trial with no world, the recording's path as its agent and
 // its scans as the returns.
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -50,8 +51,18 @@ struct InitialWeights {
     std::string source;         // where they came from (a file name), for trial files
     std::vector<float> values;  // n_place × n_bvc, row-major
     int n_place = 0, n_bvc = 0;
+    // The model that trained them (name, canonical text) when known: a model whose BVCs differ is
+    // refused (TrialConfig::validate), even when the shapes agree.
+    std::string model, model_config;
     std::string key() const;  // the source and a hash of the values
 };
+
+// The trained weights of a trial file with the model that trained them (InputError naming the file).
+std::shared_ptr<const InitialWeights> weights_from_trial_file(const std::filesystem::path& path);
+// Why weights trained by a model of canonical text `trained` cannot be loaded into `model`: the first
+// BVC key that differs (the BVCs are what the weights' columns mean), or "" when they agree. The
+// sensor and the place cells' dynamics may differ (a trained network on a real sensor's scans).
+std::string weights_model_mismatch(const std::string& trained, const ModelSpec& model);
 
 struct TrialConfig {
     WorldSpec world;
@@ -88,6 +99,11 @@ struct TrialConfig {
     // with equal keys can share one agent.
     std::string walk_key() const;
     // Everything that determines the trial's results, as text: equal text, equal results.
+    // The place cells never learn and start from the seed's random draw (a frozen replay without
+    // weights, `explore_hours 0` without weights): their metrics would mean nothing (not written).
+    bool place_cells_untrained() const;
+    // "learned", "trained" or "untrained" (TrialIdentity::place_weights).
+    std::string place_weights() const;
     std::string canonical() const;
     std::string fingerprint() const;  // a short hash of canonical()
     // The trial's analysis parameters, with the walkable region's bounds as the extent when

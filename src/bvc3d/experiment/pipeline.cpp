@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "bvc3d/analysis/metrics.hpp"
+#include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recorder/checkpoint_file.hpp"
 
@@ -85,8 +86,10 @@ GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std
         std::vector<std::pair<std::string, MetricsRecord>> populations;
         for (const auto& [name, p] : out.trials[k].populations)
             populations.emplace_back(name, metrics_record(p.metrics, p.params));
-        write_trial_file(paths[k], trial_identity(trials[k], world), out.result, k,
-                         metrics_record(out.trials[k].metrics, out.trials[k].params), populations);
+        write_trial_file(
+            paths[k], trial_identity(trials[k], world), out.result, k,
+            metrics_record(out.trials[k].metrics, out.trials[k].params, !trials[k].place_cells_untrained()),
+            populations);
     }
     if (!control.checkpoint.empty()) remove_checkpoint(control.checkpoint);
     return out;
@@ -102,6 +105,9 @@ TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world
     if (t.returns) id.data_source = t.returns->attributes();
     id.tilt_deg = world.tilt_deg.value_or(NAN);
     id.model = t.model.name;
+    id.model_config = config::model_to_yaml(t.model);
+    id.place_weights = t.place_weights();
+    if (t.weights) id.place_weights_source = t.weights->source;
     id.sensor = t.returns ? t.returns->sensor_label() : t.model.sensor.name;
     id.seed = t.seed;
     id.protocol = protocol_name(t.protocol.kind);
@@ -113,9 +119,9 @@ TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world
     return id;
 }
 
-MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& p) {
+MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& p, bool scalars) {
     MetricsRecord r;
-    r.scalars = analysis::scalar_metrics(m);
+    if (scalars) r.scalars = analysis::scalar_metrics(m);
     // How they were computed, so that `bvc3d analyze` starts from the same parameters (keys quiet at
     // their defaults only when set, as in canonical text: files read back without them get the default).
     static const analysis::AnalysisParams defaults;
@@ -210,6 +216,7 @@ analysis::Extent arena_extent(const TrialFileData& file, const std::filesystem::
 bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t) {
     const auto stamp = read_trial_stamp(path);
     if (!stamp || stamp->fingerprint != t.fingerprint()) return false;
+    if (t.place_cells_untrained()) return true;  // no metrics written
     for (const auto& name : analysis::metric_names(t.agent->dims()))
         if (std::find(stamp->metric_attributes.begin(), stamp->metric_attributes.end(), name) ==
             stamp->metric_attributes.end())

@@ -40,7 +40,9 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
 
 // What a trial file records of a trial: its identity and configuration, and its metrics.
 TrialIdentity trial_identity(const TrialConfig& t, const WorldDescription& world);
-MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& params);
+// `scalars` false: the scalar metrics are left out (untrained place cells: TrialConfig::place_cells_untrained).
+MetricsRecord metrics_record(const analysis::TrialMetrics& m, const analysis::AnalysisParams& params,
+                             bool scalars = true);
 // The analysis parameters a trial file's metrics were computed with (defaults for what it lacks);
 // a stored value of the wrong type or out of its limits is an InputError naming `path` and the key.
 analysis::AnalysisParams stored_analysis_params(const TrialFileData& file, const std::filesystem::path& path);

@@ -32,6 +32,8 @@ void write_identity(hid_t f, const TrialIdentity& id) {
     h5::write_attr(f, "sample_hours", id.sample_hours);
     h5::write_attr(f, "config", id.config);
     h5::write_attr(f, "fingerprint", id.fingerprint);
+    if (!id.place_weights.empty()) h5::write_attr(f, "place_weights", id.place_weights);
+    if (!id.place_weights_source.empty()) h5::write_attr(f, "place_weights_source", id.place_weights_source);
     for (const auto& [name, value] : id.data_source) h5::write_attr(f, name, value);
 }
 
@@ -86,6 +88,11 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         if (!rec.bvc.empty()) h5::write(s, "bvc_rates", rec.bvc, {n, static_cast<std::size_t>(rec.n_bvc)});
         h5::write(f, "weights", rec.weights,
                   {static_cast<std::size_t>(rec.n_place), static_cast<std::size_t>(rec.n_bvc)});
+        if (!id.model_config.empty()) {
+            const h5::Handle weights(H5Dopen2(f, "weights", H5P_DEFAULT), H5Dclose);
+            h5::write_attr(weights, "model", id.model);
+            h5::write_attr(weights, "model_config", id.model_config);
+        }
 
         const auto w = h5::create_group(f, "walk");
         h5::write_attr(w, "explore_steps", group.stats.explore_steps);
@@ -248,6 +255,8 @@ TrialIdentity read_identity(const TrialReader& r) {
     id.protocol = r.text(f, "/", "protocol", false);
     id.config = r.text(f, "/", "config", false);
     id.fingerprint = r.text(f, "/", "fingerprint", false);
+    id.place_weights = r.text(f, "/", "place_weights", false);
+    id.place_weights_source = r.text(f, "/", "place_weights_source", false);
     id.explore_hours = r.number(f, "/", "explore_hours");
     id.sample_hours = r.number(f, "/", "sample_hours");
     // Where a replay's returns came from (as write_identity writes data_source).
@@ -343,6 +352,13 @@ TrialWeights read_trial_weights(const std::filesystem::path& path) {
     w.values = r.finite<float>(r.file(), "/", "weights", dims[1]);
     w.n_place = dims[0];
     w.n_bvc = dims[1];
+    const h5::Handle weights(H5Dopen2(r.file(), "weights", H5P_DEFAULT), H5Dclose);
+    for (auto [name, text] : {std::pair{"model", &w.model}, std::pair{"model_config", &w.model_config}}) {
+        if (!h5::exists_attr(weights, name)) continue;
+        if (h5::attr_class(weights, name) != H5T_STRING)
+            r.fail(std::string(": attribute '/weights/") + name + "' is not text");
+        *text = h5::read_attr_string(weights, name);
+    }
     return w;
 }
 

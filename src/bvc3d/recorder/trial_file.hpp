@@ -29,6 +29,14 @@ inline int trial_file_version_for(int dims) {
 // Which trial a file holds and how it was configured (the root attributes).
 struct TrialIdentity {
     std::string name, condition, world, world_source, model, sensor, protocol, config, fingerprint;
+    // The model's canonical text (config/model_yaml.hpp), recorded with the weights it trained, so
+    // that loading them into another model is refused (an empty text records nothing).
+    std::string model_config;
+    // What the place cells' weights are (attribute `place_weights`; "" in older files): "learned" (Oja's
+    // rule ran in the trial), "trained" (frozen, from `place_weights_source`, a trial file or an array)
+    // or "untrained" (frozen at the seed's random draw: the place-cell metrics would mean nothing and
+    // are not written).
+    std::string place_weights, place_weights_source;
     std::vector<std::pair<std::string, std::string>> swept;  // the condition's defining values
     std::uint64_t seed = 0;
     double tilt_deg = NAN;  // cross arenas only
@@ -93,10 +101,13 @@ struct TrialRates {
 };
 TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc);
 
-// The trained weights (n_place × n_bvc, row-major) of a trial file.
+// The trained weights (n_place × n_bvc, row-major) of a trial file, and the model that trained them
+// (its name and canonical text, attributes `model` and `model_config` of /weights; empty in files
+// written before bvc3d recorded them).
 struct TrialWeights {
     std::vector<float> values;
     std::size_t n_place = 0, n_bvc = 0;
+    std::string model, model_config;
 };
 TrialWeights read_trial_weights(const std::filesystem::path& path);
 // Any dataset of a trial file by its path inside the file ("samples/heading", "metrics/sai",
