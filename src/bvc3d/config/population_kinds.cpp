@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <memory>
 
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/population/bvc_population.hpp"
+#include "bvc3d/population/place_population.hpp"
+
 namespace bvc3d::config {
 
 namespace {
@@ -44,6 +48,40 @@ PopulationSpec grid_spec(const std::string& name, const GridParams& p) {
     return s;
 }
 
+PopulationSpec bvc_layer_spec(const std::string& name, const BvcParams& p) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "bvc";
+    s.key = key_of(s.kind, p);
+    s.recorded = false;  // a BVC layer's rates are many; `recorded: true` keeps them
+    s.make = [p](const PopulationContext& c) -> std::unique_ptr<Population> {
+        if (!c.bvc_group) throw InputError("a BVC layer needs the model's source of returns");
+        return std::make_unique<BvcPopulation>(c.bvc_group, c.bvc_group->add(p));
+    };
+    return s;
+}
+
+PopulationSpec grid_place_spec(const std::string& name, const PlaceParams& p, std::vector<std::string> inputs) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "place";
+    s.inputs = std::move(inputs);
+    s.key = key_of(s.kind, p);
+    // FNV-1a of the name: the networks of one trial draw different weights and masks.
+    std::uint64_t tag = 14695981039346656037ull;
+    for (unsigned char ch : name) tag = (tag ^ ch) * 1099511628211ull;
+    s.make = [p, tag](const PopulationContext& c) -> std::unique_ptr<Population> {
+        if (c.input_sizes.size() != 2) throw InputError("place cells read a BVC and a grid population");
+        if (static_cast<double>(p.n_place) * static_cast<double>(c.input_sizes[0] + c.input_sizes[1]) > 1e9)
+            throw InputError("n_place × (BVCs + grid cells) is more than 1e9 weights (4 GB)");
+        return std::make_unique<PlacePopulation>(static_cast<int>(c.input_sizes[0]), p, hash_u64(c.seed, tag, 0),
+                                                 static_cast<int>(c.input_sizes[1]));
+    };
+    return s;
+}
+
 const std::vector<PopulationKind>& population_kinds() {
     static const std::vector<PopulationKind> kinds = {
         {"head-direction", "head-direction cells: cos(θ − θ_k), or the icosahedron's 20 for flying",
@@ -59,6 +97,20 @@ const std::vector<PopulationKind>& population_kinds() {
              GridParams p;
              read_table(v, p, GridParams::table(), item_keys);
              return grid_spec(name, p);
+         }},
+        {"bvc", "a further BVC layer on the model's sensor (a scale of a multiscale model); not recorded by default",
+         keys_of<BvcParams>(), 0,
+         [](const YamlView& v, const std::string& name, std::vector<std::string>) {
+             BvcParams p;
+             read_table(v, p, BvcParams::table(), item_keys);
+             return bvc_layer_spec(name, p);
+         }},
+        {"place", "place cells fed by BVCs and grid cells (inputs: [a BVC population, a grid population])",
+         keys_of<PlaceParams>(), 2,
+         [](const YamlView& v, const std::string& name, std::vector<std::string> inputs) {
+             PlaceParams p;
+             read_table(v, p, PlaceParams::table(), item_keys);
+             return grid_place_spec(name, p, std::move(inputs));
          }},
     };
     return kinds;
@@ -153,7 +205,7 @@ std::vector<PopulationSpec> populations_from_yaml(const YamlView& v) {
                       std::to_string(inputs[i].size()));
         specs[i] = k->read(item, names[i], inputs[i]);
         specs[i].inputs = inputs[i];
-        specs[i].recorded = item.get_bool("recorded", true);
+        specs[i].recorded = item.get_bool("recorded", specs[i].recorded);
     }
     // In an order where each reads only those before it (file order among the free).
     std::vector<PopulationSpec> ordered;
