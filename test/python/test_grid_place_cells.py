@@ -133,3 +133,14 @@ def test_a_multiscale_trial_records_and_analyses_each_scale_and_the_fusion(cli, 
         assert "rates" not in pops["place-fused"]
         # The scales draw their own weights and masks (seed hashed with the name).
         assert not np.array_equal(f["weights"][:1000, :400], pops["place-m/weights"][:])
+
+
+def test_run_trial_gives_each_scale_and_the_fusion():
+    r = bvc3d.run_trial(model="ms-2d", explore_hours=0.03, sample_hours=0.03, seed=2)
+    n = r["x"].shape[0]
+    assert r["rates"].shape == (n, 2000)
+    pops = r["populations"]
+    assert pops["place-m"]["rates"].shape == (n, 1000) and pops["place-l"]["rates"].shape == (n, 500)
+    assert "rates" not in pops["grid-s"]
+    for name in ("place-m", "place-l", "place-fused"):
+        assert np.isfinite(pops[name]["metrics"]["decode_median_m"]), name
