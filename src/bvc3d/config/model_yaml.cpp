@@ -82,6 +82,20 @@ void write_model(params::CommentedYaml& out, const ModelSpec& m, const std::stri
     out.fields(BvcParams::table(), m.bvc, indent + "  ");
     out.section(indent, "place", "the place-cell network");
     out.fields(PlaceParams::table(), m.place, indent + "  ");
+    if (!m.populations.empty()) {  // each with its parameters as its canonical key (which the reader takes)
+        std::string items;
+        for (const PopulationSpec& p : m.populations) {
+            items += (items.empty() ? "" : ", ") + std::string("{name: ") + params::CommentedYaml::scalar(p.name) +
+                     ", kind: " + p.kind + ", inputs: [";
+            for (std::size_t i = 0; i < p.inputs.size(); ++i) items += (i ? ", " : "") + p.inputs[i];
+            items += "], recorded: " + std::string(p.recorded ? "true" : "false") + ", key: \"" + p.key +
+                     "\"}";  // quoted: in a flow mapping, its brackets and commas
+        }
+        out.line(indent, "populations", "[" + items + "]", "further populations (docs/model-reference.md)");
+    }
+    if (!m.place_grid.empty())
+        out.line(indent, "place_grid", params::CommentedYaml::scalar(m.place_grid),
+                 "the grid population the place cells also read");
 }
 
 std::string model_to_commented_yaml(const ModelSpec& m) {

@@ -150,6 +150,27 @@ std::string cycle_through(std::size_t start, const std::vector<std::vector<std::
     return text + names[start];
 }
 
+// A population's parameters from its canonical key (`kind k1=v1 k2=[a, b]`, as a model's canonical text and
+// `bvc3d config` write it), as a YAML mapping the kind reads.
+YamlView parameters_of_key(const YamlView& key, const std::string& kind) {
+    const std::string text = key.as_string();
+    std::vector<std::string> tokens(1);
+    int depth = 0;
+    for (char ch : text) {
+        depth += (ch == '[') - (ch == ']');
+        if (ch == ' ' && depth == 0) tokens.emplace_back();
+        else tokens.back() += ch;
+    }
+    if (tokens.front() != kind) key.fail("is the key of a '" + tokens.front() + "', not of a '" + kind + "'");
+    std::string yaml = "{";
+    for (std::size_t i = 1; i < tokens.size(); ++i) {
+        const auto eq = tokens[i].find('=');
+        if (eq == std::string::npos) key.fail("'" + tokens[i] + "' is not key=value");
+        yaml += (i > 1 ? ", " : "") + tokens[i].substr(0, eq) + ": " + tokens[i].substr(eq + 1);
+    }
+    return YamlView::load_string(yaml + "}", key.file() + ": " + text);
+}
+
 }  // namespace
 
 std::vector<PopulationSpec> populations_from_yaml(const YamlView& v) {
@@ -203,7 +224,9 @@ std::vector<PopulationSpec> populations_from_yaml(const YamlView& v) {
             (item.has("inputs") ? item["inputs"] : item)
                 .fail(kind + " reads " + std::to_string(k->n_inputs) + " population(s), got " +
                       std::to_string(inputs[i].size()));
-        specs[i] = k->read(item, names[i], inputs[i]);
+        // Parameters as keys of the item, or (a model's canonical text read back) as its canonical key.
+        specs[i] = item.has("key") ? k->read(parameters_of_key(item["key"], kind), names[i], inputs[i])
+                                   : k->read(item, names[i], inputs[i]);
         specs[i].inputs = inputs[i];
         specs[i].recorded = item.get_bool("recorded", specs[i].recorded);
     }
