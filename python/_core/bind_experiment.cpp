@@ -163,6 +163,22 @@ pyb::dict outcome_to_dict(const TrialConfig& t, const GroupOutcome& done) {
     out["metrics"] = scalars;
     out["place_weights"] = t.place_weights();
     out["name"] = t.name();
+    // Every other population: its recorded rates and, when analysed, its metrics (a multiscale model's scales and
+    // their fusion, place-fused, which has metrics only).
+    pyb::dict populations;
+    const auto n = static_cast<pyb::ssize_t>(done.result.t.size());
+    for (const PopulationRecord& p : done.result.models[0].populations) {
+        pyb::dict d;
+        if (p.recorded) d["rates"] = to_numpy(p.rates.data(), {n, static_cast<pyb::ssize_t>(p.cells)});
+        populations[p.name.c_str()] = d;
+    }
+    for (const auto& [name, analysed] : done.trials[0].populations) {
+        pyb::dict metrics;
+        for (const auto& [key, v] : analysis::scalar_metrics(analysed.metrics)) metrics[key.c_str()] = v;
+        if (!populations.contains(name.c_str())) populations[name.c_str()] = pyb::dict();
+        populations[name.c_str()].cast<pyb::dict>()["metrics"] = metrics;
+    }
+    out["populations"] = populations;
     return out;
 }
 

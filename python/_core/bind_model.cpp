@@ -81,26 +81,42 @@ Keyword arguments and their defaults (the `3d-0.2` model's layer):
 void bind_network(pyb::module_& m) {
     auto cls = pyb::class_<PlaceCellNetwork>(m, "PlaceCellNetwork",
                                              (R"doc(
-Place cells driven by BVCs, with Oja learning (docs/model-reference.md#place-cell-network).
-PlaceCellNetwork(n_bvc, seed=0, **params); params and their defaults:
+Place cells driven by BVCs, with Oja learning (docs/model-reference.md#place-cell-network), and optionally by grid
+cells too (n_grid > 0, grid_influence g: docs/model-reference.md#place-cells-fed-by-grid-cells).
+PlaceCellNetwork(n_bvc, seed=0, n_grid=0, **params); params and their defaults:
 )doc" + describe(PlaceParams::table(), PlaceParams{}))
                                                  .c_str());
-    cls.def(pyb::init([](int n_bvc, const pyb::object& seed, const pyb::kwargs& kwargs) {
+    cls.def(pyb::init([](int n_bvc, const pyb::object& seed, int n_grid, const pyb::kwargs& kwargs) {
                 PlaceParams p;
                 apply_kwargs(p, PlaceParams::table(), kwargs);
-                return PlaceCellNetwork(n_bvc, p, seed_of(seed, "seed"));
+                return PlaceCellNetwork(n_bvc, p, seed_of(seed, "seed"), n_grid);
             }),
-            pyb::arg("n_bvc"), pyb::arg("seed") = 0)
+            pyb::arg("n_bvc"), pyb::arg("seed") = 0, pyb::arg("n_grid") = 0)
         .def(
             "step",
-            [](PlaceCellNetwork& net, const pyb::object& obj, bool learn) {
+            [](PlaceCellNetwork& net, const pyb::object& obj, bool learn, const pyb::object& grid_obj) {
                 const ArrayD bvc_rates = real_array(obj, "bvc_rates");
                 if (bvc_rates.ndim() != 1) throw InputError("bvc_rates must be a 1-D array");
                 const std::span<const double> in(bvc_rates.data(), static_cast<std::size_t>(bvc_rates.shape(0)));
-                const auto out = net.step(in, learn);
+                if (grid_obj.is_none() && net.n_grid() > 0)
+                    throw InputError("grid_rates: this network reads " + std::to_string(net.n_grid()) + " grid cells");
+                const ArrayD grid_rates = grid_obj.is_none() ? ArrayD() : real_array(grid_obj, "grid_rates");
+                if (!grid_obj.is_none() && grid_rates.ndim() != 1) throw InputError("grid_rates must be a 1-D array");
+                const std::span<const double> grid(
+                    grid_rates.data(), grid_obj.is_none() ? 0 : static_cast<std::size_t>(grid_rates.shape(0)));
+                const auto out = net.step(in, grid, learn);
                 return to_numpy(out.data(), {static_cast<pyb::ssize_t>(out.size())}).attr("astype")("float64");
             },
-            pyb::arg("bvc_rates"), pyb::arg("learn") = true, "One model step; returns the (n_place,) rates")
+            pyb::arg("bvc_rates"), pyb::arg("learn") = true, pyb::arg("grid_rates") = pyb::none(),
+            "One model step; returns the (n_place,) rates. grid_rates: (n_grid,), when the network reads grid cells")
+        .def_property_readonly(
+            "grid_mask",
+            [](const PlaceCellNetwork& net) {
+                const auto w = net.grid_mask();
+                return to_numpy(w.data(), {net.n_place(), net.n_grid()});
+            },
+            "(n_place, n_grid) float32 mask W_g (0 or 1), fixed, drawn from the seed")
+        .def_property_readonly("n_grid", &PlaceCellNetwork::n_grid)
         .def_property(
             "weights",
             [](const PlaceCellNetwork& net) {

@@ -20,6 +20,8 @@ struct ModelSpec {
     PlaceParams place;
     // Populations besides the BVC layer ("bvc") and the place cells ("place"), in the order they are made.
     std::vector<PopulationSpec> populations;
+    // The grid population of `populations` the place cells also read (SPEC §16), or "" (the paper's: BVCs only).
+    std::string place_grid;
     static constexpr double max_weights = 1e9;  // n_place × BVCs (4 GB of float weights)
     void validate() const;
 };

@@ -9,7 +9,7 @@
 namespace bvc3d::config {
 
 ModelSpec model_from_yaml(const YamlView& v) {
-    v.expect_map({"name", "base", "sensor", "bvc", "place", "populations"});
+    v.expect_map({"name", "base", "sensor", "bvc", "place", "populations", "place_grid"});
     ModelSpec m;
     try {
         m = model_preset(v.get("base", "3d-0.2"));
@@ -20,13 +20,20 @@ ModelSpec model_from_yaml(const YamlView& v) {
     // changed when it changes anything.
     const std::string base_name = m.name;
     const bool inline_model = !v.path().empty();
-    const bool changed = v.has("sensor") || v.has("bvc") || v.has("place") || v.has("populations");
+    const bool changed =
+        v.has("sensor") || v.has("bvc") || v.has("place") || v.has("populations") || v.has("place_grid");
     m.name = v.get("name", inline_model ? base_name + (changed ? "-custom" : "")
                                         : std::filesystem::path(v.file()).stem().string());
     if (v.has("sensor")) m.sensor = sensor_from_yaml(v["sensor"]);
     if (v.has("bvc")) read_table(v["bvc"], m.bvc, BvcParams::table());
     if (v.has("place")) read_table(v["place"], m.place, PlaceParams::table());
     if (v.has("populations")) m.populations = populations_from_yaml(v["populations"]);
+    if (v.has("place_grid")) m.place_grid = v["place_grid"].as_string();
+    if (!m.place_grid.empty() && std::none_of(m.populations.begin(), m.populations.end(),
+                                              [&](const PopulationSpec& p) { return p.name == m.place_grid; }))
+        (v.has("place_grid") ? v["place_grid"] : v["populations"])
+            .fail("'" + m.place_grid +
+                  "' names no population of the model's populations: list (the place cells' grid)");
     // The sections one by one may still not fit together (too many weights): at the key named.
     try {
         m.validate();
@@ -58,6 +65,7 @@ std::string model_to_yaml(const ModelSpec& m) {
             text += "]\n    recorded: " + std::string(p.recorded ? "true" : "false") + "\n    key: " + p.key + "\n";
         }
     }
+    if (!m.place_grid.empty()) text += "place_grid: " + m.place_grid + "\n";
     return text;
 }
 
@@ -74,6 +82,20 @@ void write_model(params::CommentedYaml& out, const ModelSpec& m, const std::stri
     out.fields(BvcParams::table(), m.bvc, indent + "  ");
     out.section(indent, "place", "the place-cell network");
     out.fields(PlaceParams::table(), m.place, indent + "  ");
+    if (!m.populations.empty()) {  // each with its parameters as its canonical key (which the reader takes)
+        std::string items;
+        for (const PopulationSpec& p : m.populations) {
+            items += (items.empty() ? "" : ", ") + std::string("{name: ") + params::CommentedYaml::scalar(p.name) +
+                     ", kind: " + p.kind + ", inputs: [";
+            for (std::size_t i = 0; i < p.inputs.size(); ++i) items += (i ? ", " : "") + p.inputs[i];
+            items += "], recorded: " + std::string(p.recorded ? "true" : "false") + ", key: \"" + p.key +
+                     "\"}";  // quoted: in a flow mapping, its brackets and commas
+        }
+        out.line(indent, "populations", "[" + items + "]", "further populations (docs/model-reference.md)");
+    }
+    if (!m.place_grid.empty())
+        out.line(indent, "place_grid", params::CommentedYaml::scalar(m.place_grid),
+                 "the grid population the place cells also read");
 }
 
 std::string model_to_commented_yaml(const ModelSpec& m) {

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <memory>
 
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/population/bvc_population.hpp"
+#include "bvc3d/population/place_population.hpp"
+
 namespace bvc3d::config {
 
 namespace {
@@ -57,6 +61,20 @@ PopulationSpec growing_place_spec(const std::string& name, const PlaceParams& pl
     return s;
 }
 
+PopulationSpec bvc_layer_spec(const std::string& name, const BvcParams& p) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "bvc";
+    s.key = key_of(s.kind, p);
+    s.recorded = false;  // a BVC layer's rates are many; `recorded: true` keeps them
+    s.make = [p](const PopulationContext& c) -> std::unique_ptr<Population> {
+        if (!c.bvc_group) throw InputError("a BVC layer needs the model's source of returns");
+        return std::make_unique<BvcPopulation>(c.bvc_group, c.bvc_group->add(p));
+    };
+    return s;
+}
+
 namespace {
 
 // A growing network's keys: its own and the place cells' dynamics (n_place aside: its cells are budget, n_initial).
@@ -84,6 +102,26 @@ std::vector<std::string> growing_place_keys() {
 
 }  // namespace
 
+PopulationSpec grid_place_spec(const std::string& name, const PlaceParams& p, std::vector<std::string> inputs) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "place";
+    s.inputs = std::move(inputs);
+    s.key = key_of(s.kind, p);
+    // FNV-1a of the name: the networks of one trial draw different weights and masks.
+    std::uint64_t tag = 14695981039346656037ull;
+    for (unsigned char ch : name) tag = (tag ^ ch) * 1099511628211ull;
+    s.make = [p, tag](const PopulationContext& c) -> std::unique_ptr<Population> {
+        if (c.input_sizes.size() != 2) throw InputError("place cells read a BVC and a grid population");
+        if (static_cast<double>(p.n_place) * static_cast<double>(c.input_sizes[0] + c.input_sizes[1]) > 1e9)
+            throw InputError("n_place × (BVCs + grid cells) is more than 1e9 weights (4 GB)");
+        return std::make_unique<PlacePopulation>(static_cast<int>(c.input_sizes[0]), p, hash_u64(c.seed, tag, 0),
+                                                 static_cast<int>(c.input_sizes[1]));
+    };
+    return s;
+}
+
 const std::vector<PopulationKind>& population_kinds() {
     static const std::vector<PopulationKind> kinds = {
         {"head-direction", "head-direction cells: cos(θ − θ_k), or the icosahedron's 20 for flying",
@@ -105,6 +143,20 @@ const std::vector<PopulationKind>& population_kinds() {
          growing_place_keys(), 1,
          [](const YamlView& v, const std::string& name, std::vector<std::string>) {
              return read_growing_place(v, name);
+         }},
+        {"bvc", "a further BVC layer on the model's sensor (a scale of a multiscale model); not recorded by default",
+         keys_of<BvcParams>(), 0,
+         [](const YamlView& v, const std::string& name, std::vector<std::string>) {
+             BvcParams p;
+             read_table(v, p, BvcParams::table(), item_keys);
+             return bvc_layer_spec(name, p);
+         }},
+        {"place", "place cells fed by BVCs and grid cells (inputs: [a BVC population, a grid population])",
+         keys_of<PlaceParams>(), 2,
+         [](const YamlView& v, const std::string& name, std::vector<std::string> inputs) {
+             PlaceParams p;
+             read_table(v, p, PlaceParams::table(), item_keys);
+             return grid_place_spec(name, p, std::move(inputs));
          }},
     };
     return kinds;
@@ -142,6 +194,27 @@ std::string cycle_through(std::size_t start, const std::vector<std::vector<std::
     std::string text;
     for (std::size_t i : path) text += names[i] + " → ";
     return text + names[start];
+}
+
+// A population's parameters from its canonical key (`kind k1=v1 k2=[a, b]`, as a model's canonical text and
+// `bvc3d config` write it), as a YAML mapping the kind reads.
+YamlView parameters_of_key(const YamlView& key, const std::string& kind) {
+    const std::string text = key.as_string();
+    std::vector<std::string> tokens(1);
+    int depth = 0;
+    for (char ch : text) {
+        depth += (ch == '[') - (ch == ']');
+        if (ch == ' ' && depth == 0) tokens.emplace_back();
+        else tokens.back() += ch;
+    }
+    if (tokens.front() != kind) key.fail("is the key of a '" + tokens.front() + "', not of a '" + kind + "'");
+    std::string yaml = "{";
+    for (std::size_t i = 1; i < tokens.size(); ++i) {
+        const auto eq = tokens[i].find('=');
+        if (eq == std::string::npos) key.fail("'" + tokens[i] + "' is not key=value");
+        yaml += (i > 1 ? ", " : "") + tokens[i].substr(0, eq) + ": " + tokens[i].substr(eq + 1);
+    }
+    return YamlView::load_string(yaml + "}", key.file() + ": " + text);
 }
 
 }  // namespace
@@ -199,9 +272,11 @@ std::vector<PopulationSpec> populations_from_yaml(const YamlView& v) {
             (item.has("inputs") ? item["inputs"] : item)
                 .fail(kind + " reads " + std::to_string(k->n_inputs) + " population(s), got " +
                       std::to_string(inputs[i].size()));
-        specs[i] = k->read(item, names[i], inputs[i]);
+        // Parameters as keys of the item, or (a model's canonical text read back) as its canonical key.
+        specs[i] = item.has("key") ? k->read(parameters_of_key(item["key"], kind), names[i], inputs[i])
+                                   : k->read(item, names[i], inputs[i]);
         specs[i].inputs = inputs[i];
-        specs[i].recorded = item.get_bool("recorded", true);
+        specs[i].recorded = item.get_bool("recorded", specs[i].recorded);
     }
     // In an order where each reads only those before it (file order among the free).
     std::vector<PopulationSpec> ordered;

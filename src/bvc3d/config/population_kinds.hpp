@@ -8,8 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/bvc/bvc_params.hpp"
 #include "bvc3d/config/population_spec.hpp"
 #include "bvc3d/config/yaml_reader.hpp"
+#include "bvc3d/place/place_cell_network.hpp"
 #include "bvc3d/population/grid_cells.hpp"
 #include "bvc3d/population/growing_place_cells.hpp"
 #include "bvc3d/population/head_direction_cells.hpp"
@@ -33,6 +35,11 @@ const PopulationKind* find_population_kind(const std::string& name);
 PopulationSpec head_direction_spec(const std::string& name, const HeadDirectionParams& p);
 PopulationSpec grid_spec(const std::string& name, const GridParams& p);
 PopulationSpec growing_place_spec(const std::string& name, const PlaceParams& place, const GrowingParams& growing);
+// A further BVC layer on the model's sensor (a scale of a multiscale model).
+PopulationSpec bvc_layer_spec(const std::string& name, const BvcParams& p);
+// Place cells reading `inputs` = {a BVC population, a grid population} (SPEC §16; place/place_cell_network.hpp).
+// Their weights and mask come from the trial's seed hashed with `name`: each network draws its own.
+PopulationSpec grid_place_spec(const std::string& name, const PlaceParams& p, std::vector<std::string> inputs);
 
 }  // namespace bvc3d::config
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/bvc/bvc_group.hpp"
 #include "bvc3d/population/population.hpp"
 #include "bvc3d/world/world.hpp"
 
@@ -18,6 +19,8 @@ struct PopulationContext {
     std::uint64_t seed = 0;                // the trial's
     std::vector<std::size_t> input_sizes;  // cells of each population it reads, in the order of `inputs`
     const World* world = nullptr;          // null for a trial without one
+    // The BVC layers of the model's source (its "bvc" is one): a population that is a BVC layer adds its own.
+    std::shared_ptr<BvcLayerGroup> bvc_group;
 };
 
 struct PopulationSpec {

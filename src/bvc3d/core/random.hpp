@@ -12,7 +12,7 @@
 
 namespace bvc3d {
 
-enum class Stream : std::uint64_t { walk = 1, weights = 2, sensor_noise = 3, heading_drift = 4 };
+enum class Stream : std::uint64_t { walk = 1, weights = 2, sensor_noise = 3, heading_drift = 4, grid_mask = 5 };
 
 class Rng {
 public:

@@ -59,10 +59,8 @@ void add_model(Built& b, Groups& groups, const TrialConfig& c, std::size_t i, co
     const std::size_t layer = group->add(c.model.bvc);
     wiring.bvc = b.nodes.size();
     b.nodes.push_back({prefix + "bvc", std::make_unique<BvcPopulation>(group, layer), {}, record_bvc});
-    auto place = std::make_unique<PlacePopulation>(c.model.bvc.n_cells(), c.model.place, c.seed);
-    if (c.weights) place->network().set_weights(c.weights->values);
     wiring.place = b.nodes.size();
-    b.nodes.push_back({prefix + "place", std::move(place), {wiring.bvc}, true});
+    b.nodes.push_back({prefix + "place", nullptr, {wiring.bvc}, true});
     // The others, by name: each may read "bvc", "place" or another of the model's populations listed before it.
     std::vector<std::pair<std::string, std::size_t>> named{{"bvc", wiring.bvc}, {"place", wiring.place}};
     const std::size_t first = b.nodes.size();
@@ -72,23 +70,50 @@ void add_model(Built& b, Groups& groups, const TrialConfig& c, std::size_t i, co
         wiring.others.push_back(first + wiring.others.size());
         named.emplace_back(spec.name, wiring.others.back());
     }
+    const auto node_of = [&](const std::string& name) {
+        const auto at = std::find_if(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
+        return at == named.end() ? b.nodes.size() : at->second;
+    };
     for (const PopulationSpec& spec : c.model.populations) {
         std::vector<std::size_t> inputs;
         for (const std::string& input : spec.inputs) {
-            const auto at = std::find_if(named.begin(), named.end(), [&](const auto& n) { return n.first == input; });
-            if (at == named.end())
+            const std::size_t at = node_of(input);
+            if (at == b.nodes.size())
                 throw InputError(prefix + "population '" + spec.name + "' reads '" + input +
                                  "', which names no population of the model");
-            inputs.push_back(at->second);
+            inputs.push_back(at);
         }
         b.nodes.push_back({prefix + spec.name, nullptr, inputs, spec.recorded});
     }
+    // The place cells: made once what they read is (their grid population, when they read one).
+    std::size_t grid = b.nodes.size();
+    if (!c.model.place_grid.empty()) {
+        grid = node_of(c.model.place_grid);
+        if (grid == b.nodes.size() || grid == wiring.bvc || grid == wiring.place)
+            throw InputError(prefix + "place_grid '" + c.model.place_grid + "' names no population of the model");
+        b.nodes[wiring.place].inputs.push_back(grid);
+    }
+    const auto make_place = [&] {
+        if (b.nodes[wiring.place].population) return;
+        int n_grid = 0;
+        if (grid < b.nodes.size()) {
+            if (!b.nodes[grid].population)
+                throw InputError(prefix + "the place cells read '" + c.model.place_grid +
+                                 "', made after a population that reads them: list it first");
+            n_grid = static_cast<int>(b.nodes[grid].population->size());
+        }
+        auto place = std::make_unique<PlacePopulation>(c.model.bvc.n_cells(), c.model.place, c.seed, n_grid);
+        if (c.weights) place->network().set_weights(c.weights->values);
+        b.nodes[wiring.place].population = std::move(place);
+    };
+    if (c.model.place_grid.empty()) make_place();
     // Made in order, each knowing the sizes of its inputs.
     for (std::size_t k = 0; k < c.model.populations.size(); ++k) {
         const PopulationSpec& spec = c.model.populations[k];
         PopulationNode& node = b.nodes[wiring.others[k]];
-        PopulationContext context{c.seed, {}, world};
+        PopulationContext context{c.seed, {}, world, group};
         for (std::size_t in : node.inputs) {
+            if (in == wiring.place) make_place();
             if (!b.nodes[in].population)
                 throw InputError(prefix + "population '" + spec.name + "' reads a population made after it: list '" +
                                  b.nodes[in].name + "' first");
@@ -97,6 +122,7 @@ void add_model(Built& b, Groups& groups, const TrialConfig& c, std::size_t i, co
         node.population = spec.make(context);
         if (!node.population) throw InputError(prefix + "population '" + spec.name + "' could not be made");
     }
+    make_place();
     b.wiring.push_back(std::move(wiring));
 }
 

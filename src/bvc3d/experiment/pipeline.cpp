@@ -47,6 +47,32 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
         a.populations.emplace_back(
             p.name, AnalyzedPopulation{analysis::analyze_trial<float>(positions, cells, a.params), a.params});
     }
+    // A multiscale model's scales fused (docs/model-reference.md#multiscale-models): its place cells and each recorded
+    // population of kind "place", side by side, each scale's rate vector scaled to unit length per sample.
+    std::vector<std::pair<const float*, std::size_t>> scales{{rec.rates.data(), static_cast<std::size_t>(rec.n_place)}};
+    for (const PopulationSpec& spec : t.model.populations)
+        for (const PopulationRecord& p : rec.populations)
+            if (spec.kind == "place" && p.name == spec.name && p.recorded && p.cells > 0)
+                scales.emplace_back(p.rates.data(), p.cells);
+    if (scales.size() > 1) {
+        std::size_t total = 0;
+        for (const auto& sc : scales) total += sc.second;
+        std::vector<float> fused(static_cast<std::size_t>(n) * total);
+        for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+            float* out = fused.data() + i * total;
+            for (const auto& [scale_rates, cells] : scales) {
+                const float* row = scale_rates + i * cells;
+                double norm = 0;
+                for (std::size_t j = 0; j < cells; ++j) norm += static_cast<double>(row[j]) * row[j];
+                const double scale = norm > 0 ? 1.0 / std::sqrt(norm) : 0.0;
+                for (std::size_t j = 0; j < cells; ++j) out[j] = static_cast<float>(row[j] * scale);
+                out += cells;
+            }
+        }
+        const Eigen::Map<const analysis::RowMatrixXf> cells(fused.data(), n, static_cast<Eigen::Index>(total));
+        a.populations.emplace_back(
+            fused_population, AnalyzedPopulation{analysis::analyze_trial<float>(positions, cells, a.params), a.params});
+    }
     return a;
 }
 

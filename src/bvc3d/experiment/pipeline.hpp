@@ -16,6 +16,8 @@ struct AnalyzedPopulation {
     analysis::TrialMetrics metrics;
     analysis::AnalysisParams params;  // what the metrics were computed with (extent resolved)
 };
+// The name under which a multiscale model's scales, fused, are analysed (pipeline.cpp's analyze).
+inline constexpr const char* fused_population = "place-fused";
 // A trial's metrics: of its place cells, and of each other recorded population (by name).
 struct AnalyzedTrial : AnalyzedPopulation {
     std::vector<std::pair<std::string, AnalyzedPopulation>> populations;

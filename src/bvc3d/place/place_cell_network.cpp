@@ -31,14 +31,26 @@ const params::Table<PlaceParams>& PlaceParams::table() {
          real("gamma_pp", &PlaceParams::gamma_pp, finite(), "recurrent inhibition Γ_pp"),
          real("gain", &PlaceParams::gain, open_closed(0, 1e6), "g in v = tanh(g·[s]+)"),
          real("eta", &PlaceParams::eta, closed(0, 1e6), "learning rate η = Δt/τ_W"),
-         real("alpha_pb", &PlaceParams::alpha_pb, above(0), "α_pb of Oja's rule")});
+         real("alpha_pb", &PlaceParams::alpha_pb, above(0), "α_pb of Oja's rule"),
+         real("grid_influence", &PlaceParams::grid_influence, closed(0, 1),
+              "g: the grid cells' share of the drive (0: BVCs only, the paper's network)")
+             .quiet_at_default(),
+         real("gamma_pg", &PlaceParams::gamma_pg, finite(), "inhibition Γ_pg by the grid cells' total")
+             .quiet_at_default(),
+         real("grid_p_connect", &PlaceParams::grid_p_connect, closed(0, 1),
+              "the grid mask W_g is Bernoulli(grid_p_connect)")
+             .quiet_at_default()});
     return t;
 }
 
-PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::uint64_t seed)
-    : n_bvc_(n_bvc), p_(params) {
+PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::uint64_t seed, int n_grid)
+    : n_bvc_(n_bvc), n_grid_(n_grid), p_(params) {
     p_.validate();
     if (n_bvc < 1) throw InputError("place cells: need at least one BVC input");
+    if (n_grid < 0) throw InputError("place cells: a negative number of grid cells");
+    if (n_grid == 0 && p_.grid_influence > 0)
+        throw InputError("place cells: grid_influence = " + std::to_string(p_.grid_influence) +
+                         " needs grid cells as input (none given)");
     stride_ = (static_cast<std::size_t>(n_bvc) + 7) / 8 * 8;
     w_.assign(static_cast<std::size_t>(pairs()) * pair_stride(), 0.0f);
     Rng rng(seed, Stream::weights);
@@ -48,6 +60,17 @@ PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::ui
     v_.assign(p_.n_place, 0.0f);
     drive_.assign(2 * static_cast<std::size_t>(pairs()), 0.0f);
     vb_.assign(stride_, 0.0f);
+    grid_stride_ = (static_cast<std::size_t>(n_grid) + 7) / 8 * 8;
+    if (n_grid > 0) {
+        gw_.assign(static_cast<std::size_t>(pairs()) * 2 * grid_stride_, 0.0f);
+        Rng mask(seed, Stream::grid_mask);
+        for (int i = 0; i < p_.n_place; ++i) {
+            float* r = gw_.data() + static_cast<std::size_t>(i / 2) * 2 * grid_stride_ + 8 * (i % 2);
+            for (int j = 0; j < n_grid; ++j)
+                r[kernels::paired_column(j)] = mask.bernoulli(p_.grid_p_connect) ? 1.0f : 0.0f;
+        }
+        vg_.assign(grid_stride_, 0.0f);
+    }
 }
 
 void PlaceCellNetwork::inputs(std::span<const double> bvc_rates, float* vb) const {
@@ -58,15 +81,33 @@ void PlaceCellNetwork::inputs(std::span<const double> bvc_rates, float* vb) cons
     if (bad < bvc_rates.size()) throw InputError("place cells: BVC rate " + std::to_string(bad) + " is not finite");
 }
 
-void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, std::vector<int>* learned) {
+void PlaceCellNetwork::grid_inputs(std::span<const double> grid_rates, float* vg) const {
+    if (grid_rates.size() != static_cast<std::size_t>(n_grid_))
+        throw InputError("place cells: expected " + std::to_string(n_grid_) + " grid rates, got " +
+                         std::to_string(grid_rates.size()));
+    const std::size_t bad = kernels::to_floats(grid_rates.data(), vg, grid_rates.size(), tiny_operand);
+    if (bad < grid_rates.size()) throw InputError("place cells: grid rate " + std::to_string(bad) + " is not finite");
+}
+
+void PlaceCellNetwork::advance(const float* drive, const float* grid_drive, const float* vb, const float* vg,
+                               bool learn, std::vector<int>* learned) {
     const float k = static_cast<float>(p_.dt_over_tau);
     // Inhibition uses the BVC total and the place cells' previous rates, summed in index order. Only
     // the cells that were active can have a rate other than ±0, and adding ±0 to a sum that is not −0
     // leaves it as it is (a sum of floats from +0 is never −0): summing the active ones is the sum.
     float previous = 0;
     for (int i : active_) previous += v_[i];
-    const float inhibition =
-        static_cast<float>(p_.gamma_pb) * kernels::sum8(vb, stride_) + static_cast<float>(p_.gamma_pp) * previous;
+    const double g = p_.grid_influence;
+    float feedforward = static_cast<float>((1.0 - g) * p_.gamma_pb) * kernels::sum8(vb, stride_);
+    if (grid_drive) {
+        // (1−g)·W_b·b + g·W_g·c; with g = 0, 1·x + 0 = x (x ≥ +0): the paper's drive, bit for bit.
+        const float kb = static_cast<float>(1.0 - g), kg = static_cast<float>(g);
+        combined_.resize(s_.size());
+        for (std::size_t i = 0; i < s_.size(); ++i) combined_[i] = kb * drive[i] + kg * grid_drive[i];
+        drive = combined_.data();
+        feedforward += static_cast<float>(g * p_.gamma_pg) * kernels::sum8(vg, grid_stride_);
+    }
+    const float inhibition = feedforward + static_cast<float>(p_.gamma_pp) * previous;
     // tanh(g·[s]+); for a silent cell (the argument ±0, or NaN) the argument is its own tanh.
     bool finite = false;
     active_.resize(s_.size());
@@ -80,8 +121,8 @@ void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, 
             "learning rate eta = " +
             std::to_string(p_.eta) + " too large?");
     if (!learn || !(p_.eta > 0)) return;
-    // Oja: W_i += eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
-    const float eta = static_cast<float>(p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
+    // Oja: W_i += (1−g)·eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
+    const float eta = static_cast<float>((1.0 - g) * p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
     for (int i : active_) {
         const float vi = v_[i];
         if (vi == 0.0f) continue;
@@ -93,18 +134,30 @@ void PlaceCellNetwork::advance(const float* drive, const float* vb, bool learn, 
     }
 }
 
-std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates, bool learn) {
+std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates, std::span<const double> grid_rates,
+                                              bool learn) {
     inputs(bvc_rates, vb_.data());
+    if (n_grid_ > 0 || !grid_rates.empty()) grid_inputs(grid_rates, vg_.data());
     kernels::paired_products(w_.data(), pair_stride(), vb_.data(), stride_, stride_, pairs(), 1, drive_.data(), 0);
-    advance(drive_.data(), vb_.data(), learn, nullptr);
+    if (n_grid_ > 0) {
+        grid_drive_.resize(drive_.size());
+        kernels::paired_products(gw_.data(), 2 * grid_stride_, vg_.data(), grid_stride_, grid_stride_, pairs(), 1,
+                                 grid_drive_.data(), 0);
+    }
+    advance(drive_.data(), n_grid_ > 0 ? grid_drive_.data() : nullptr, vb_.data(), vg_.data(), learn, nullptr);
     return v_;
 }
 
-std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_rates, std::span<const char> learn) {
-    const std::size_t steps = learn.size(), n = static_cast<std::size_t>(n_bvc_);
+std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_rates,
+                                                    std::span<const double> grid_rates, std::span<const char> learn) {
+    const std::size_t steps = learn.size(), n = static_cast<std::size_t>(n_bvc_),
+                      ng = static_cast<std::size_t>(n_grid_);
     if (bvc_rates.size() != steps * n)
         throw InputError("place cells: expected " + std::to_string(steps) + " × " + std::to_string(n_bvc_) +
                          " BVC rates, got " + std::to_string(bvc_rates.size()));
+    if (grid_rates.size() != steps * ng)
+        throw InputError("place cells: expected " + std::to_string(steps) + " × " + std::to_string(n_grid_) +
+                         " grid rates, got " + std::to_string(grid_rates.size()));
     // Every input is checked before the state changes.
     vb_.resize(std::max<std::size_t>(steps, 1) * stride_, 0.0f);
     for (std::size_t t = 0; t < steps; ++t) inputs(bvc_rates.subspan(t * n, n), vb_.data() + t * stride_);
@@ -112,6 +165,14 @@ std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_
     drive_.resize(std::max<std::size_t>(steps, 1) * drive_stride);
     kernels::paired_products(w_.data(), pair_stride(), vb_.data(), stride_, stride_, pairs(), static_cast<int>(steps),
                              drive_.data(), drive_stride);
+    if (n_grid_ > 0) {  // W_g never changes: one pass serves the block
+        vg_.resize(std::max<std::size_t>(steps, 1) * grid_stride_, 0.0f);
+        for (std::size_t t = 0; t < steps; ++t)
+            grid_inputs(grid_rates.subspan(t * ng, ng), vg_.data() + t * grid_stride_);
+        grid_drive_.resize(std::max<std::size_t>(steps, 1) * drive_stride);
+        kernels::paired_products(gw_.data(), 2 * grid_stride_, vg_.data(), grid_stride_, grid_stride_, pairs(),
+                                 static_cast<int>(steps), grid_drive_.data(), drive_stride);
+    }
     block_rates_.resize(steps * static_cast<std::size_t>(p_.n_place));
     learned_.clear();
     is_learned_.assign(p_.n_place, 0);
@@ -120,7 +181,8 @@ std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_
         const float* vb = vb_.data() + t * stride_;
         // The products of rows changed since the block began, with their weights as they are now.
         for (int i : learned_) drive[i] = kernels::paired_row_product(row(i), vb, stride_);
-        advance(drive, vb, learn[t] != 0, &learned_);
+        const float* grid_drive = n_grid_ > 0 ? grid_drive_.data() + t * drive_stride : nullptr;
+        advance(drive, grid_drive, vb, n_grid_ > 0 ? vg_.data() + t * grid_stride_ : nullptr, learn[t] != 0, &learned_);
         std::copy(v_.begin(), v_.end(), block_rates_.begin() + static_cast<std::ptrdiff_t>(t * p_.n_place));
     }
     return block_rates_;
@@ -131,6 +193,14 @@ std::vector<float> PlaceCellNetwork::weights() const {
     for (int i = 0; i < p_.n_place; ++i)
         for (int j = 0; j < n_bvc_; ++j)
             out[static_cast<std::size_t>(i) * n_bvc_ + j] = row(i)[kernels::paired_column(j)];
+    return out;
+}
+
+std::vector<float> PlaceCellNetwork::grid_mask() const {
+    std::vector<float> out(static_cast<std::size_t>(p_.n_place) * n_grid_);
+    for (int i = 0; i < p_.n_place; ++i)
+        for (int j = 0; j < n_grid_; ++j)
+            out[static_cast<std::size_t>(i) * n_grid_ + j] = grid_row(i)[kernels::paired_column(j)];
     return out;
 }
 

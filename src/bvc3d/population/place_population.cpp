@@ -8,8 +8,11 @@ namespace bvc3d {
 
 void PlacePopulation::step(const StepBlock& block, std::span<const std::span<const double>> inputs,
                            std::span<double> out) {
-    if (inputs.size() != 1) throw InputError("a place-cell network reads one BVC population");
-    const auto v = net_.step_block(inputs[0], block.learn);
+    const std::size_t expected = net_.n_grid() > 0 ? 2 : 1;
+    if (inputs.size() != expected)
+        throw InputError(net_.n_grid() > 0 ? "place cells fed by grid cells read a BVC and a grid population"
+                                           : "a place-cell network reads one BVC population");
+    const auto v = net_.step_block(inputs[0], expected == 2 ? inputs[1] : std::span<const double>{}, block.learn);
     std::copy(v.begin(), v.end(), out.begin());  // float rates, exactly
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Population stage: the paper's place-cell network (place/place_cell_network.hpp) as a population. Takes: the rates
-// of one BVC population. Gives: place-cell rates, learning with Oja's rule on the steps that learn; keeps its
-// weights (n_place × n_bvc) at the end of a trial.
+// of one BVC population, and with n_grid > 0 those of a grid-cell population (the second input). Gives: place-cell
+// rates, learning with Oja's rule on the steps that learn; keeps its weights (n_place × n_bvc) at the end of a trial.
 #include <cstdint>
 #include <span>
 
@@ -12,7 +12,8 @@ namespace bvc3d {
 
 class PlacePopulation : public Population {
 public:
-    PlacePopulation(int n_bvc, const PlaceParams& params, std::uint64_t seed) : net_(n_bvc, params, seed) {}
+    PlacePopulation(int n_bvc, const PlaceParams& params, std::uint64_t seed, int n_grid = 0)
+        : net_(n_bvc, params, seed, n_grid) {}
     PlaceCellNetwork& network() { return net_; }
 
     std::size_t size() const override { return static_cast<std::size_t>(net_.n_place()); }
