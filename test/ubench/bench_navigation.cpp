@@ -2,9 +2,9 @@
 // learned adjacency — and a whole decision with the sensor, BVCs and place cells, for the paper's 250 place cells and
 // for adjacencies of the authors' multiscale sizes (2 000 / 1 000 / 500 cells per scale; learned here on a
 // synthetic walk of sparse place fields, the multiscale network itself not being in the library yet). The second
-// argument p: the products read the sparse copy with prune = 10⁻ᵖ (p = 0: prune 0, every non-zero weight, the
-// exact products); the third T: steps of each rollout (SPEC: 3); counters give the copy's entries and bytes against
-// the dense n_hd·n² float32.
+// argument p: the products read the sparse copy with prune = 10^(−p/2) (p = 2: 10⁻¹, 3: 3.2·10⁻², 4: 10⁻²; p = 0:
+// prune 0, every non-zero weight, the exact products); the third T: steps of each rollout (SPEC: 3); counters give
+// the copy's entries and bytes against the dense n_hd·n² float32.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -66,7 +66,9 @@ Learned& learned(int n) {
     return *l;
 }
 
-double prune_of(const benchmark::State& state) { return state.range(1) ? std::pow(10.0, -double(state.range(1))) : 0; }
+double prune_of(const benchmark::State& state) {
+    return state.range(1) ? std::pow(10.0, -double(state.range(1)) / 2) : 0;
+}
 RewardParams rollout_of(const benchmark::State& state) {
     RewardParams p;
     p.rollout_steps = static_cast<int>(state.range(2));
@@ -85,7 +87,7 @@ void BM_DirectionChoice(benchmark::State& state) {
     state.counters["MB"] = sparse.bytes() / 1e6;
     state.counters["dense_MB"] = HdAdjacency::bytes(n, l.adj.n_hd()) / 1e6;
 }
-BENCHMARK(BM_DirectionChoice)->ArgsProduct({{250, 1000, 2000}, {0, 2}, {3, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DirectionChoice)->ArgsProduct({{250, 1000, 2000}, {0, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
 
 // The authors' multiscale size: three scales of 2 000 / 1 000 / 500 place cells, each scale's rollouts (the scales'
 // combination, a softmax over 8 numbers, is left out).
@@ -108,7 +110,7 @@ void BM_DirectionChoiceMultiscale(benchmark::State& state) {
     state.counters["MB"] = bytes / 1e6;
     state.counters["dense_MB"] = dense / 1e6;
 }
-BENCHMARK(BM_DirectionChoiceMultiscale)->ArgsProduct({{3500}, {0, 2}, {3, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DirectionChoiceMultiscale)->ArgsProduct({{3500}, {0, 2, 3, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
 
 // A whole decision of the paper's 2d model: scan, BVCs, one place-cell step, the rollouts.
 void BM_DecisionWithModel(benchmark::State& state) {
