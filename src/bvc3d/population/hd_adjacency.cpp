@@ -118,7 +118,11 @@ void HdAdjacency::apply(int k, std::span<const double> x, std::span<double> out)
 }
 
 SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
-    : n_(adj.n_), scale_(adj.scale_), antisymmetric_(adj.antisymmetric_), rows_(std::size_t(adj.p_.n_hd)) {
+    : n_(adj.n_),
+      scale_(adj.scale_),
+      antisymmetric_(adj.antisymmetric_),
+      pruned_(prune > 0),
+      rows_(std::size_t(adj.p_.n_hd)) {
     if (!(prune >= 0 && prune < 1)) throw InputError("adjacency: prune must lie in [0, 1)");
     if (std::size_t(adj.n_) * std::size_t(adj.n_) > std::size_t(UINT32_MAX))
         throw InputError("adjacency: too many place cells for the sparse copy (" + std::to_string(adj.n_) + ")");
@@ -141,10 +145,13 @@ SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
 
 void SparseAdjacency::apply(int k, std::span<const double> x, std::span<double> out) const {
     // The same two forms, in the same order, as HdAdjacency::apply: a left-out weight only adds ±0 there.
+    // A pruned copy's bits are its own: it takes the column form whenever that reads fewer entries (a rollout's
+    // state after a step covers a fifth to a third of the cells: a third of the entries or less).
     const Rows& r = rows_[std::size_t(k)];
-    std::size_t active = 0;
-    for (double v : x) active += v != 0.0;
-    if (antisymmetric_ && 4 * active < std::size_t(n_)) {
+    std::size_t active = 0, work = 0;
+    for (std::size_t j = 0; j < x.size(); ++j)
+        if (x[j] != 0.0) ++active, work += r.start[j + 1] - r.start[j];
+    if (antisymmetric_ && (4 * active < std::size_t(n_) || (pruned_ && work < r.col.size()))) {
         std::fill(out.begin(), out.end(), 0.0);
         for (int j = 0; j < n_; ++j) {
             const double xj = x[std::size_t(j)];

@@ -86,8 +86,9 @@ private:
 };
 
 // A frozen copy of an adjacency for products (see above): per HD cell, the weights with |w| > prune·max|W_rec[k]|
-// in compressed rows (column index and float32 value, 8 bytes an entry). apply() gives the same bits as
-// HdAdjacency::apply on the matrices with the left-out weights set to 0.
+// in compressed rows (column index and float32 value, 8 bytes an entry). With prune 0, apply() gives the same bits
+// as HdAdjacency::apply; pruned, the products of the matrices with the left-out weights set to 0 (its sums in the
+// order that reads fewer entries).
 class SparseAdjacency {
 public:
     explicit SparseAdjacency(const HdAdjacency& adj) : SparseAdjacency(adj, adj.params().prune) {}
@@ -109,6 +110,7 @@ private:
     int n_;
     double scale_;
     bool antisymmetric_;
+    bool pruned_;
     std::vector<Rows> rows_;
 };
 
