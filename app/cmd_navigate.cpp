@@ -1,14 +1,20 @@
 // bvc3d navigate: navigation to goals (docs/navigation.md): learning runs, then starts per goal, written as
-// starts.csv, learning.csv, paths.csv, reward_map.csv, summary.csv/.md and figures.
+// starts.csv, learning.csv, paths.csv, reward_map.csv, summary.csv/.md and figures. Each finished learning run is
+// kept in runs/seed-N.nav (exact numbers and a fingerprint of everything that fixes it): a run interrupted (Ctrl-C,
+// a kill) and started again with the same options takes the finished seeds from there and writes the same files.
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
 
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/trial_config.hpp"
 #include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/config/yaml_reader.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
@@ -23,12 +29,26 @@ namespace bvc3d::cli {
 namespace {
 
 struct NavigateOptions {
-    std::string world, lean = "+x+y", goals, model = "2d";
+    std::string config, world, lean = "+x+y", goals, model = "2d";
     std::optional<double> tilt;
     int seeds = 1;
     std::uint64_t first_seed = 0;
     NavigationParams nav;
+    bool dry_run = false;
     RunOptions run;  // --out, --no-report
+};
+
+// What one command runs: models × seeds in a world with its goals, and every parameter.
+struct NavigatePlan {
+    std::string world, lean = "+x+y";
+    std::optional<double> tilt;
+    std::vector<Vec2> goals;
+    std::vector<std::string> models;  // as given: a preset name or a model file
+    int seeds = 1;
+    std::uint64_t first_seed = 0;
+    NavigationParams nav;
+    AdjacencyParams adjacency;
+    RewardParams reward;
 };
 
 // "x,y;x,y": the goals (InputError naming the bad one).
@@ -47,6 +67,63 @@ std::vector<Vec2> parse_goals(const std::string& text) {
     return out;
 }
 
+NavigatePlan plan_of_options(const NavigateOptions& o) {
+    if (o.world.empty()) throw InputError("navigate: give --world and --goals, or --config");
+    if (o.seeds < 1) throw InputError("--seeds: must be at least 1");
+    NavigatePlan p;
+    p.world = o.world, p.tilt = o.tilt, p.lean = o.lean;
+    p.goals = parse_goals(o.goals);
+    p.models = {o.model};
+    p.seeds = o.seeds, p.first_seed = o.first_seed;
+    p.nav = o.nav;
+    p.nav.validate();
+    return p;
+}
+
+// The sweep-friendly YAML (docs/navigation.md#a-yaml-file): world (a preset or a file, relative to the YAML's
+// folder), tilt, lean, goals ([[x, y], ...]), models (a name or a list), seeds, first_seed, and the parameter
+// tables navigation:, adjacency:, reward:. Any other key: InputError naming it.
+NavigatePlan plan_of_yaml(const std::string& file) {
+    const auto v = config::YamlView::load_file(file);
+    v.expect_map(
+        {"world", "tilt", "lean", "goals", "models", "seeds", "first_seed", "navigation", "adjacency", "reward"});
+    NavigatePlan p;
+    p.world = config::path_in_file(v, v["world"].as_string());
+    if (v.has("tilt")) p.tilt = v["tilt"].as_double();
+    p.lean = v.get("lean", p.lean);
+    const auto goals = v["goals"];
+    if (!goals.is_sequence()) goals.fail("must be a list of [x, y]");
+    for (std::size_t i = 0; i < goals.size(); ++i) {
+        const auto xy = goals.at(i).as_doubles(2);
+        p.goals.emplace_back(xy[0], xy[1]);
+    }
+    if (v.has("models")) {
+        const auto m = v["models"];
+        if (m.is_scalar()) {
+            p.models.push_back(m.as_string());
+        } else {
+            if (m.size() == 0) m.fail("must name at least one model");
+            for (std::size_t i = 0; i < m.size(); ++i) p.models.push_back(m.at(i).as_string());
+        }
+    } else {
+        p.models = {"2d"};
+    }
+    for (std::string& m : p.models) m = config::path_in_file(v, m);
+    p.seeds = v.get("seeds", 1);
+    if (p.seeds < 1) v["seeds"].fail("must be at least 1");
+    if (v.has("first_seed")) p.first_seed = v["first_seed"].as_uint64();
+    if (v.has("navigation")) config::read_table(v["navigation"], p.nav, NavigationParams::table());
+    if (v.has("adjacency")) config::read_table(v["adjacency"], p.adjacency, AdjacencyParams::table());
+    if (v.has("reward")) config::read_table(v["reward"], p.reward, RewardParams::table());
+    return p;
+}
+
+// A world or model file by its stem (configs/worlds/nav-open.yaml: nav-open), a preset by its name.
+std::string label_of(const std::string& name_or_file) {
+    const std::filesystem::path path(name_or_file);
+    return std::filesystem::is_regular_file(path) ? path.stem().string() : name_or_file;
+}
+
 double quantile(std::vector<double> v, double q) {
     if (v.empty()) return std::nan("");
     std::sort(v.begin(), v.end());
@@ -56,76 +133,210 @@ double quantile(std::vector<double> v, double q) {
     return v[lo] + (at - double(lo)) * (v[hi] - v[lo]);
 }
 
+// A learning run's results as the command writes them, exactly (shortest round-trip numbers): runs/seed-N.nav.
+constexpr const char* run_magic = "bvc3d-navigation-run 1";
+
+std::string number_text(double v) {
+    char buf[32];
+    return {buf, std::to_chars(buf, buf + sizeof buf, v).ptr};
+}
+
+void save_run(const std::filesystem::path& file, const std::string& fingerprint, const NavigationRun& r) {
+    AtomicFile f(file);
+    auto& o = f.stream();
+    o << run_magic << '\n' << fingerprint << "\nend-fingerprint\n";
+    o << number_text(r.learn_s) << ' ' << number_text(r.coverage) << ' ' << r.visits.size() << '\n';
+    for (std::size_t g = 0; g < r.visits.size(); ++g) {
+        o << r.visits[g] << ' ' << r.goal_cells[g] << ' ' << r.reward_maps[g].size() << '\n';
+        for (const auto& m : r.reward_maps[g])
+            o << number_text(m.p.x()) << ' ' << number_text(m.p.y()) << ' ' << number_text(m.reward) << '\n';
+    }
+    o << r.starts.size() << '\n';
+    for (const auto& st : r.starts) {
+        o << st.goal << ' ' << number_text(st.start.x()) << ' ' << number_text(st.start.y()) << ' ' << st.success << ' '
+          << number_text(st.path_m) << ' ' << number_text(st.shortest_m) << ' ' << number_text(st.time_s) << ' '
+          << st.path.size() << '\n';
+        for (const Vec2& p : st.path) o << number_text(p.x()) << ' ' << number_text(p.y()) << '\n';
+    }
+    o << "end\n";
+    f.commit();
+}
+
+// The run kept in `file` if it is whole and was made with `fingerprint`; else nothing.
+std::optional<NavigationRun> load_run(const std::filesystem::path& file, const std::string& fingerprint) {
+    std::ifstream in(file);
+    std::string line, fp;
+    if (!std::getline(in, line) || line != run_magic) return std::nullopt;
+    while (std::getline(in, line) && line != "end-fingerprint") fp += (fp.empty() ? "" : "\n") + line;
+    if (fp != fingerprint) return std::nullopt;
+    std::string word;
+    bool ok = true;
+    auto real = [&] {
+        double v = 0;
+        ok = ok && (in >> word) && std::from_chars(word.data(), word.data() + word.size(), v).ec == std::errc{};
+        return v;
+    };
+    auto count = [&] {
+        long long v = 0;
+        ok = ok && (in >> v) && v >= 0;
+        return static_cast<std::size_t>(std::max(v, 0LL));
+    };
+    NavigationRun r;
+    r.learn_s = real();
+    r.coverage = real();
+    const std::size_t goals = count();
+    for (std::size_t g = 0; ok && g < goals; ++g) {
+        int visits = 0, cell = 0;
+        ok = ok && (in >> visits >> cell);
+        r.visits.push_back(visits), r.goal_cells.push_back(cell);
+        r.reward_maps.emplace_back();
+        for (std::size_t m = count(); ok && m > 0; --m) {
+            const double x = real(), y = real();
+            r.reward_maps.back().push_back({Vec2(x, y), real()});
+        }
+    }
+    for (std::size_t n = count(); ok && n > 0; --n) {
+        NavigationStart st;
+        ok = ok && (in >> st.goal);
+        const double x = real(), y = real();
+        st.start = Vec2(x, y);
+        ok = ok && (in >> st.success);
+        st.path_m = real(), st.shortest_m = real(), st.time_s = real();
+        for (std::size_t m = count(); ok && m > 0; --m) {
+            const double px = real();
+            st.path.emplace_back(px, real());
+        }
+        r.starts.push_back(std::move(st));
+    }
+    if (!ok || !(in >> word) || word != "end") return std::nullopt;
+    return r;
+}
+
+// Everything that fixes a learning run's results.
+std::string run_fingerprint(const NavigatePlan& o, const NavigationSetup& s, std::uint64_t seed) {
+    std::string fp = "world: " + WorldSpec{o.world, o.tilt, o.lean}.fingerprint() + "\nmodel:\n" +
+                     config::model_to_yaml(s.model) + "goals:";
+    for (const Vec2& g : s.goals) fp += " " + number_text(g.x()) + "," + number_text(g.y());
+    fp += "\nnavigation:\n" + params::yaml_lines(NavigationParams::table(), s.nav, "  ") + "adjacency:\n" +
+          params::yaml_lines(AdjacencyParams::table(), s.adjacency, "  ") + "reward:\n" +
+          params::yaml_lines(RewardParams::table(), s.reward, "  ") + "seed: " + std::to_string(seed);
+    return fp;
+}
+
 void navigate_command(const NavigateOptions& o) {
     o.run.check();
-    if (o.seeds < 1) throw InputError("--seeds: must be at least 1");
+    const NavigatePlan plan = o.config.empty() ? plan_of_options(o) : plan_of_yaml(o.config);
     NavigationSetup setup;
-    setup.nav = o.nav;
-    setup.nav.validate();
-    setup.model = config::resolve_model(o.model);
-    setup.goals = parse_goals(o.goals);
-    const World world(config::resolve_world(o.world, o.tilt, o.lean));
-    check_goals(world, setup);  // before anything is written
+    setup.nav = plan.nav, setup.adjacency = plan.adjacency, setup.reward = plan.reward;
+    setup.goals = plan.goals;
+    std::vector<ModelSpec> models;
+    std::optional<World> world;
+    try {  // before anything is written; a YAML file's errors name it
+        for (const auto& m : plan.models) models.push_back(config::resolve_model(m));
+        world.emplace(config::resolve_world(plan.world, plan.tilt, plan.lean));
+        check_goals(*world, setup);
+    } catch (const InputError& e) {
+        if (o.config.empty()) throw;
+        throw InputError(o.config + ": " + e.what());
+    }
+    const std::string world_name = label_of(plan.world) + (plan.tilt ? "-" + format_number(*plan.tilt) : "");
+    if (o.dry_run) {
+        std::printf("%s: %zu goal(s), %zu model(s) × %d seed(s) = %zu learning runs, %d starts per goal each\n",
+                    world_name.c_str(), plan.goals.size(), models.size(), plan.seeds,
+                    models.size() * std::size_t(plan.seeds), plan.nav.starts);
+        return;
+    }
     const std::filesystem::path out = o.run.out;
+    if (out.empty()) throw InputError("--out: give an output folder");
     const auto lock = lock_output_folder(out);
-    // A world file by its stem (configs/worlds/nav-open.yaml: nav-open), a preset by its name (and tilt).
-    const std::filesystem::path wpath(o.world);
-    const std::string world_name = (std::filesystem::is_regular_file(wpath) ? wpath.stem().string() : o.world) +
-                                   (o.tilt ? "-" + format_number(*o.tilt) : "");
+
+    // The learning runs first (each kept as soon as it is done), then the files, all at once.
+    const std::filesystem::path runs = out / "runs";
+    ensure_writable_directory(runs);
+    struct Done {
+        std::size_t model;
+        std::uint64_t seed;
+        NavigationRun run;
+    };
+    std::vector<Done> results;
+    for (std::size_t m = 0; m < models.size(); ++m) {
+        setup.model = models[m];
+        for (int k = 0; k < plan.seeds; ++k) {
+            const std::uint64_t seed = plan.first_seed + std::uint64_t(k);
+            const std::string name =
+                (models.size() > 1 ? label_of(plan.models[m]) + " " : "") + "seed " + std::to_string(seed);
+            const auto kept = runs / ((models.size() > 1 ? label_of(plan.models[m]) + "-" : "") + "seed-" +
+                                      std::to_string(seed) + ".nav");
+            const std::string fingerprint = run_fingerprint(plan, setup, seed);
+            std::optional<NavigationRun> done = load_run(kept, fingerprint);
+            if (done) {
+                std::fprintf(stderr, "%s: already done (%s)\n", name.c_str(), kept.string().c_str());
+            } else {
+                std::fprintf(stderr, "%s: learning...\n", name.c_str());
+                done = navigate(*world, setup, seed);
+                save_run(kept, fingerprint, *done);
+                std::fprintf(stderr, "%s: learned in %.2f h (coverage %.3f); %zu starts\n", name.c_str(),
+                             done->learn_s / 3600, done->coverage, done->starts.size());
+            }
+            results.push_back({m, seed, std::move(*done)});
+        }
+    }
 
     AtomicFile starts(out / "starts.csv"), paths(out / "paths.csv"), maps(out / "reward_map.csv"),
         learning(out / "learning.csv");
     starts.stream() << "world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s\n";
-    paths.stream() << "seed,start,x,y\n";
-    maps.stream() << "seed,goal,x,y,reward\n";
-    learning.stream() << "seed,learn_s,coverage,goal,visits,goal_cell\n";
-    // Per goal: the path ratios of the successes, successes, starts, learning times.
-    const std::size_t n_goals = setup.goals.size();
-    std::vector<std::vector<double>> ratios(n_goals), learn_s(n_goals);
-    std::vector<int> reached(n_goals, 0), tried(n_goals, 0);
-    for (int k = 0; k < o.seeds; ++k) {
-        const std::uint64_t seed = o.first_seed + std::uint64_t(k);
-        std::fprintf(stderr, "seed %llu: learning...\n", static_cast<unsigned long long>(seed));
-        const NavigationRun r = navigate(world, setup, seed);
-        std::fprintf(stderr, "seed %llu: learned in %.2f h (coverage %.3f); %zu starts\n",
-                     static_cast<unsigned long long>(seed), r.learn_s / 3600, r.coverage, r.starts.size());
+    paths.stream() << "model,seed,start,x,y\n";
+    maps.stream() << "model,seed,goal,x,y,reward\n";
+    learning.stream() << "model,seed,learn_s,coverage,goal,visits,goal_cell\n";
+    // Per model and goal: the path ratios of the successes, successes, starts, learning times.
+    const std::size_t n_goals = setup.goals.size(), n_cells = models.size() * n_goals;
+    std::vector<std::vector<double>> ratios(n_cells), learn_s(n_cells);
+    std::vector<int> reached(n_cells, 0), tried(n_cells, 0);
+    for (const Done& d : results) {
+        const NavigationRun& r = d.run;
+        const std::string& model = plan.models[d.model];
         for (std::size_t g = 0; g < n_goals; ++g) {
-            learning.stream() << seed << ',' << r.learn_s << ',' << r.coverage << ',' << g << ',' << r.visits[g] << ','
-                              << r.goal_cells[g] << '\n';
-            learn_s[g].push_back(r.learn_s);
+            learning.stream() << model << ',' << d.seed << ',' << r.learn_s << ',' << r.coverage << ',' << g << ','
+                              << r.visits[g] << ',' << r.goal_cells[g] << '\n';
+            learn_s[d.model * n_goals + g].push_back(r.learn_s);
             for (const auto& m : r.reward_maps[g])
-                maps.stream() << seed << ',' << g << ',' << m.p.x() << ',' << m.p.y() << ',' << m.reward << '\n';
+                maps.stream() << model << ',' << d.seed << ',' << g << ',' << m.p.x() << ',' << m.p.y() << ','
+                              << m.reward << '\n';
         }
         for (std::size_t i = 0; i < r.starts.size(); ++i) {
             const auto& s = r.starts[i];
             const Vec2 goal = setup.goals[std::size_t(s.goal)];
             const double ratio = s.path_m / s.shortest_m;
-            starts.stream() << world_name << ',' << o.model << ',' << seed << ',' << goal.x() << ',' << goal.y() << ','
+            starts.stream() << world_name << ',' << model << ',' << d.seed << ',' << goal.x() << ',' << goal.y() << ','
                             << s.start.x() << ',' << s.start.y() << ',' << (s.success ? 1 : 0) << ',' << s.path_m << ','
                             << s.shortest_m << ',' << ratio << ',' << s.time_s << '\n';
-            for (const Vec2& p : s.path) paths.stream() << seed << ',' << i << ',' << p.x() << ',' << p.y() << '\n';
-            ++tried[std::size_t(s.goal)];
-            if (s.success) ++reached[std::size_t(s.goal)], ratios[std::size_t(s.goal)].push_back(ratio);
+            for (const Vec2& p : s.path)
+                paths.stream() << model << ',' << d.seed << ',' << i << ',' << p.x() << ',' << p.y() << '\n';
+            const std::size_t c = d.model * n_goals + std::size_t(s.goal);
+            ++tried[c];
+            if (s.success) ++reached[c], ratios[c].push_back(ratio);
         }
     }
     AtomicFile csv(out / "summary.csv"), md(out / "summary.md");
     csv.stream() << "world,model,goal_x,goal_y,seeds,starts,success_rate,path_ratio_median,path_ratio_q25,"
                     "path_ratio_q75,learn_h_mean\n";
-    md.stream() << "# Navigation: " << world_name << ", model " << o.model << ", " << o.seeds << " learning run(s)\n\n"
-                << "| goal | starts | success | path ratio median [q25, q75] (successes) | learning h (mean) |\n"
-                << "|---|---|---|---|---|\n";
-    for (std::size_t g = 0; g < n_goals; ++g) {
+    md.stream()
+        << "# Navigation: " << world_name << ", " << plan.seeds << " learning run(s) per model\n\n"
+        << "| model | goal | starts | success | path ratio median [q25, q75] (successes) | learning h (mean) |\n"
+        << "|---|---|---|---|---|---|\n";
+    for (std::size_t c = 0; c < n_cells; ++c) {
+        const std::string& model = plan.models[c / n_goals];
+        const Vec2 goal = setup.goals[c % n_goals];
         double mean_learn = 0;
-        for (double t : learn_s[g]) mean_learn += t / 3600 / double(learn_s[g].size());
-        const double rate = tried[g] ? double(reached[g]) / tried[g] : 0.0;
-        const double med = quantile(ratios[g], 0.5), q25 = quantile(ratios[g], 0.25), q75 = quantile(ratios[g], 0.75);
-        csv.stream() << world_name << ',' << o.model << ',' << setup.goals[g].x() << ',' << setup.goals[g].y() << ','
-                     << o.seeds << ',' << tried[g] << ',' << rate << ',' << med << ',' << q25 << ',' << q75 << ','
-                     << mean_learn << '\n';
+        for (double t : learn_s[c]) mean_learn += t / 3600 / double(learn_s[c].size());
+        const double rate = tried[c] ? double(reached[c]) / tried[c] : 0.0;
+        const double med = quantile(ratios[c], 0.5), q25 = quantile(ratios[c], 0.25), q75 = quantile(ratios[c], 0.75);
+        csv.stream() << world_name << ',' << model << ',' << goal.x() << ',' << goal.y() << ',' << plan.seeds << ','
+                     << tried[c] << ',' << rate << ',' << med << ',' << q25 << ',' << q75 << ',' << mean_learn << '\n';
         char line[256];
-        std::snprintf(line, sizeof line, "| (%g, %g) | %d | %.0f %% | %.2f [%.2f, %.2f] | %.2f |\n", setup.goals[g].x(),
-                      setup.goals[g].y(), tried[g], 100 * rate, med, q25, q75, mean_learn);
-        md.stream() << line;
+        std::snprintf(line, sizeof line, "| (%g, %g) | %d | %.0f %% | %.2f [%.2f, %.2f] | %.2f |\n", goal.x(), goal.y(),
+                      tried[c], 100 * rate, med, q25, q75, mean_learn);
+        md.stream() << "| " << model << " " << line;
     }
     for (AtomicFile* f : {&starts, &paths, &maps, &learning, &csv, &md}) f->commit();
     std::printf("wrote %s (starts.csv, summary.csv, summary.md)\n", out.string().c_str());
@@ -142,21 +353,30 @@ void add_navigate_command(CLI::App& app) {
     auto* cmd = app.add_subcommand("navigate",
                                    "Navigation to goals: learn by a random walk, then reach each goal "
                                    "from random starts (docs/navigation.md)");
-    cmd->add_option("--world", o->world, "World preset or YAML file (configs/worlds/nav-*.yaml)")->required();
-    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
-    cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
-    cmd->add_option("--goals", o->goals, "Goals on the floor: x,y[;x,y...] (m)")->required();
-    cmd->add_option("--model", o->model, "Model preset or YAML file")->capture_default_str();
-    cmd->add_option("--seeds", o->seeds, "Learning runs (seeds first-seed, first-seed+1, ...)")->capture_default_str();
-    cmd->add_option("--first-seed", o->first_seed, "The first seed")->check(seed_check)->capture_default_str();
-    cmd->add_option("--starts", o->nav.starts, "Starts per goal")->capture_default_str();
-    cmd->add_option("--max-learn-hours", o->nav.max_learn_hours, "Longest learning walk, simulated hours")
-        ->capture_default_str();
-    cmd->add_option("--coverage", o->nav.coverage, "Learning ends at this fraction of free 0.5 m cells visited")
-        ->capture_default_str();
-    cmd->add_option("--goal-visits", o->nav.goal_visits, "... and this many visits of each goal")
-        ->capture_default_str();
-    o->run.add_out(*cmd, "Output folder")->required();
+    auto* config = cmd->add_option("--config", o->config,
+                                   "A YAML file: world, goals, models, seeds and parameters (docs/navigation.md)");
+    std::vector<CLI::Option*> given;
+    given.push_back(cmd->add_option("--world", o->world, "World preset or YAML file (configs/worlds/nav-*.yaml)"));
+    given.push_back(cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees"));
+    given.push_back(cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str());
+    given.push_back(cmd->add_option("--goals", o->goals, "Goals on the floor: x,y[;x,y...] (m)"));
+    given.push_back(cmd->add_option("--model", o->model, "Model preset or YAML file")->capture_default_str());
+    given.push_back(cmd->add_option("--seeds", o->seeds, "Learning runs (seeds first-seed, first-seed+1, ...)")
+                        ->capture_default_str());
+    given.push_back(
+        cmd->add_option("--first-seed", o->first_seed, "The first seed")->check(seed_check)->capture_default_str());
+    given.push_back(cmd->add_option("--starts", o->nav.starts, "Starts per goal")->capture_default_str());
+    given.push_back(
+        cmd->add_option("--max-learn-hours", o->nav.max_learn_hours, "Longest learning walk, simulated hours")
+            ->capture_default_str());
+    given.push_back(
+        cmd->add_option("--coverage", o->nav.coverage, "Learning ends at this fraction of free 0.5 m cells visited")
+            ->capture_default_str());
+    given.push_back(cmd->add_option("--goal-visits", o->nav.goal_visits, "... and this many visits of each goal")
+                        ->capture_default_str());
+    for (CLI::Option* g : given) config->excludes(g);
+    cmd->add_flag("--dry-run", o->dry_run, "Read and check everything, say what would run, and exit");
+    o->run.add_out(*cmd, "Output folder (runs/ in it keeps each finished learning run, to resume)");
     o->run.add_no_report(*cmd);
     cmd->callback([o] { navigate_command(*o); });
 }

@@ -23,6 +23,14 @@ def floats(table, key):
     return table[key].astype(float)
 
 
+def only(table, model):
+    """The rows of one model (tables of several models carry a model column)."""
+    if not table or "model" not in table:
+        return table
+    pick = table["model"] == model
+    return {k: v[pick] for k, v in table.items()}
+
+
 def reward_background(ax, maps, seed, goal):
     pick = (floats(maps, "seed") == seed) & (floats(maps, "goal") == goal)
     sc = ax.scatter(floats(maps, "x")[pick], floats(maps, "y")[pick], c=floats(maps, "reward")[pick], s=12,
@@ -34,6 +42,8 @@ def main(folder, world=""):
     folder = pathlib.Path(folder)
     starts, paths, maps, learning = (read(folder / n) for n in ("starts.csv", "paths.csv", "reward_map.csv",
                                                                  "learning.csv"))
+    model = starts["model"][0]  # the figures show the first model of the folder
+    starts, paths, maps, learning = (only(t, model) for t in (starts, paths, maps, learning))
     seeds = np.unique(floats(starts, "seed"))
     seed = seeds[0]
     goals = sorted({(float(x), float(y)) for x, y in zip(starts["goal_x"], starts["goal_y"])})
@@ -58,7 +68,7 @@ def main(folder, world=""):
         ax.set_title(f"goal ({gx:g}, {gy:g}): paths (blue reached, red failed)")
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
-    fig.suptitle(f"{world} seed {seed:g}")
+    fig.suptitle(f"{world}, model {model}, seed {seed:g}")
     save(fig, folder / "paths.png")
     # The reward maps of the first seed.
     if maps:
@@ -79,7 +89,7 @@ def main(folder, world=""):
             ax.plot(learn[s], np.median(floats(starts, "path_ratio")[pick]), "o", color="C0")
     ax.set_xlabel("learning time (simulated h)")
     ax.set_ylabel("path ratio (median of reached starts)")
-    ax.set_title("path ratio against learning time")
+    ax.set_title(f"path ratio against learning time ({model})")
     save(fig, folder / "path_ratio_learning.png")
 
 

@@ -5,6 +5,7 @@ Every ```yaml block of README.md and docs/*.md carries a marker on the line befo
   writes every key with its exact value, so the docs restate no default by hand);
 - `<!-- example: trial|model|sensor|sweep -->`: the block is a configuration the program reads, and it
   restates no preset or default value rounded (e.g. `alpha_pb: 0.7071` for √0.5 gives other results);
+- `<!-- example: navigate -->`: a file `bvc3d navigate --config` reads (checked with --dry-run);
 - `<!-- schema: world -->`: a list of keys with letters for numbers, not a file to read.
 The model files and sweeps in configs/ get the example checks, and a sweep's comment that counts its
 trials must count what `bvc3d sweep --dry-run` lists.
@@ -53,7 +54,7 @@ def by_kind(prefix):
 
 def test_every_yaml_block_is_marked():
     assert BLOCKS, "no YAML blocks found: the pages moved?"
-    kinds = re.compile(r"^(bvc3d config( .*)?|example: (trial|model|sensor|sweep)|schema: world)$")
+    kinds = re.compile(r"^(bvc3d config( .*)?|example: (trial|model|sensor|sweep|navigate)|schema: world)$")
     unmarked = [f"{block_id(b)} ({b[2] or 'no marker'})" for b in BLOCKS if not kinds.match(b[2])]
     assert not unmarked, f"YAML blocks without a known marker: {unmarked}"
     assert by_kind("bvc3d config"), "the docs show no generated configuration"
@@ -157,6 +158,10 @@ def test_examples_load_and_restate_no_default_rounded(block, tmp_path):
         sweep = tmp_path / "sweep.yaml"
         sweep.write_text(text)
         run_cli("sweep", sweep, "--dry-run", check=True, cwd=SOURCE_DIR)
+    elif kind == "navigate":
+        nav = tmp_path / "nav.yaml"
+        nav.write_text(text)
+        run_cli("navigate", "--config", nav, "--dry-run", check=True, cwd=SOURCE_DIR)
     else:
         check_config(kind, data, tmp_path, where)
 

@@ -2,7 +2,9 @@
 adjacency's update on a hand-made sequence, replay and the reward read-out on a hand-made chain of cells, the
 direction choice, the shortest path against the arena's geometry, and `bvc3d navigate` on bad input."""
 import math
+import signal
 import subprocess
+import time
 
 import numpy as np
 import pytest
@@ -164,3 +166,62 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
     with pytest.raises(ValueError, match="goal 1"):
         bvc3d.navigate(world, [[30.0, 0.0]])
+
+
+def test_navigate_killed_resumes_from_its_finished_runs_and_writes_the_same_files(tmp_path):
+    """A navigate run killed (SIGKILL) after its first learning run and started again takes that run from
+    runs/seed-0.nav and writes byte for byte what an uninterrupted run writes; other options start afresh."""
+    def options(starts):
+        return ["navigate", "--world", "cross", "--goals", "3.5,3.5", "--seeds", "3", "--starts", starts,
+                "--max-learn-hours", "0.1", "--no-report"]
+    args = options("2")
+    whole = tmp_path / "whole"
+    assert run(*args, "--out", str(whole)).returncode == 0
+    part = tmp_path / "part"
+    proc = subprocess.Popen([CLI, *args, "--out", str(part)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 300
+    while not (part / "runs" / "seed-0.nav").exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL, "the run ended before it could be killed"
+    assert not (part / "starts.csv").exists() and not (part / "runs" / "seed-2.nav").exists()
+    again = run(*args, "--out", str(part))
+    assert again.returncode == 0, again.stderr
+    assert "seed 0: already done" in again.stderr and "seed 2: learning" in again.stderr
+    names = sorted(p.relative_to(whole) for p in whole.rglob("*") if p.is_file())
+    assert names == sorted(p.relative_to(part) for p in part.rglob("*") if p.is_file())
+    assert "starts.csv" in map(str, names) and "runs/seed-2.nav" in map(str, names)
+    for name in names:
+        assert (whole / name).read_bytes() == (part / name).read_bytes(), name
+    other = run(*options("1"), "--out", str(part))
+    assert other.returncode == 0 and "seed 0: learning" in other.stderr, other.stderr
+
+
+def test_navigate_config_runs_several_models_as_the_options_would(tmp_path):
+    """A YAML file with two models gives, for each, what the command-line options give for that model alone."""
+    (tmp_path / "nav.yaml").write_text(
+        "world: cross\ngoals: [[3.5, 3.5]]\nmodels: [2d, 3d-0.2]\nseeds: 2\nfirst_seed: 4\n"
+        "navigation: {starts: 1, max_learn_hours: 0.05}\n")
+    r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--out", str(tmp_path / "yaml"), "--no-report")
+    assert r.returncode == 0, r.stderr
+    rows = (tmp_path / "yaml" / "starts.csv").read_text().splitlines()
+    assert [row.split(",")[1:3] for row in rows[1:]] == [["2d", "4"], ["2d", "5"], ["3d-0.2", "4"], ["3d-0.2", "5"]]
+    for model in ("2d", "3d-0.2"):
+        one = tmp_path / model
+        r = run("navigate", "--world", "cross", "--goals", "3.5,3.5", "--model", model, "--seeds", "2",
+                "--first-seed", "4", "--starts", "1", "--max-learn-hours", "0.05", "--out", str(one), "--no-report")
+        assert r.returncode == 0, r.stderr
+        alone = (one / "starts.csv").read_text().splitlines()
+        assert [row for row in rows if row.split(",")[1] == model] == alone[1:]
+    summary = (tmp_path / "yaml" / "summary.csv").read_text().splitlines()
+    assert [row.split(",")[1] for row in summary[1:]] == ["2d", "3d-0.2"]
+
+
+def test_navigate_config_refuses_unknown_keys_and_options_beside_it(tmp_path):
+    (tmp_path / "nav.yaml").write_text("world: cross\ngoals: [[3.5, 3.5]]\nreward: {betta: 5}\n")
+    r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--out", str(tmp_path / "out"))
+    assert r.returncode == 2 and "reward.betta" in r.stderr and "unknown key" in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+    r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--world", "cross", "--out", str(tmp_path / "out"))
+    assert r.returncode != 0 and "--world" in r.stderr, r.stderr

@@ -1,7 +1,10 @@
 // Navigation (docs/navigation.md#speed): one exploitation decision — the rollouts of every HD direction through a
 // learned adjacency — and a whole decision with the sensor, BVCs and place cells, for the paper's 250 place cells and
 // for adjacencies of the authors' multiscale sizes (2 000 / 1 000 / 500 cells per scale; learned here on a
-// synthetic walk of sparse place fields, the multiscale network itself not being in the library yet).
+// synthetic walk of sparse place fields, the multiscale network itself not being in the library yet). The second
+// argument p: the products read the sparse copy with prune = 10^(−p/2) (p = 2: 10⁻¹, 3: 3.2·10⁻², 4: 10⁻²; p = 0:
+// prune 0, every non-zero weight, the exact products); the third T: steps of each rollout (SPEC: 3); counters give
+// the copy's entries and bytes against the dense n_hd·n² float32.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -42,6 +45,7 @@ struct Learned {
     HdAdjacency adj;
     std::vector<double> w;
     double width;
+    explicit Learned(int n) : Learned(n, n >= 2000 ? 0.5 : n >= 1000 ? 1.0 : 1.5) {}
     Learned(int n, double width_) : fields(n), adj(n), width(width_) {
         Rng rng(2, Stream::walk);
         double x = 0, y = 0, h = 0;
@@ -55,17 +59,58 @@ struct Learned {
     }
 };
 
-void BM_DirectionChoice(benchmark::State& state) {
-    const int n = static_cast<int>(state.range(0));
-    const double width = n >= 2000 ? 0.5 : n >= 1000 ? 1.0 : 1.5;
+Learned& learned(int n) {
     static std::map<int, std::unique_ptr<Learned>> cache;
     auto& l = cache[n];
-    if (!l) l = std::make_unique<Learned>(n, width);
-    const auto v = l->fields.rates(-3, -2, width);
-    for (auto _ : state) benchmark::DoNotOptimize(direction_returns(l->adj, l->w, v));
-    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+    if (!l) l = std::make_unique<Learned>(n);
+    return *l;
 }
-BENCHMARK(BM_DirectionChoice)->Arg(250)->Arg(500)->Arg(1000)->Arg(2000)->Unit(benchmark::kMicrosecond);
+
+double prune_of(const benchmark::State& state) {
+    return state.range(1) ? std::pow(10.0, -double(state.range(1)) / 2) : 0;
+}
+RewardParams rollout_of(const benchmark::State& state) {
+    RewardParams p;
+    p.rollout_steps = static_cast<int>(state.range(2));
+    return p;
+}
+
+void BM_DirectionChoice(benchmark::State& state) {
+    const int n = static_cast<int>(state.range(0));
+    const Learned& l = learned(n);
+    const SparseAdjacency sparse(l.adj, prune_of(state));
+    const auto v = l.fields.rates(-3, -2, l.width);
+    const RewardParams p = rollout_of(state);
+    for (auto _ : state) benchmark::DoNotOptimize(direction_returns(sparse, l.w, v, p));
+    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["entries"] = double(sparse.entries());
+    state.counters["MB"] = sparse.bytes() / 1e6;
+    state.counters["dense_MB"] = HdAdjacency::bytes(n, l.adj.n_hd()) / 1e6;
+}
+BENCHMARK(BM_DirectionChoice)->ArgsProduct({{250, 1000, 2000}, {0, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
+
+// The authors' multiscale size: three scales of 2 000 / 1 000 / 500 place cells, each scale's rollouts (the scales'
+// combination, a softmax over 8 numbers, is left out).
+void BM_DirectionChoiceMultiscale(benchmark::State& state) {
+    std::vector<const Learned*> scales;
+    std::vector<SparseAdjacency> sparse;
+    double bytes = 0, dense = 0;
+    for (int n : {2000, 1000, 500}) {
+        scales.push_back(&learned(n));
+        sparse.emplace_back(scales.back()->adj, prune_of(state));
+        bytes += sparse.back().bytes(), dense += HdAdjacency::bytes(n, 8);
+    }
+    std::vector<std::vector<double>> v;
+    for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
+    const RewardParams p = rollout_of(state);
+    for (auto _ : state)
+        for (std::size_t s = 0; s < scales.size(); ++s)
+            benchmark::DoNotOptimize(direction_returns(sparse[s], scales[s]->w, v[s], p));
+    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["MB"] = bytes / 1e6;
+    state.counters["dense_MB"] = dense / 1e6;
+}
+BENCHMARK(BM_DirectionChoiceMultiscale)->ArgsProduct({{3500}, {0, 2, 3, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
 
 // A whole decision of the paper's 2d model: scan, BVCs, one place-cell step, the rollouts.
 void BM_DecisionWithModel(benchmark::State& state) {
@@ -74,7 +119,8 @@ void BM_DecisionWithModel(benchmark::State& state) {
     const Lidar lidar(model.sensor);
     const BoundaryVectorLayer layer(model.bvc);
     PlaceCellNetwork net(static_cast<int>(layer.n_cells()), model.place, 0);
-    static Learned l(250, 1.5);
+    const Learned& l = learned(250);
+    const SparseAdjacency sparse(l.adj);
     Scan scan;
     std::vector<double> bvc(layer.n_cells());
     for (auto _ : state) {
@@ -82,7 +128,7 @@ void BM_DecisionWithModel(benchmark::State& state) {
         layer.rates(scan, bvc);
         const auto p = net.step(bvc, false);
         const std::vector<double> v(p.begin(), p.end());
-        benchmark::DoNotOptimize(direction_returns(l.adj, l.w, v));
+        benchmark::DoNotOptimize(direction_returns(sparse, l.w, v));
     }
     state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }

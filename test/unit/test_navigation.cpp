@@ -126,6 +126,43 @@ TEST(HdAdjacency, UpdateIsAntisymmetricSkipsBumpsAndDecays) {
     EXPECT_EQ(adj.weight(0, 2, 1), 0.0);
 }
 
+// The sparse copy navigation multiplies with: prune 0 gives exactly the dense products' bits (both of apply's forms:
+// few active cells, many); a prune leaves out the weights at most that fraction of their matrix's largest, and the
+// products are those of the matrices with them set to 0 (summed here another way).
+TEST(HdAdjacency, SparseCopyIsExactAtPruneZeroAndDropsOnlySmallWeights) {
+    const int n = 40;
+    HdAdjacency adj(n);
+    std::mt19937 gen(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int t = 0; t < 300; ++t) {
+        std::vector<double> v(n, 0.0);
+        for (int c = 0; c < 3; ++c) v[std::size_t((t / 4 + c * 7) % n)] = u(gen);
+        adj.learn(v, hd_rates(6.3 * u(gen)), t % 11 == 0);
+    }
+    const SparseAdjacency exact(adj, 0.0), pruned(adj, 0.05);
+    EXPECT_LT(pruned.entries(), exact.entries());
+    for (int active : {3, 30}) {
+        std::vector<double> x(n, 0.0);
+        for (int c = 0; c < active; ++c) x[std::size_t((c * 13) % n)] = u(gen);
+        std::vector<double> dense(n), a(n), b(n);
+        for (int k = 0; k < adj.n_hd(); ++k) {
+            adj.apply(k, x, dense);
+            exact.apply(k, x, a);
+            pruned.apply(k, x, b);
+            double top = 0;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) top = std::max(top, std::abs(adj.weight(k, i, j)));
+            for (int i = 0; i < n; ++i) {
+                EXPECT_EQ(a[std::size_t(i)], dense[std::size_t(i)]) << "k " << k << " i " << i;
+                double kept = 0;
+                for (int j = 0; j < n; ++j)
+                    if (std::abs(adj.weight(k, i, j)) > 0.05 * top) kept += adj.weight(k, i, j) * x[std::size_t(j)];
+                EXPECT_NEAR(b[std::size_t(i)], kept, 1e-6 * top) << "k " << k << " i " << i;
+            }
+        }
+    }
+}
+
 namespace {
 
 // A chain of n cells along x: heading east (HD 0) cell i+1 follows cell i, heading west (HD 4) the reverse.

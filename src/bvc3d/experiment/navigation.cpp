@@ -88,7 +88,7 @@ struct Senses {
 // SPEC §17's choice: softmax(β·R) over the offered directions, sampled.
 class RewardPolicy : public DirectionPolicy {
 public:
-    RewardPolicy(const HdAdjacency& adj, const std::vector<double>& w, const std::vector<double>& v,
+    RewardPolicy(const SparseAdjacency& adj, const std::vector<double>& w, const std::vector<double>& v,
                  const RewardParams& p, Rng& rng)
         : adj_(adj), w_(w), v_(v), p_(p), rng_(rng) {}
     int choose(const Pose&, std::span<const char> allowed) override {
@@ -106,7 +106,7 @@ public:
     }
 
 private:
-    const HdAdjacency& adj_;
+    const SparseAdjacency& adj_;
     const std::vector<double>& w_;
     const std::vector<double>& v_;
     RewardParams p_;
@@ -191,13 +191,14 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
         if (goals_done && run.coverage >= nav.coverage) break;
     }
 
-    // Exploitation.
+    // Exploitation, on the learned adjacency's sparse copy.
+    const SparseAdjacency frozen(adj);
     int n_parts = 0;
     const auto parts = path_grid.parts(s.robot.radius, n_parts);
     const auto bounds = body->walkable().bounds();
     for (std::size_t g = 0; g < n_goals; ++g) {
         const Vec2 goal = s.goals[g];
-        run.rewards.push_back(run.goal_cells[g] >= 0 ? replay(adj, run.goal_cells[g], s.reward)
+        run.rewards.push_back(run.goal_cells[g] >= 0 ? replay(frozen, run.goal_cells[g], s.reward)
                                                      : std::vector<double>(std::size_t(adj.n_place()), 0.0));
         const auto& w = run.rewards.back();
         run.reward_maps.emplace_back();
@@ -235,7 +236,7 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
             Pose pose = Pose::on_floor(p.x(), p.y(), rng.uniform(-pi, pi));
             std::vector<double> v;
             for (int k = 0; k < std::max(1, nav.settle_steps); ++k) v = senses.step(pose, false);
-            RewardPolicy policy(adj, w, v, s.reward, rng);
+            RewardPolicy policy(frozen, w, v, s.reward, rng);
             GoalSeekingWalk agent(body, s.robot, {adj.n_hd(), nav.step, nav.clearance}, policy, pose);
             out.path.push_back(p);
             while (true) {

@@ -1,6 +1,8 @@
 #include "bvc3d/population/hd_adjacency.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "bvc3d/core/angles.hpp"
@@ -18,7 +20,9 @@ const params::Table<AdjacencyParams>& AdjacencyParams::table() {
          real("tau_x", &AdjacencyParams::tau_x, above(0), "place-cell trace: x += (η/τ_x)(v − x)"),
          real("tau_hd", &AdjacencyParams::tau_hd, above(0), "HD trace: Υ += (η/τ_hd)(v_hd − Υ)"),
          real("rate", &AdjacencyParams::rate, finite(), "a in ΔW_rec[k] = a·Υ_k·(v xᵀ − x vᵀ)"),
-         real("decay", &AdjacencyParams::decay, closed_open(0, 1), "every weight × (1 − decay) per learning step")});
+         real("decay", &AdjacencyParams::decay, closed_open(0, 1), "every weight × (1 − decay) per learning step"),
+         real("prune", &AdjacencyParams::prune, closed_open(0, 1),
+              "navigation's products leave out |w| <= prune × the matrix's largest; 0: exact")});
     return t;
 }
 
@@ -111,6 +115,70 @@ void HdAdjacency::apply(int k, std::span<const double> x, std::span<double> out)
         for (int j = 0; j < n_; ++j) sum += double(row[j]) * x[std::size_t(j)];
         out[std::size_t(i)] = scale_ * sum;
     }
+}
+
+SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
+    : n_(adj.n_),
+      scale_(adj.scale_),
+      antisymmetric_(adj.antisymmetric_),
+      pruned_(prune > 0),
+      rows_(std::size_t(adj.p_.n_hd)) {
+    if (!(prune >= 0 && prune < 1)) throw InputError("adjacency: prune must lie in [0, 1)");
+    if (std::size_t(adj.n_) * std::size_t(adj.n_) > std::size_t(UINT32_MAX))
+        throw InputError("adjacency: too many place cells for the sparse copy (" + std::to_string(adj.n_) + ")");
+    for (int k = 0; k < adj.p_.n_hd; ++k) {
+        const float* m = &adj.m_[adj.index(k, 0, 0)];
+        float top = 0.0f;
+        for (std::size_t e = 0; e < std::size_t(n_) * std::size_t(n_); ++e) top = std::max(top, std::abs(m[e]));
+        // |w| > cut: with prune = 0, every non-zero weight (symmetric in i, j: the copy stays antisymmetric).
+        const float cut = static_cast<float>(prune * double(top));
+        Rows& r = rows_[std::size_t(k)];
+        r.start.assign(std::size_t(n_) + 1, 0);
+        for (int i = 0; i < n_; ++i) {
+            const float* row = m + std::size_t(i) * std::size_t(n_);
+            for (int j = 0; j < n_; ++j)
+                if (std::abs(row[j]) > cut) r.col.push_back(std::uint32_t(j)), r.w.push_back(row[j]);
+            r.start[std::size_t(i) + 1] = std::uint32_t(r.col.size());
+        }
+    }
+}
+
+void SparseAdjacency::apply(int k, std::span<const double> x, std::span<double> out) const {
+    // The same two forms, in the same order, as HdAdjacency::apply: a left-out weight only adds ±0 there.
+    // A pruned copy's bits are its own: it takes the column form whenever that reads fewer entries (a rollout's
+    // state after a step covers a fifth to a third of the cells: a third of the entries or less).
+    const Rows& r = rows_[std::size_t(k)];
+    std::size_t active = 0, work = 0;
+    for (std::size_t j = 0; j < x.size(); ++j)
+        if (x[j] != 0.0) ++active, work += r.start[j + 1] - r.start[j];
+    if (antisymmetric_ && (4 * active < std::size_t(n_) || (pruned_ && work < r.col.size()))) {
+        std::fill(out.begin(), out.end(), 0.0);
+        for (int j = 0; j < n_; ++j) {
+            const double xj = x[std::size_t(j)];
+            if (xj == 0.0) continue;
+            for (std::uint32_t e = r.start[std::size_t(j)]; e < r.start[std::size_t(j) + 1]; ++e)
+                out[r.col[e]] -= xj * double(r.w[e]);
+        }
+        for (double& o : out) o *= scale_;
+        return;
+    }
+    for (int i = 0; i < n_; ++i) {
+        double sum = 0.0;
+        for (std::uint32_t e = r.start[std::size_t(i)]; e < r.start[std::size_t(i) + 1]; ++e)
+            sum += double(r.w[e]) * x[r.col[e]];
+        out[std::size_t(i)] = scale_ * sum;
+    }
+}
+
+std::size_t SparseAdjacency::entries() const {
+    std::size_t e = 0;
+    for (const Rows& r : rows_) e += r.col.size();
+    return e;
+}
+
+double SparseAdjacency::bytes() const {
+    return double(entries()) * (sizeof(std::uint32_t) + sizeof(float)) +
+           double(rows_.size()) * double(n_ + 1) * sizeof(std::uint32_t);
 }
 
 std::vector<StateArray> HdAdjacency::state() const {

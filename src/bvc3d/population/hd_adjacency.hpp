@@ -13,11 +13,18 @@
 // traces are updated first and the update reads the new ones (SPEC's order). HD rates are SPEC §16's
 // cells, v_k = cos(h − 2πk/n_hd) (hd_rates below), unless a model gives an HD population.
 //
-// Memory: n_hd dense float32 matrices, n_hd·n²·4 bytes (8 HD cells: 2 MB for the paper's 250 place cells,
-// 128 MB for 2 000, 392 MB for 3 500): checked against the free memory before it is taken. The decay is a
-// common scale factor (W = scale·M, folded back into M when it falls below 10⁻⁶), and the update touches
-// only the rows and columns of the active cells: a step costs O(n_hd · active · n), not O(n_hd · n²). Products
-// W·x with few active cells read only their rows (W is antisymmetric), which makes a rollout cheap.
+// Memory while learning: n_hd dense float32 matrices, n_hd·n²·4 bytes (8 HD cells: 2 MB for the paper's 250
+// place cells, 128 MB for 2 000, 392 MB for 3 500): checked against the free memory before it is taken. The decay
+// is a common scale factor (W = scale·M, folded back into M when it falls below 10⁻⁶), and the update touches
+// only the rows and columns of the active cells: a step costs O(n_hd · active · n), not O(n_hd · n²).
+//
+// Products for navigation (replay, the rollouts) read a SparseAdjacency, a frozen copy in compressed rows. With
+// `prune` = 0 (the default) it keeps every non-zero weight and gives exactly the dense products' bits. The trace x
+// of a cell never returns to exactly 0 once it fired, so W_rec[k][i][j] becomes non-zero for nearly every pair of
+// cells ever active within a few thousand steps of each other (the copy then holds ~all n² entries), but only the
+// pairs active together within ~τ_x/η ≈ 30 steps carry weights near the largest. `prune` = p leaves out the
+// weights with |w| ≤ p · max|W_rec[k]|: at p = 10⁻² the copy keeps 2–25 % of the entries (docs/performance.md),
+// and the far cells no longer rise a hair above 0 in a rollout's tanh([Wx − x]+).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -34,6 +41,7 @@ struct AdjacencyParams {
     double tau_hd = 0.1;  // HD trace: Υ += (η/τ_hd)(v_hd − Υ)
     double rate = 0.3;    // a in ΔW_rec[k] = a·Υ_k·(v xᵀ − x vᵀ)
     double decay = 1e-4;  // δ: every weight × (1 − δ) per learning step
+    double prune = 0.0;   // products leave out |w| ≤ prune · max|W_rec[k]| (SparseAdjacency); 0: none
     static const params::Table<AdjacencyParams>& table();
     void validate() const { table().check(*this); }
 };
@@ -74,6 +82,36 @@ private:
     bool antisymmetric_ = true;  // as learned; a hand-made W need not be
     std::vector<double> x_, u_;
     std::vector<int> active_;
+    friend class SparseAdjacency;
+};
+
+// A frozen copy of an adjacency for products (see above): per HD cell, the weights with |w| > prune·max|W_rec[k]|
+// in compressed rows (column index and float32 value, 8 bytes an entry). With prune 0, apply() gives the same bits
+// as HdAdjacency::apply; pruned, the products of the matrices with the left-out weights set to 0 (its sums in the
+// order that reads fewer entries).
+class SparseAdjacency {
+public:
+    explicit SparseAdjacency(const HdAdjacency& adj) : SparseAdjacency(adj, adj.params().prune) {}
+    SparseAdjacency(const HdAdjacency& adj, double prune);
+
+    int n_place() const { return n_; }
+    int n_hd() const { return static_cast<int>(rows_.size()); }
+    // out = W_rec[k]·x (n each).
+    void apply(int k, std::span<const double> x, std::span<double> out) const;
+    std::size_t entries() const;
+    double bytes() const;
+
+private:
+    struct Rows {
+        std::vector<std::uint32_t> start;  // n + 1 offsets into col and w
+        std::vector<std::uint32_t> col;
+        std::vector<float> w;
+    };
+    int n_;
+    double scale_;
+    bool antisymmetric_;
+    bool pruned_;
+    std::vector<Rows> rows_;
 };
 
 // The adjacency as a population of a model: reads the place cells (and an HD population, if a second input

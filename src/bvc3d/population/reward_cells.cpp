@@ -21,6 +21,10 @@ const params::Table<RewardParams>& RewardParams::table() {
 }
 
 std::vector<double> replay(const HdAdjacency& adj, int goal_cell, const RewardParams& p) {
+    return replay(SparseAdjacency(adj), goal_cell, p);
+}
+
+std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const RewardParams& p) {
     const auto n = std::size_t(adj.n_place());
     if (goal_cell < 0 || std::size_t(goal_cell) >= n)
         throw InputError("replay: goal cell " + std::to_string(goal_cell) + " is not one of " + std::to_string(n));
@@ -52,6 +56,11 @@ double reward(std::span<const double> w, std::span<const double> v) {
 }
 
 std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const double> w, std::span<const double> v,
+                                      const RewardParams& p) {
+    return direction_returns(SparseAdjacency(adj), w, v, p);
+}
+
+std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<const double> w, std::span<const double> v,
                                       const RewardParams& p) {
     const auto n = std::size_t(adj.n_place());
     std::vector<double> out(std::size_t(adj.n_hd()), 0.0), x(n), y(n);

@@ -11,6 +11,8 @@
 //       x_{t+1} = tanh([W_rec[k]·x_t − x_t]+),   R_k = Σ_{t=0}^{T−1} γ^t r(x_{t+1})
 // with λ = 20 and A = 5/λ (the authors' smallest scale), T = 3, γ = 0.7. The authors sample 10 rollouts
 // per direction; the rollout here is deterministic, so one is all 10 would be (docs/navigation.md).
+// Both read the adjacency's frozen sparse copy (hd_adjacency.hpp: weights below `prune` of the largest left out);
+// the forms taking an HdAdjacency make that copy first (O(n_hd·n²)): navigation makes it once per learning run.
 #include <span>
 #include <vector>
 
@@ -31,10 +33,13 @@ struct RewardParams {
 };
 
 // The reward cell's weights after replay from place cell `goal_cell`.
+std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const RewardParams& params = {});
 std::vector<double> replay(const HdAdjacency& adj, int goal_cell, const RewardParams& params = {});
 // r(v) = w·v / max(|v|₁, 10⁻⁴).
 double reward(std::span<const double> w, std::span<const double> v);
 // R_k for each HD direction k.
+std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<const double> w, std::span<const double> v,
+                                      const RewardParams& params = {});
 std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const double> w, std::span<const double> v,
                                       const RewardParams& params = {});
 // softmax(β·values) over the entries where `allowed` (others 0; all 0 if none is allowed).
