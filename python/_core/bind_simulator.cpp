@@ -90,6 +90,13 @@ void bind_world(pyb::module_& m) {
             [](const std::filesystem::path& path) { return World(config::load_world_file(path.string())); },
             pyb::arg("path"))
         .def_static(
+            "from_yaml_text",
+            [](const std::string& text, const std::string& name) {
+                return World(config::world_from_yaml(config::YamlView::load_string(text, name)));
+            },
+            pyb::arg("text"), pyb::arg("name") = "<python>",
+            "A world from the text of a world YAML (docs/worlds.md); errors name `name` and the key")
+        .def_static(
             "preset",
             [](const std::string& name, std::optional<double> tilt_deg) {
                 return World(config::resolve_world(name, tilt_deg));

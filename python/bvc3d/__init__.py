@@ -15,6 +15,7 @@ from ._core import place_recognition, scan_context, scan_context_distance
 from ._core import lidar_models, route, tour, write_trajectory
 from ._core import GridCells, HeadDirectionCells
 from . import analysis
+from . import worlds  # World.from_dict, World.from_triangles
 
 __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording", "Sensor", "World", "analysis",
            "choose_elevations", "flying_walk", "localize", "metric_table", "model_presets", "model_sensor",

@@ -173,10 +173,12 @@ SphereSet point_cloud_from_yaml(const YamlView& v) {
     return set;
 }
 
+constexpr const char* kObjectKinds = "cross_arena, box, quad, triangle, tilted_wall, mesh or point_cloud";
+
 // One entry of `objects`: a map with exactly one key naming the primitive.
 void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDescription>& arena) {
     if (!obj.is_map() || obj.keys().size() != 1)
-        obj.fail("each object is a mapping with one key: cross_arena, box, quad, tilted_wall, mesh or point_cloud");
+        obj.fail(std::string("each object is a mapping with one key: ") + kObjectKinds);
     const std::string kind = obj.keys().front();
     const YamlView v = obj[kind];
     TriangleMesh part;
@@ -198,6 +200,9 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         Vec3 c[4];
         for (int i = 0; i < 4; ++i) c[i] = vec3(v.at(i));
         part.add_quad(c[0], c[1], c[2], c[3]);
+    } else if (kind == "triangle") {
+        if (!v.is_sequence() || v.size() != 3) v.fail("a triangle is a list of 3 corners [x, y, z]");
+        part.add_triangle(vec3(v.at(0)), vec3(v.at(1)), vec3(v.at(2)));
     } else if (kind == "tilted_wall") {
         TiltedWall t;
         double yaw = 0.0, tilt = 0.0;
@@ -236,8 +241,7 @@ void add_object(const YamlView& obj, WorldDescription& w, std::optional<WorldDes
         w.spheres.push_back(point_cloud_from_yaml(v));
         return;
     } else {
-        obj.fail("unknown object kind '" + kind +
-                 "' (expected cross_arena, box, quad, tilted_wall, mesh or point_cloud)");
+        obj.fail("unknown object kind '" + kind + "' (expected " + kObjectKinds + ")");
     }
     check_mesh(v, part);
     w.mesh.append(part);
