@@ -2,6 +2,8 @@
 // hand, the shortest path of SPEC §17, and a whole navigation run.
 #include "bindings.hpp"
 
+#include <cmath>
+
 #include "bvc3d/agent/body_collider.hpp"
 #include "bvc3d/agent/shortest_path.hpp"
 #include "bvc3d/config/model_yaml.hpp"
@@ -15,6 +17,8 @@ std::vector<double> vector_of(const pyb::handle& obj, const std::string& name, s
     const auto a = real_array(obj, name);
     if (a.ndim() != 1 || std::size_t(a.shape(0)) != n)
         throw InputError(name + " must be a 1-D array of " + std::to_string(n) + " values");
+    for (std::size_t i = 0; i < n; ++i)
+        if (!std::isfinite(a.data()[i])) throw InputError(name + "[" + std::to_string(i) + "] is not finite");
     return {a.data(), a.data() + n};
 }
 
