@@ -295,7 +295,8 @@ TEST(Seams, AgentKindsAreFoundByNameByYamlKeyAndBySpec) {
     }
     // A parameter in the YAML reaches the agent through its kind's table.
     const auto fly = dir.write("fly.yaml", "world: flight-room\nmodel: fly-up\nflight: {radius: 0.3}\n");
-    const auto* flight = dynamic_cast<const FlightSpec*>(config::load_trial_file(fly.string()).agent.get());
+    const auto fly_trial = config::load_trial_file(fly.string());  // kept: the agent lives in it
+    const auto* flight = dynamic_cast<const FlightSpec*>(fly_trial.agent.get());
     ASSERT_NE(flight, nullptr);
     EXPECT_EQ(flight->flight().radius, 0.3);
     // Unknown names are refused with the names there are; two kinds in one trial are refused.
