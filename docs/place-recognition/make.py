@@ -263,24 +263,37 @@ def figure_kitti(work):
             out = work / f"kitti-{s}-sequential-{recording}"
             pr = read_csv(out / "pr.csv")
             for d in read_csv(out / "details.csv"):
-                name = label(d, recording)
-                points = [p for p in pr if p["descriptor"] == d["descriptor"]]
-                heading = " *" if d["uses_heading"] == "1" else ""
-                ax.plot([float(p["recall"]) for p in points], [float(p["precision"]) for p in points], lw=1.2,
-                        ls="--" if recording == "heights" else "-",
-                        label=f"{name}{heading}: R@1 {100 * float(d['recall_at_1']):.1f}%, "
-                              f"F1 {float(d['f1_max']):.2f}")
-        ax.set_title(f"KITTI {s}, sequential loop closure", fontsize=10)
-        ax.set_xlabel("recall")
-        ax.set_xlim(0, 1.02)
-        ax.set_ylim(0, 1.02)
-        ax.legend(fontsize=6.5, loc="lower left")
+                plot_curve(ax, d, pr, label(d, recording), 1.2, recording == "heights")
+        finish_pr_panel(ax, f"KITTI {s}, sequential loop closure")
+    save_pr_figure(fig, axes, "pr-kitti.png")
+
+
+def plot_curve(ax, d, pr, name, lw, dashed):
+    """One descriptor's precision-recall curve (its details row d, the run's pr rows), labelled with its
+    recall@1 and F1max; * marks a descriptor that reads the pose's heading."""
+    points = [p for p in pr if p["descriptor"] == d["descriptor"]]
+    heading = " *" if d["uses_heading"] == "1" else ""
+    ax.plot([float(p["recall"]) for p in points], [float(p["precision"]) for p in points], lw=lw,
+            ls="--" if dashed else "-",
+            label=f"{name}{heading}: R@1 {100 * float(d['recall_at_1']):.1f}%, F1 {float(d['f1_max']):.2f}")
+
+
+def finish_pr_panel(ax, title):
+    ax.set_title(title, fontsize=10)
+    ax.set_xlabel("recall")
+    ax.set_xlim(0, 1.02)
+    ax.set_ylim(0, 1.02)
+    ax.legend(fontsize=6.5, loc="lower left")
+
+
+def save_pr_figure(fig, axes, file):
+    import matplotlib.pyplot as plt
     axes[0].set_ylabel("precision")
     fig.suptitle("* reads the pose's heading", fontsize=9, x=0.99, ha="right")
     fig.tight_layout()
-    fig.savefig(FIGURES / "pr-kitti.png", dpi=110)
+    fig.savefig(FIGURES / file, dpi=110)
     plt.close(fig)
-    log("wrote", FIGURES / "pr-kitti.png")
+    log("wrote", FIGURES / file)
 
 
 def f1_threshold(pr_rows):
@@ -553,23 +566,9 @@ def figure_buildings_pr(work):
         out = work / f"{name}-tour"
         pr = read_csv(out / "pr.csv")
         for d in read_csv(out / "details.csv"):
-            points = [p for p in pr if p["descriptor"] == d["descriptor"]]
-            heading = " *" if d["uses_heading"] == "1" else ""
-            ax.plot([float(p["recall"]) for p in points], [float(p["precision"]) for p in points], lw=1.1,
-                    ls="--" if d["descriptor"].startswith(("bvc-", "place-")) else "-",
-                    label=f"{d['descriptor']}{heading}: R@1 {100 * float(d['recall_at_1']):.1f}%, "
-                          f"F1 {float(d['f1_max']):.2f}")
-        ax.set_title(f"{name} tour ({BUILDING_SENSOR}), sequential loop closure", fontsize=10)
-        ax.set_xlabel("recall")
-        ax.set_xlim(0, 1.02)
-        ax.set_ylim(0, 1.02)
-        ax.legend(fontsize=6.5, loc="lower left")
-    axes[0].set_ylabel("precision")
-    fig.suptitle("* reads the pose's heading", fontsize=9, x=0.99, ha="right")
-    fig.tight_layout()
-    fig.savefig(FIGURES / "pr-buildings.png", dpi=110)
-    plt.close(fig)
-    log("wrote", FIGURES / "pr-buildings.png")
+            plot_curve(ax, d, pr, d["descriptor"], 1.1, d["descriptor"].startswith(("bvc-", "place-")))
+        finish_pr_panel(ax, f"{name} tour ({BUILDING_SENSOR}), sequential loop closure")
+    save_pr_figure(fig, axes, "pr-buildings.png")
 
 
 def driven_twice(route, work, name, lift):
