@@ -103,6 +103,7 @@ void kernels::dots(const float* q, std::size_t rows, const float* t, std::size_t
     if (isa == simd::Isa::v4) return v4::dots(q, rows, t, n, stride, out, out_stride);
     if (isa == simd::Isa::v3) return v3::dots(q, rows, t, n, stride, out, out_stride);
 #endif
+    (void)isa;  // no clones in this build: the baseline is all there is
     baseline::dots(q, rows, t, n, stride, out, out_stride);
 }
 

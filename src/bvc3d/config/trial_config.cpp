@@ -150,7 +150,8 @@ std::string weights_model_mismatch(const std::string& trained, const ModelSpec& 
     const auto theirs = bvc_keys(trained), ours = bvc_keys(config::model_to_yaml(model));
     if (theirs.empty()) return "";  // not a model's text: nothing to compare
     for (const auto& [key, value] : ours) {
-        const auto it = std::find_if(theirs.begin(), theirs.end(), [&](const auto& kv) { return kv.first == key; });
+        const std::string& name = key;  // clang 14 cannot capture a structured binding
+        const auto it = std::find_if(theirs.begin(), theirs.end(), [&](const auto& kv) { return kv.first == name; });
         const std::string was = it == theirs.end() ? "(absent)" : it->second;
         if (was != value) return "bvc." + key + " is " + was + " in the model that trained them, " + value + " here";
     }

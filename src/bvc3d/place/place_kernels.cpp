@@ -140,7 +140,7 @@ std::size_t to_floats(const double* in, float* out, std::size_t n, float tiny) {
         simd::load(x, in + j);
         bad += x - x;
         const f8 f = __builtin_convertvector(x, f8);
-        simd::store(out + j, (f < lo) & (f > -lo) ? zero : f);
+        simd::store(out + j, ((f < lo) & (f > -lo)) ? zero : f);
     }
     const bool finite = simd::all_zero(bad);
     for (std::size_t i = 0; i < j && !finite; ++i)
@@ -202,7 +202,7 @@ void oja_row(float* __restrict w, const float* __restrict v, float a, float c, f
         simd::load(x, w + 2 * j);
         simd::load(b, v + j);
         x = x + a * (b - c * x);
-        simd::store(w + 2 * j, (x < lo) & (x > -lo) ? zero : x);  // NaN stays NaN
+        simd::store(w + 2 * j, ((x < lo) & (x > -lo)) ? zero : x);  // NaN stays NaN
     }
 }
 

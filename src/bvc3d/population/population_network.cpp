@@ -129,10 +129,10 @@ void PopulationNetwork::restore(const std::vector<std::vector<StateArray>>& stat
 std::vector<std::pair<std::string, std::int64_t>> PopulationNetwork::counters() const {
     std::vector<std::pair<std::string, std::int64_t>> sum;
     for (const PopulationNode& node : nodes_)
-        for (const auto& [name, count] : node.population->counters()) {
-            auto at = std::find_if(sum.begin(), sum.end(), [&](const auto& c) { return c.first == name; });
-            if (at == sum.end()) sum.emplace_back(name, count);
-            else at->second += count;
+        for (const auto& counter : node.population->counters()) {
+            auto at = std::find_if(sum.begin(), sum.end(), [&](const auto& c) { return c.first == counter.first; });
+            if (at == sum.end()) sum.push_back(counter);
+            else at->second += counter.second;
         }
     return sum;
 }

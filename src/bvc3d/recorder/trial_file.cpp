@@ -63,10 +63,10 @@ void write_populations(hid_t f, const ModelRecord& rec, std::size_t n,
             if (name == p.name) write_metrics(g, m);
     }
     // Metrics of no population of its own (a multiscale model's scales fused): a group with the metrics alone.
-    for (const auto& [name, m] : metrics)
+    for (const auto& entry : metrics)
         if (std::none_of(rec.populations.begin(), rec.populations.end(),
-                         [&](const PopulationRecord& p) { return p.name == name; }))
-            write_metrics(h5::create_group(all, name), m);
+                         [&](const PopulationRecord& p) { return p.name == entry.first; }))
+            write_metrics(h5::create_group(all, entry.first), entry.second);
 }
 
 }  // namespace
