@@ -3,6 +3,7 @@ Python, progress lines, seeds over their whole range, summaries that refuse to m
 import csv
 import os
 import pathlib
+import re
 import resource
 import shutil
 import signal
@@ -328,6 +329,28 @@ def test_a_run_that_cannot_fit_in_memory_is_refused_before_it_starts():
     assert proc.returncode == 2
     line = one_error_line(proc.stderr)
     assert "this trial needs about" in line and "MemAvailable" in line and "--no-memory-check" in line
+
+
+def test_the_memory_check_counts_every_recorded_population(tmp_path):
+    # A recorded population keeps one float per cell and sample: 800 grid cells recorded must add at least
+    # samples × 800 × 4 bytes to the estimate of the same model with them not recorded, and a multiscale model (three
+    # place-cell scales and HD cells recorded) at least its scales' rates beyond the paper's 250 cells.
+    def needed(model):
+        proc = run_cli("run", "--model", model, "--sample-hours", "9000", "--explore-hours", "0")
+        assert proc.returncode == 2
+        number, unit = re.search(r"needs about ([0-9.]+) ([kMGTPE]?B) of memory", one_error_line(proc.stderr)).groups()
+        return float(number) * 1000 ** "BkMGTPE".index(unit[0])
+
+    def with_grid(recorded):
+        path = tmp_path / f"grid-{recorded}.yaml"
+        path.write_text(f"name: g{recorded}\nbase: 2d\npopulations:\n"
+                        f"  - {{name: g, kind: grid, n: 800, recorded: {str(recorded).lower()}}}\n")
+        return str(path)
+
+    samples = 9000 * 3600 / 0.288
+    assert needed(with_grid(True)) - needed(with_grid(False)) >= samples * 800 * 4 * 0.99  # 3 digits printed
+    scales = 2000 + 1000 + 500 + 8  # place, place-m, place-l, hd (the grid modules are not recorded)
+    assert needed("ms-2d") - needed("2d") >= samples * (scales - 250) * 4
 
 
 def test_jobs_zero_means_one_per_core_in_the_help():

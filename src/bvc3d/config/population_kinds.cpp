@@ -35,6 +35,9 @@ PopulationSpec head_direction_spec(const std::string& name, const HeadDirectionP
     s.kind = "head-direction";
     s.key = key_of(s.kind, p);
     s.make = [p](const PopulationContext&) { return std::make_unique<HeadDirectionCells>(p); };
+    s.footprint = [p](const std::vector<std::size_t>&) {
+        return PopulationFootprint{p.space == HdSpace::spherical ? 20u : static_cast<std::size_t>(p.n), 0};
+    };
     return s;
 }
 
@@ -45,6 +48,9 @@ PopulationSpec grid_spec(const std::string& name, const GridParams& p) {
     s.kind = "grid";
     s.key = key_of(s.kind, p);
     s.make = [p](const PopulationContext& c) { return std::make_unique<GridCells>(p, c.seed); };
+    s.footprint = [p](const std::vector<std::size_t>&) {
+        return PopulationFootprint{static_cast<std::size_t>(p.n), 24.0 * p.n};  // each cell's orientation, phase
+    };
     return s;
 }
 
@@ -57,6 +63,11 @@ PopulationSpec growing_place_spec(const std::string& name, const PlaceParams& pl
     s.make = [place, growing](const PopulationContext& c) {
         if (c.input_sizes.size() != 1) throw InputError("a growing place-cell network reads one BVC population");
         return std::make_unique<GrowingPlaceCells>(static_cast<int>(c.input_sizes[0]), place, growing, c.seed);
+    };
+    // At its budget: a float weight per cell and input (the vector's doubling may hold up to twice that for a while).
+    s.footprint = [growing](const std::vector<std::size_t>& in) {
+        const auto n = static_cast<std::size_t>(growing.budget);
+        return PopulationFootprint{n, 2.0 * 4.0 * static_cast<double>(n) * static_cast<double>(in.empty() ? 0 : in[0])};
     };
     return s;
 }
@@ -71,6 +82,9 @@ PopulationSpec bvc_layer_spec(const std::string& name, const BvcParams& p) {
     s.make = [p](const PopulationContext& c) -> std::unique_ptr<Population> {
         if (!c.bvc_group) throw InputError("a BVC layer needs the model's source of returns");
         return std::make_unique<BvcPopulation>(c.bvc_group, c.bvc_group->add(p));
+    };
+    s.footprint = [p](const std::vector<std::size_t>&) {
+        return PopulationFootprint{static_cast<std::size_t>(p.n_cells()), 0};
     };
     return s;
 }
@@ -118,6 +132,11 @@ PopulationSpec grid_place_spec(const std::string& name, const PlaceParams& p, st
             throw InputError("n_place × (BVCs + grid cells) is more than 1e9 weights (4 GB)");
         return std::make_unique<PlacePopulation>(static_cast<int>(c.input_sizes[0]), p, hash_u64(c.seed, tag, 0),
                                                  static_cast<int>(c.input_sizes[1]));
+    };
+    // A float weight per cell and BVC, and per cell and grid cell (the fixed mask, stored as weights).
+    s.footprint = [p](const std::vector<std::size_t>& in) {
+        const double n_in = in.size() > 1 ? static_cast<double>(in[0] + in[1]) : 0;
+        return PopulationFootprint{static_cast<std::size_t>(p.n_place), 4.0 * p.n_place * n_in};
     };
     return s;
 }

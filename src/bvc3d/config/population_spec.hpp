@@ -23,6 +23,13 @@ struct PopulationContext {
     std::shared_ptr<BvcLayerGroup> bvc_group;
 };
 
+// What a population holds, for the memory check before a run: its cells (each recorded sample keeps one float per
+// cell) and the bytes of its state (weights and the like) at their largest.
+struct PopulationFootprint {
+    std::size_t cells = 0;
+    double state_bytes = 0;
+};
+
 struct PopulationSpec {
     std::string name;                 // unique in its model; "bvc" and "place" name the model's own
     std::string kind;                 // for messages and tables
@@ -31,6 +38,8 @@ struct PopulationSpec {
     // Canonical text of everything that changes its results (its kind and parameters): part of the model's.
     std::string key;
     std::function<std::unique_ptr<Population>(const PopulationContext&)> make;
+    // Its footprint for the cells of the populations it reads (in the order of `inputs`).
+    std::function<PopulationFootprint(const std::vector<std::size_t>& input_sizes)> footprint;
 };
 
 }  // namespace bvc3d

@@ -131,6 +131,40 @@ private:
     std::mutex mutex_;
 };
 
+// What a trial's model holds beyond its BVC layer and place cells: every population of ModelSpec::populations (their
+// footprints, resolved in order: each reads only those before it), and the fused scales of a multiscale model.
+struct ModelFootprint {
+    double recorded_cells = 0;    // floats per recorded sample
+    double state_bytes = 0;       // weights and the like
+    double largest_analysed = 0;  // cells of the largest population analysed (the fused scales count as one)
+};
+
+ModelFootprint model_footprint(const ModelSpec& model, bool record_bvc) {
+    std::map<std::string, std::size_t> cells{{"bvc", model.bvc.n_cells()},
+                                             {"place", static_cast<std::size_t>(model.place.n_place)}};
+    ModelFootprint f;
+    f.recorded_cells = model.place.n_place + (record_bvc ? model.bvc.n_cells() : 0);
+    f.largest_analysed = model.place.n_place;
+    double fused = model.place.n_place;
+    for (const PopulationSpec& spec : model.populations) {
+        std::vector<std::size_t> in;
+        for (const auto& name : spec.inputs) in.push_back(cells.count(name) ? cells.at(name) : 0);
+        const PopulationFootprint p = spec.footprint ? spec.footprint(in) : PopulationFootprint{};
+        cells[spec.name] = p.cells;
+        f.state_bytes += p.state_bytes;
+        if (!spec.recorded) continue;
+        f.recorded_cells += static_cast<double>(p.cells);
+        f.largest_analysed = std::max(f.largest_analysed, static_cast<double>(p.cells));
+        if (spec.kind == "place") fused += static_cast<double>(p.cells);
+    }
+    if (!model.place_grid.empty()) f.state_bytes += 4.0 * model.place.n_place * cells[model.place_grid];
+    if (fused > model.place.n_place) {  // analysed as one population, beside the scales' own recorded rates
+        f.recorded_cells += fused;
+        f.largest_analysed = std::max(f.largest_analysed, fused);
+    }
+    return f;
+}
+
 // The peak memory of one group of trials sharing an agent.
 double group_memory(const std::vector<const TrialConfig*>& group) {
     const TrialConfig& first = *group.front();
@@ -139,12 +173,14 @@ double group_memory(const std::vector<const TrialConfig*>& group) {
     double largest_trial = 0;
     for (const auto* t : group) {
         const double n_place = t->model.place.n_place, n_bvc = t->model.bvc.n_cells();
+        const ModelFootprint more = model_footprint(t->model, t->protocol.record_bvc);
         const double gridsize = t->analysis.gridsize;
         const double bins = std::min(samples, 1.2 * gridsize * gridsize);  // hexagons visited, at most
-        const double recorded =
-            samples * n_place * sizeof(float) + (t->protocol.record_bvc ? samples * n_bvc * sizeof(float) : 0);
-        const double weights = n_place * n_bvc * sizeof(float);
-        const double analysis = 4 * bins * n_place * sizeof(double) + samples * n_place * sizeof(double) / 8;
+        const double recorded = samples * more.recorded_cells * sizeof(float);
+        const double weights = n_place * n_bvc * sizeof(float) + more.state_bytes;
+        // One population analysed at a time: its maps and a copy of its rates in double.
+        const double analysis =
+            4 * bins * more.largest_analysed * sizeof(double) + samples * more.largest_analysed * sizeof(double) / 8;
         const double scan = static_cast<double>(t->model.sensor.beam_count()) * 3 * sizeof(double);
         bytes += recorded + 3 * weights + scan;
         largest_trial = std::max(largest_trial, analysis + recorded + weights);  // analyzed and written one at a time
