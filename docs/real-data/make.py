@@ -227,8 +227,9 @@ def scan_to_map(rec, work):
     for model, name in zip(MODELS, MODEL_NAMES):
         out = work / f"templates_{name}.h5"
         if not out.exists():
-            bvc3d("replay", "--world", work / "hall-map.yaml", "--trajectory", work / "grid.csv", "--sensor",
-                  HERE / "hall-os64.yaml", "--model", model, "--out", out)
+            # The grid's rows are places, not a track in time: one scan per row.
+            bvc3d("replay", "--world", work / "hall-map.yaml", "--trajectory", work / "grid.csv", "--step-per-row",
+                  "--sensor", HERE / "hall-os64.yaml", "--model", model, "--out", out)
     out = work / "scan-to-map"
     bvc3d("localize", "--templates", work / "templates_{model}.h5", "--queries", rec, "--query-poses",
           rec / "poses.csv", "--model", ",".join(MODELS), "--out", out)
