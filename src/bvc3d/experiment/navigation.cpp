@@ -169,12 +169,21 @@ void check_goals(const World& world, const NavigationSetup& s) {
     }
 }
 
+void check_scales(const ModelSpec& model, const RewardParams& reward) {
+    const std::size_t n = model.place_scales().size(), given = reward.scale_lambdas.size() + 1;
+    if (n > given)
+        RewardParams::table().fail("scale_lambdas", "gives λ for " + std::to_string(given) +
+                                                        " scales (with lambda), but '" + model.name + "' has " +
+                                                        std::to_string(n) + " scales of place cells");
+}
+
 NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64_t seed,
                        const std::function<void(const NavigationStart&)>& progress) {
     s.nav.validate();
     s.reward.validate();
     s.model.validate();
     check_goals(world, s);
+    check_scales(s.model, s.reward);
     const NavigationParams& nav = s.nav;
     auto body = std::make_shared<const BodyCollider>(world.description(), s.robot.radius, s.robot.height);
     const FreeSpaceGrid path_grid(*body, nav.path_cell);
@@ -182,10 +191,7 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
     Senses senses(world, s.model, seed);
     const std::size_t n_scales = senses.n_scales();
     std::vector<HdAdjacency> adjacency;  // per scale, learned
-    for (std::size_t k = 0; k < n_scales; ++k) {
-        s.reward.for_scale(k);  // InputError before learning if the scale has no λ
-        adjacency.emplace_back(senses.n_place(k), s.adjacency);
-    }
+    for (std::size_t k = 0; k < n_scales; ++k) adjacency.emplace_back(senses.n_place(k), s.adjacency);
     NavigationRun run;
     const std::size_t n_goals = s.goals.size();
     run.visits.assign(n_goals, 0);

@@ -94,6 +94,9 @@ struct NavigationSetup {
 // reached from the others' part of the floor; and for no goals.
 void check_goals(const World& world, const NavigationSetup& setup);
 
+// ParamError naming reward.scale_lambdas if the model has more scales of place cells than λs are given for.
+void check_scales(const ModelSpec& model, const RewardParams& reward);
+
 // One learning run and its exploitation. `progress` (if set) is told of each finished start.
 NavigationRun navigate(const World& world, const NavigationSetup& setup, std::uint64_t seed,
                        const std::function<void(const NavigationStart&)>& progress = {});
