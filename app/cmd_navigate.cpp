@@ -232,7 +232,10 @@ void navigate_command(const NavigateOptions& o) {
     std::vector<ModelSpec> models;
     std::optional<World> world;
     try {  // before anything is written; a YAML file's errors name it
-        for (const auto& m : plan.models) models.push_back(config::resolve_model(m));
+        for (const auto& m : plan.models) {
+            models.push_back(config::resolve_model(m));
+            check_scales(models.back(), setup.reward);
+        }
         world.emplace(config::resolve_world(plan.world, plan.tilt, plan.lean));
         check_goals(*world, setup);
     } catch (const InputError& e) {

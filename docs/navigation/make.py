@@ -3,8 +3,9 @@ docs/navigation/starts.csv and the per-goal summaries into docs/navigation/summa
 docs/navigation/results.png (success rate and path ratio per world and model).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/make.py [--seeds N] [--starts N]
-[--learn-hours H] [--models 2d,3d-3l] [--worlds nav-open,...]. Each run's own folder (paths, reward maps, figures)
-is kept in build/navigation/.
+[--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P] [--prefix P]. Each run's own
+folder (paths, reward maps, figures, and runs/ with each finished learning run: a run again with the same options
+skips those) is kept in build/navigation/PREFIXWORLD-MODEL/; the learning runs' times go to PREFIXlearning.csv.
 """
 import argparse
 import csv
@@ -37,21 +38,27 @@ def main():
     ap.add_argument("--models", default="2d,3d-3l")
     ap.add_argument("--worlds", default="nav-open,nav-cross,nav-maze,nav-wall,cross-0,cross-60")
     ap.add_argument("--prefix", default="", help="prefix of the files written (a partial run beside the main one)")
+    ap.add_argument("--prune", type=float, default=0.0, help="adjacency.prune (0.01 for the multiscale sizes)")
+    ap.add_argument("--bvc3d", default=str(ROOT / "build" / "bvc3d"), help="the program to run")
     a = ap.parse_args()
-    rows, summary = [], []
+    rows, summary, learning = [], [], []
     for world in a.worlds.split(","):
         for model in a.models.split(","):
-            out = ROOT / "build" / "navigation" / f"{world}-{model}"
-            cmd = [str(ROOT / "build" / "bvc3d"), "navigate", "--world", world_arg(world), "--goals", GOALS[world],
-                   "--model", model, "--seeds", str(a.seeds), "--starts", str(a.starts), "--max-learn-hours",
-                   str(a.learn_hours), "--out", str(out)]
+            out = ROOT / "build" / "navigation" / f"{a.prefix}{world}-{model}"
+            out.mkdir(parents=True, exist_ok=True)
+            # A YAML file: the options of the command line and the adjacency's pruning, which has no option.
+            config = out.parent / f"{a.prefix}{world}-{model}.yaml"
+            goals = [[float(c) for c in g.split(",")] for g in GOALS[world].split(";")]
+            config.write_text(f"world: {world_arg(world)}\ngoals: {goals}\nmodels: [{model}]\nseeds: {a.seeds}\n"
+                              f"navigation: {{starts: {a.starts}, max_learn_hours: {a.learn_hours}}}\n"
+                              f"adjacency: {{prune: {a.prune}}}\n")
+            cmd = [a.bvc3d, "navigate", "--config", str(config), "--out", str(out)]
             print(" ".join(cmd), file=sys.stderr, flush=True)
             subprocess.run(cmd, check=True)
-            with open(out / "starts.csv", newline="") as f:
-                rows += list(csv.DictReader(f))
-            with open(out / "summary.csv", newline="") as f:
-                summary += list(csv.DictReader(f))
-    for name, table in (("starts.csv", rows), ("summary.csv", summary)):
+            for name, table in (("starts.csv", rows), ("summary.csv", summary), ("learning.csv", learning)):
+                with open(out / name, newline="") as f:
+                    table += [dict(r, world=world) if name == "learning.csv" else r for r in csv.DictReader(f)]
+    for name, table in (("starts.csv", rows), ("summary.csv", summary), ("learning.csv", learning)):
         with open(HERE / (a.prefix + name), "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(table[0].keys()))
             w.writeheader()

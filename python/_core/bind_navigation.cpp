@@ -108,6 +108,33 @@ HdAdjacency(n_place, **params); params and their defaults:
             },
             pyb::arg("w"), pyb::arg("v"), "Each HD direction's rollout return R_k from place-cell rates v (SPEC §17)");
     m.def(
+        "combine_scales",
+        [](const pyb::object& returns, const pyb::object& allowed, const pyb::object& scores,
+           const pyb::kwargs& kwargs) {
+            const auto r = real_array(returns, "returns");
+            if (r.ndim() != 2 || r.shape(0) < 1 || r.shape(1) < 1)
+                throw InputError("returns must be a 2-D array: scales × directions");
+            const auto n_scales = std::size_t(r.shape(0)), n_dir = std::size_t(r.shape(1));
+            std::vector<std::vector<double>> per_scale;
+            for (std::size_t s = 0; s < n_scales; ++s) {
+                per_scale.emplace_back(r.data() + s * n_dir, r.data() + (s + 1) * n_dir);
+                for (double x : per_scale.back())
+                    if (!std::isfinite(x)) throw InputError("returns are not all finite");
+            }
+            const auto open = vector_of(allowed, "allowed", n_dir);
+            std::vector<double> carried =
+                scores.is_none() ? std::vector<double>{} : vector_of(scores, "scores", n_scales);
+            const auto prob =
+                combine_scales(per_scale, std::vector<char>(open.begin(), open.end()), reward_of(kwargs), carried);
+            return pyb::make_tuple(to_numpy(prob.data(), {pyb::ssize_t(n_dir)}),
+                                   to_numpy(carried.data(), {pyb::ssize_t(n_scales)}));
+        },
+        pyb::arg("returns"), pyb::arg("allowed"), pyb::arg("scores") = pyb::none(),
+        "The choice's probabilities over directions from each scale's returns (scales × directions; allowed: 1 where "
+        "a direction is offered) and the scales' smoothed scores after it (pass them back as scores at the next "
+        "decision; None at a start's first). SPEC §17, docs/navigation.md#multiscale. Keywords: the reward "
+        "parameters (beta, scale_beta, scale_smoothing).");
+    m.def(
         "reward_readout",
         [](const pyb::object& w, const pyb::object& v) {
             const auto wv = real_array(w, "w");

@@ -22,8 +22,8 @@ __all__ = ["BoundaryVectorLayer", "InputError", "PlaceCellNetwork", "Recording",
            "random_walk", "read_trajectory", "replay_simulated", "run_trial"]
 __all__ += ["place_recognition", "scan_context", "scan_context_distance"]
 __all__ += ["lidar_models", "route", "tour", "write_trajectory"]
-from ._core import HdAdjacency, navigate, reward_readout, shortest_path
-__all__ += ["HdAdjacency", "navigate", "reward_readout", "shortest_path"]
+from ._core import HdAdjacency, combine_scales, navigate, reward_readout, shortest_path
+__all__ += ["HdAdjacency", "combine_scales", "navigate", "reward_readout", "shortest_path"]
 __all__ += ["GridCells", "HeadDirectionCells"]
 from ._core import GrowingPlaceCells
 __all__ += ["GrowingPlaceCells"]

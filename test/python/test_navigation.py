@@ -123,6 +123,56 @@ def test_direction_returns_match_numpy_and_point_to_the_goal():
     assert np.argmax(r) == 0  # east, along the chain toward the goal
 
 
+def combine_numpy(returns, allowed, scores=None, beta=500.0, scale_beta=2.0, f=0.25):
+    """SPEC §17's combination of scales, as docs/navigation.md#multiscale reads it, written out."""
+    returns, allowed = np.asarray(returns, float), np.asarray(allowed, bool)
+    probs, fresh = [], []
+    for r in returns:
+        z = np.where(allowed, beta * r, -np.inf)
+        p = np.exp(z - z.max())
+        p /= p.sum()
+        h = -sum(q * math.log(q) for q in p if q > 0)
+        probs.append(p)
+        fresh.append(r[allowed].mean() / max(h, 1e-3))
+    fresh = np.array(fresh)
+    scores = fresh if scores is None else (1 - f) * np.asarray(scores) + f * fresh
+    a = np.exp(scale_beta * (scores - scores.max()))
+    a /= a.sum()
+    return a @ np.array(probs), scores
+
+
+def test_combine_scales_matches_numpy_on_hand_made_returns():
+    # Scale 0 is sure of east (a clear gradient), scale 1 is unsure between north and east: the sure scale's
+    # score (mean return over a small entropy) is the larger, so its choice gets most of the weight.
+    returns = np.array([[0.030, 0.020, 0.010, 0.0, 0.0, 0.0, 0.0, 0.005],
+                        [0.040, 0.041, 0.042, 0.0, 0.0, 0.0, 0.0, 0.040]])
+    allowed = np.array([1, 1, 1, 1, 1, 1, 0, 1])
+    prob, scores = bvc3d.combine_scales(returns, allowed)
+    expected, expected_scores = combine_numpy(returns, allowed)
+    np.testing.assert_allclose(prob, expected, rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose(scores, expected_scores, rtol=1e-12)
+    assert prob.sum() == pytest.approx(1.0) and prob[6] == 0.0
+    # By hand: scale 0's softmax(500 R) over the offered directions and its entropy; scale 1's likewise.
+    p0 = np.exp(500 * (returns[0] - 0.03)) * allowed
+    p0 /= p0.sum()
+    p1 = np.exp(500 * (returns[1] - 0.042)) * allowed
+    p1 /= p1.sum()
+    h0, h1 = (-np.sum(p[p > 0] * np.log(p[p > 0])) for p in (p0, p1))
+    c = np.array([returns[0][allowed == 1].mean() / h0, returns[1][allowed == 1].mean() / h1])
+    a0 = 1 / (1 + math.exp(2 * (c[1] - c[0])))
+    np.testing.assert_allclose(prob, a0 * p0 + (1 - a0) * p1, rtol=1e-9)
+    assert a0 > 0.5 and np.argmax(prob) == 0
+    # The next decision smooths the scores: 0.75 of the carried, 0.25 of the new.
+    later = np.array([[0.0, 0.0, 0.0, 0.0, 0.01, 0.0, 0.0, 0.0], returns[1]])
+    prob2, scores2 = bvc3d.combine_scales(later, allowed, scores)
+    expected2, expected_scores2 = combine_numpy(later, allowed, expected_scores)
+    np.testing.assert_allclose(scores2, expected_scores2, rtol=1e-12)
+    np.testing.assert_allclose(prob2, expected2, rtol=1e-12, atol=1e-300)
+    # One scale: exactly its own softmax(β R) (the single-scale model's choice, bit for bit).
+    one, _ = bvc3d.combine_scales(returns[:1], allowed)
+    np.testing.assert_allclose(one, p0, rtol=1e-12, atol=1e-300)
+
+
 def test_shortest_path_in_the_cross_arena_goes_round_the_wall():
     world = bvc3d.World.cross()
     # Straight across the open corner: the segment's own length, on the 0.1 m grid's octile moves (≤ 8 % longer).

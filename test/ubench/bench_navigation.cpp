@@ -1,7 +1,7 @@
 // Navigation (docs/navigation.md#speed): one exploitation decision — the rollouts of every HD direction through a
 // learned adjacency — and a whole decision with the sensor, BVCs and place cells, for the paper's 250 place cells and
 // for adjacencies of the authors' multiscale sizes (2 000 / 1 000 / 500 cells per scale; learned here on a
-// synthetic walk of sparse place fields, the multiscale network itself not being in the library yet). The second
+// synthetic walk of sparse place fields, so that the figures do not depend on a long learning walk). The second
 // argument p: the products read the sparse copy with prune = 10^(−p/2) (p = 2: 10⁻¹, 3: 3.2·10⁻², 4: 10⁻²; p = 0:
 // prune 0, every non-zero weight, the exact products); the third T: steps of each rollout (SPEC: 3); counters give
 // the copy's entries and bytes against the dense n_hd·n² float32.
@@ -89,8 +89,8 @@ void BM_DirectionChoice(benchmark::State& state) {
 }
 BENCHMARK(BM_DirectionChoice)->ArgsProduct({{250, 1000, 2000}, {0, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
 
-// The authors' multiscale size: three scales of 2 000 / 1 000 / 500 place cells, each scale's rollouts (the scales'
-// combination, a softmax over 8 numbers, is left out).
+// The authors' multiscale size: three scales of 2 000 / 1 000 / 500 place cells, each scale's rollouts and the
+// scales' combination (combine_scales: softmaxes over 8 and 3 numbers), as navigation decides.
 void BM_DirectionChoiceMultiscale(benchmark::State& state) {
     std::vector<const Learned*> scales;
     std::vector<SparseAdjacency> sparse;
@@ -103,9 +103,14 @@ void BM_DirectionChoiceMultiscale(benchmark::State& state) {
     std::vector<std::vector<double>> v;
     for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
     const RewardParams p = rollout_of(state);
-    for (auto _ : state)
+    const std::vector<char> allowed(8, 1);
+    std::vector<std::vector<double>> returns(scales.size());
+    std::vector<double> scores;
+    for (auto _ : state) {
         for (std::size_t s = 0; s < scales.size(); ++s)
-            benchmark::DoNotOptimize(direction_returns(sparse[s], scales[s]->w, v[s], p));
+            returns[s] = direction_returns(sparse[s], scales[s]->w, v[s], p);
+        benchmark::DoNotOptimize(combine_scales(returns, allowed, p, scores));
+    }
     state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["MB"] = bytes / 1e6;
     state.counters["dense_MB"] = dense / 1e6;

@@ -1,7 +1,7 @@
 // Navigation to goals (SPEC §17, docs/navigation.md): the shortest path against hand-made grids and a brute-force
 // relaxation, the HD-conditioned adjacency's update, replay and the choice of direction on a hand-made chain of
-// cells, and a closed-loop run that reaches a goal in sight, the same for the same seed. (The update and replay
-// against numpy: test/python/test_navigation.py.)
+// cells, and closed-loop runs (one scale, and a small multiscale model) that reach a goal in sight, the same for the
+// same seed. (The update, replay and the combination of scales against numpy: test/python/test_navigation.py.)
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +14,9 @@
 
 #include "bvc3d/agent/shortest_path.hpp"
 #include "bvc3d/agent/voxel_path.hpp"
+#include "bvc3d/config/population_kinds.hpp"
 #include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/navigation.hpp"
 #include "bvc3d/population/reward_cells.hpp"
@@ -266,6 +268,67 @@ TEST(Navigation, ReachesAGoalInSightInAnOpenRoomTheSameForTheSameSeed) {
         EXPECT_EQ(again.starts[i].start, run.starts[i].start);
     }
     EXPECT_EQ(again.rewards, run.rewards);
+}
+
+namespace {
+
+// A small multiscale model (SPEC §16's structure at a test's size): the paper's 2-D model as the first scale, and a
+// second scale of broader BVCs and 150 place cells fed by them and a grid module.
+ModelSpec two_scales() {
+    ModelSpec m = model_preset("2d");
+    m.name = "two-scales";
+    BvcParams bvc = m.bvc;
+    bvc.n_per_axis = 60;
+    bvc.sigma_r = 1.0;
+    bvc.sigma_theta = 3 * pi / 180;
+    GridParams grid;
+    grid.spacing = 5.5;
+    grid.n = 100;
+    PlaceParams place;
+    place.n_place = 150;
+    place.grid_influence = 0.35;
+    place.gamma_pp = 0.7;
+    m.populations = {config::grid_spec("grid-m", grid), config::bvc_layer_spec("bvc-m", bvc),
+                     config::grid_place_spec("place-m", place, {"bvc-m", "grid-m"})};
+    return m;
+}
+
+}  // namespace
+
+TEST(Navigation, MultiscaleReachesAGoalInSightTheSameForTheSameSeed) {
+    test::TempDir dir;
+    const World world = open_room(dir.path());
+    auto setup = room_setup();
+    setup.model = two_scales();
+    ASSERT_EQ(setup.model.place_scales(), (std::vector<std::string>{"place", "place-m"}));
+    const auto run = navigate(world, setup, 3);
+    int reached = 0;
+    for (const auto& s : run.starts) {
+        reached += s.success;
+        if (s.success) {
+            EXPECT_LT(s.path_m / s.shortest_m, 2.5);
+        }
+    }
+    EXPECT_GE(reached, 3) << "of " << run.starts.size();
+    const auto again = navigate(world, setup, 3);
+    ASSERT_EQ(again.starts.size(), run.starts.size());
+    for (std::size_t i = 0; i < run.starts.size(); ++i) EXPECT_EQ(again.starts[i].path, run.starts[i].path) << i;
+    // The second scale takes part in the choice: the first alone (the 2-D model, the same learning walk and the
+    // same first scale's reward cell) walks other paths.
+    auto single = room_setup();
+    const auto alone = navigate(world, single, 3);
+    EXPECT_EQ(alone.goal_cells, run.goal_cells);
+    bool differs = false;
+    for (std::size_t i = 0; i < run.starts.size(); ++i) differs = differs || alone.starts[i].path != run.starts[i].path;
+    EXPECT_TRUE(differs);
+    // A second scale without a λ of its own: refused, naming the key.
+    setup.reward.scale_lambdas = {};
+    try {
+        navigate(world, setup, 3);
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("scale_lambdas"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Navigation, RefusesGoalsOutsideInWallsOrNone) {

@@ -22,6 +22,13 @@ void ModelSpec::validate() const {
                                                         " but the place cells read no grid cells (place_grid)");
 }
 
+std::vector<std::string> ModelSpec::place_scales() const {
+    std::vector<std::string> names{"place"};
+    for (const PopulationSpec& spec : populations)
+        if (spec.kind == "place") names.push_back(spec.name);
+    return names;
+}
+
 namespace {
 
 // A model reading the horizontal scanner (no elevation layers), 120 distances per direction.

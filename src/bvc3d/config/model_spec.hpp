@@ -24,6 +24,10 @@ struct ModelSpec {
     std::string place_grid;
     static constexpr double max_weights = 1e9;  // n_place × BVCs (4 GB of float weights)
     void validate() const;
+    // The model's scales of place cells, by population name: its own ("place"), then each population of kind
+    // "place" (a multiscale model's further scales, SPEC §16) in the order of `populations`. The multiscale
+    // analysis fuses them; navigation learns an adjacency and reward cells on each.
+    std::vector<std::string> place_scales() const;
 };
 
 struct ModelPreset {

@@ -12,10 +12,6 @@ namespace bvc3d {
 
 namespace {
 
-// Place-cell steps wait until this many are due; then each network takes them at once, reading its weights once for
-// every 8 steps.
-constexpr std::size_t block_steps = 16;
-
 struct Built {
     std::vector<PopulationNode> nodes;
     std::vector<ModelNetwork::Nodes> wiring;
@@ -136,11 +132,11 @@ Built build(const World* world, const std::vector<TrialConfig>& trials, const So
 }  // namespace
 
 ModelNetwork::ModelNetwork(const World* world, const std::vector<TrialConfig>& trials, const SourceFactory& factory,
-                           bool record_bvc)
+                           bool record_bvc, std::size_t block)
     : network({}, 1) {
     Built b = build(world, trials, factory, record_bvc);
     nodes = std::move(b.wiring);
-    network = PopulationNetwork(std::move(b.nodes), block_steps);
+    network = PopulationNetwork(std::move(b.nodes), block);
 }
 
 std::vector<ModelRecord> ModelNetwork::records(std::size_t from, bool final) {

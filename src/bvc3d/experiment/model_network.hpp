@@ -17,9 +17,12 @@
 namespace bvc3d {
 
 struct ModelNetwork {
+    // Place-cell steps wait until this many are due; then each network takes them at once, reading its weights once
+    // for every 8 steps. A closed loop (navigation) steps with block 1 and reads each step's rates at once.
+    static constexpr std::size_t block_steps = 16;
     // InputError naming the model and population for inputs that name no population of its model, cycles, ...
     ModelNetwork(const World* world, const std::vector<TrialConfig>& trials, const SourceFactory& factory,
-                 bool record_bvc);
+                 bool record_bvc, std::size_t block = block_steps);
 
     PopulationNetwork network;
     // Per model: the nodes of its BVC layer, its place cells, and its other populations.

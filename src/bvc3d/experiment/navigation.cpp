@@ -9,12 +9,10 @@
 #include "bvc3d/agent/goal_seeking_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/shortest_path.hpp"
-#include "bvc3d/bvc/boundary_vector_layer.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
-#include "bvc3d/place/place_cell_network.hpp"
-#include "bvc3d/sensor/lidar.hpp"
+#include "bvc3d/experiment/model_network.hpp"
 
 namespace bvc3d {
 
@@ -62,38 +60,71 @@ int largest_part(const std::vector<int>& parts, int count) {
     return count > 0 ? static_cast<int>(std::max_element(n.begin(), n.end()) - n.begin()) : -1;
 }
 
-std::vector<double> to_double(std::span<const float> v) { return {v.begin(), v.end()}; }
-
-// The model's senses: the sensor's scan at a pose, the BVC rates, one place-cell step.
-struct Senses {
-    const World& world;
-    Lidar lidar;
-    BoundaryVectorLayer layer;
-    PlaceCellNetwork net;
-    Scan scan;
-    std::vector<double> bvc;
-    Senses(const World& w, const ModelSpec& m, std::uint64_t seed)
-        : world(w),
-          lidar(m.sensor),
-          layer(m.bvc),
-          net(static_cast<int>(layer.n_cells()), m.place, seed),
-          bvc(layer.n_cells()) {}
-    std::vector<double> step(const Pose& pose, bool learn) {
-        lidar.scan(world, pose, scan);
-        layer.rates(scan, bvc);
-        return to_double(net.step(bvc, learn));
+// The model's senses: its populations (model_network.hpp) stepped one model step at a time, and the rates of its
+// scales of place cells (ModelSpec::place_scales: the paper's model has one, a multiscale model three).
+class Senses {
+public:
+    Senses(const World& world, const ModelSpec& model, std::uint64_t seed)
+        : net_(&world, {trial_of(model, seed)}, {}, false, 1) {
+        const auto& nodes = net_.nodes.front();
+        for (const std::string& name : model.place_scales()) {
+            std::size_t node = nodes.place;
+            for (std::size_t k = 0; k < model.populations.size(); ++k)
+                if (model.populations[k].name == name) node = nodes.others[k];
+            scales_.push_back(node);
+        }
+        rates_.resize(scales_.size());
     }
+    std::size_t n_scales() const { return scales_.size(); }
+    int n_place(std::size_t s) const { return static_cast<int>(net_.network.node(scales_[s]).population->size()); }
+    // One model step at `pose`; each scale's place-cell rates after it.
+    const std::vector<std::vector<double>>& step(const Pose& pose, bool learn, bool bumped = false, double t = 0.0) {
+        net_.network.step(ModelStep{t, pose, bumped, std::nullopt}, index_++, learn, false);
+        for (std::size_t s = 0; s < scales_.size(); ++s) {
+            const auto v = net_.network.latest(scales_[s]);
+            rates_[s].assign(v.begin(), v.end());
+        }
+        return rates_;
+    }
+    const std::vector<std::vector<double>>& rates() const { return rates_; }
+    // Every population back to rest (a new start), what it learned kept.
+    void reset() {
+        for (std::size_t i = 0; i < net_.network.size(); ++i) net_.network.node(i).population->reset_activity();
+    }
+
+private:
+    static TrialConfig trial_of(const ModelSpec& model, std::uint64_t seed) {
+        TrialConfig t;
+        t.model = model;
+        t.seed = seed;
+        return t;
+    }
+    ModelNetwork net_;
+    std::vector<std::size_t> scales_;  // the nodes of the place-cell scales
+    std::int64_t index_ = 0;
+    std::vector<std::vector<double>> rates_;
 };
 
-// SPEC §17's choice: softmax(β·R) over the offered directions, sampled.
+// What one scale gives the choice: its frozen adjacency, its parameters and, per goal, its reward cell's weights.
+struct ScaleMemory {
+    SparseAdjacency adjacency;
+    RewardParams reward;
+    std::vector<std::vector<double>> rewards;  // per goal
+};
+
+// SPEC §17's choice: per scale softmax(β·R) over the offered directions, the scales combined (combine_scales),
+// sampled.
 class RewardPolicy : public DirectionPolicy {
 public:
-    RewardPolicy(const SparseAdjacency& adj, const std::vector<double>& w, const std::vector<double>& v,
-                 const RewardParams& p, Rng& rng)
-        : adj_(adj), w_(w), v_(v), p_(p), rng_(rng) {}
+    RewardPolicy(const std::vector<ScaleMemory>& scales, std::size_t goal, const Senses& senses, const RewardParams& p,
+                 Rng& rng)
+        : scales_(scales), goal_(goal), senses_(senses), p_(p), rng_(rng) {}
     int choose(const Pose&, std::span<const char> allowed) override {
-        const auto returns = direction_returns(adj_, w_, v_, p_);
-        const auto prob = softmax(returns, p_.beta, {allowed.begin(), allowed.end()});
+        std::vector<std::vector<double>> returns;
+        for (std::size_t s = 0; s < scales_.size(); ++s)
+            returns.push_back(direction_returns(scales_[s].adjacency, scales_[s].rewards[goal_], senses_.rates()[s],
+                                                scales_[s].reward));
+        const auto prob = combine_scales(returns, {allowed.begin(), allowed.end()}, p_, scores_);
         const double u = rng_.uniform();
         double sum = 0;
         int last = -1;
@@ -106,11 +137,12 @@ public:
     }
 
 private:
-    const SparseAdjacency& adj_;
-    const std::vector<double>& w_;
-    const std::vector<double>& v_;
+    const std::vector<ScaleMemory>& scales_;
+    std::size_t goal_;
+    const Senses& senses_;
     RewardParams p_;
     Rng& rng_;
+    std::vector<double> scores_;  // each scale's smoothed score over this start's decisions
 };
 
 }  // namespace
@@ -137,22 +169,35 @@ void check_goals(const World& world, const NavigationSetup& s) {
     }
 }
 
+void check_scales(const ModelSpec& model, const RewardParams& reward) {
+    const std::size_t n = model.place_scales().size(), given = reward.scale_lambdas.size() + 1;
+    if (n > given)
+        RewardParams::table().fail("scale_lambdas", "gives λ for " + std::to_string(given) +
+                                                        " scales (with lambda), but '" + model.name + "' has " +
+                                                        std::to_string(n) + " scales of place cells");
+}
+
 NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64_t seed,
                        const std::function<void(const NavigationStart&)>& progress) {
     s.nav.validate();
     s.reward.validate();
     s.model.validate();
     check_goals(world, s);
+    check_scales(s.model, s.reward);
     const NavigationParams& nav = s.nav;
     auto body = std::make_shared<const BodyCollider>(world.description(), s.robot.radius, s.robot.height);
     const FreeSpaceGrid path_grid(*body, nav.path_cell);
     const FreeSpaceGrid cover_grid(*body, nav.coverage_cell);
     Senses senses(world, s.model, seed);
-    HdAdjacency adj(senses.net.n_place(), s.adjacency);
+    const std::size_t n_scales = senses.n_scales();
+    std::vector<HdAdjacency> adjacency;  // per scale, learned
+    for (std::size_t k = 0; k < n_scales; ++k) adjacency.emplace_back(senses.n_place(k), s.adjacency);
     NavigationRun run;
     const std::size_t n_goals = s.goals.size();
     run.visits.assign(n_goals, 0);
-    run.goal_cells.assign(n_goals, -1);
+    // Per scale and goal: the reward cell (the most active inside the goal's radius) and its rate.
+    std::vector<std::vector<int>> goal_cells(n_scales, std::vector<int>(n_goals, -1));
+    std::vector<std::vector<double>> best(n_scales, std::vector<double>(n_goals, 0.0));
 
     // Learning.
     int n_cover_parts = 0;
@@ -162,15 +207,15 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
     for (int l : cover_parts) free_cells += l == cover_main;
     std::vector<char> visited(cover_grid.size(), 0);
     std::vector<char> inside(n_goals, 0);
-    std::vector<double> best(n_goals, 0.0);
     const auto walk = RandomWalkSpec(s.robot).make(&world, seed);
     const double learn_end = nav.max_learn_hours * 3600;
     for (std::int64_t k = 0;; ++k) {
         const auto step = walk->next(learn_end);
         if (!step) break;
         const Vec2 p(step->pose.x, step->pose.y);
-        const auto v = senses.step(step->pose, true);
-        adj.learn(v, hd_rates(step->pose.heading, adj.n_hd()), step->bumped);
+        const auto& rates = senses.step(step->pose, true, step->bumped, step->t);
+        const auto hd = hd_rates(step->pose.heading, s.adjacency.n_hd);
+        for (std::size_t sc = 0; sc < n_scales; ++sc) adjacency[sc].learn(rates[sc], hd, step->bumped);
         if (k % 8 == 0) run.learn_path.push_back(p);
         if (const auto c = cover_grid.cell_of(p); c && !visited[cover_grid.index(*c)]) {
             visited[cover_grid.index(*c)] = 1;
@@ -182,8 +227,10 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
             if (in && !inside[g]) ++run.visits[g];
             inside[g] = in;
             if (in)
-                for (std::size_t i = 0; i < v.size(); ++i)
-                    if (v[i] > best[g]) best[g] = v[i], run.goal_cells[g] = static_cast<int>(i);
+                for (std::size_t sc = 0; sc < n_scales; ++sc)
+                    for (std::size_t i = 0; i < rates[sc].size(); ++i)
+                        if (rates[sc][i] > best[sc][g])
+                            best[sc][g] = rates[sc][i], goal_cells[sc][g] = static_cast<int>(i);
             goals_done = goals_done && run.visits[g] >= nav.goal_visits;
         }
         run.learn_s = step->t;
@@ -191,16 +238,25 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
         if (goals_done && run.coverage >= nav.coverage) break;
     }
 
-    // Exploitation, on the learned adjacency's sparse copy.
-    const SparseAdjacency frozen(adj);
+    // Exploitation, per scale on the learned adjacency's sparse copy, after replay from each goal's reward cell.
+    std::vector<ScaleMemory> memory;
+    for (std::size_t k = 0; k < n_scales; ++k) {
+        memory.push_back({SparseAdjacency(adjacency[k]), s.reward.for_scale(k), {}});
+        adjacency[k] = HdAdjacency(1, s.adjacency);  // its dense matrices are not needed any more
+        for (std::size_t g = 0; g < n_goals; ++g)
+            memory[k].rewards.push_back(goal_cells[k][g] >= 0
+                                            ? replay(memory[k].adjacency, goal_cells[k][g], memory[k].reward)
+                                            : std::vector<double>(std::size_t(senses.n_place(k)), 0.0));
+    }
+    // What a run reports: the first scale's (the model's own place cells).
+    run.goal_cells = goal_cells.front();
+    run.rewards = memory.front().rewards;
     int n_parts = 0;
     const auto parts = path_grid.parts(s.robot.radius, n_parts);
     const auto bounds = body->walkable().bounds();
     for (std::size_t g = 0; g < n_goals; ++g) {
         const Vec2 goal = s.goals[g];
-        run.rewards.push_back(run.goal_cells[g] >= 0 ? replay(frozen, run.goal_cells[g], s.reward)
-                                                     : std::vector<double>(std::size_t(adj.n_place()), 0.0));
-        const auto& w = run.rewards.back();
+        const auto& w = run.rewards[g];
         run.reward_maps.emplace_back();
         if (nav.reward_map_cell > 0)
             for (double y = bounds.min().y() + nav.reward_map_cell / 2; y < bounds.max().y(); y += nav.reward_map_cell)
@@ -208,11 +264,10 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
                      x += nav.reward_map_cell) {
                     const Vec2 q(x, y);
                     if (!body->walkable().contains(q) || body->clearance(q) < 0) continue;
-                    senses.net.reset();
-                    std::vector<double> v;
+                    senses.reset();
                     for (int k = 0; k < std::max(1, nav.settle_steps); ++k)
-                        v = senses.step(Pose::on_floor(x, y, 0.0), false);
-                    run.reward_maps.back().push_back({q, reward(w, v)});
+                        senses.step(Pose::on_floor(x, y, 0.0), false);
+                    run.reward_maps.back().push_back({q, reward(w, senses.rates().front())});
                 }
         const int goal_part = parts[path_grid.index(*nearest_usable_cell(path_grid, goal, s.robot.radius))];
         Rng rng(hash_u64(seed, 0x6e617669676174ULL, g), Stream::walk);
@@ -232,12 +287,11 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
             }
             out.start = p;
             out.shortest_m = shortest_path(path_grid, p, goal, nav.path_inflate).length;
-            senses.net.reset();
+            senses.reset();
             Pose pose = Pose::on_floor(p.x(), p.y(), rng.uniform(-pi, pi));
-            std::vector<double> v;
-            for (int k = 0; k < std::max(1, nav.settle_steps); ++k) v = senses.step(pose, false);
-            RewardPolicy policy(frozen, w, v, s.reward, rng);
-            GoalSeekingWalk agent(body, s.robot, {adj.n_hd(), nav.step, nav.clearance}, policy, pose);
+            for (int k = 0; k < std::max(1, nav.settle_steps); ++k) senses.step(pose, false);
+            RewardPolicy policy(memory, g, senses, s.reward, rng);
+            GoalSeekingWalk agent(body, s.robot, {s.adjacency.n_hd, nav.step, nav.clearance}, policy, pose);
             out.path.push_back(p);
             while (true) {
                 const Vec2 here(agent.pose().x, agent.pose().y);
@@ -248,7 +302,7 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
                 if (agent.travelled() >= nav.max_path_ratio * out.shortest_m) break;
                 const auto step = agent.next(nav.max_hours * 3600);
                 if (!step) break;
-                v = senses.step(step->pose, false);
+                senses.step(step->pose, false, step->bumped, step->t);
                 out.path.emplace_back(step->pose.x, step->pose.y);
             }
             out.path_m = agent.travelled();

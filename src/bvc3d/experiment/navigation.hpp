@@ -14,9 +14,12 @@
 // directions' rollout returns R, sampled from its seeded stream, until it is within `success_radius` of
 // the goal, or its path reaches `max_path_ratio` × the shortest path, or `max_hours` pass.
 //
-// The place cells here are one network (the paper's). A model with several scales plugs in by giving,
-// per scale, a place-cell population and its adjacency; the choice then combines the scales' returns
-// (SPEC §17: softmax(2·score)), see docs/navigation.md#multiscale.
+// The model is stepped through its populations (experiment/model_network.hpp, one step at a time), and each of
+// its scales of place cells (ModelSpec::place_scales: the paper's model has one, ms-2d and ms-3d three) learns its
+// own adjacency and binds its own reward cell; replay and the rollouts run per scale (λ per scale:
+// RewardParams::for_scale) and the choice combines the scales' returns (combine_scales, SPEC §17:
+// softmax(2·score)), see docs/navigation.md#multiscale. With one scale the choice is softmax(β·R) exactly. A run
+// reports the first scale's reward cells and reward map.
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -66,8 +69,8 @@ struct NavigationRun {
     double learn_s = 0;                        // simulated learning time
     double coverage = 0;                       // reached
     std::vector<int> visits;                   // per goal
-    std::vector<int> goal_cells;               // per goal, -1 if never visited
-    std::vector<std::vector<double>> rewards;  // per goal, the reward cell's weights after replay
+    std::vector<int> goal_cells;               // per goal, -1 if never visited (the first scale's)
+    std::vector<std::vector<double>> rewards;  // per goal, the reward cell's weights after replay (the first scale's)
     std::vector<NavigationStart> starts;
     std::vector<Vec2> learn_path;  // positions of the learning walk (every 8th step)
     // Per goal, the reward read-out r at points of a grid over the free floor, the place cells settled there.
@@ -90,6 +93,9 @@ struct NavigationSetup {
 // InputError naming each goal outside the walkable floor, where the body does not fit, or that cannot be
 // reached from the others' part of the floor; and for no goals.
 void check_goals(const World& world, const NavigationSetup& setup);
+
+// ParamError naming reward.scale_lambdas if the model has more scales of place cells than λs are given for.
+void check_scales(const ModelSpec& model, const RewardParams& reward);
 
 // One learning run and its exploitation. `progress` (if set) is told of each finished start.
 NavigationRun navigate(const World& world, const NavigationSetup& setup, std::uint64_t seed,

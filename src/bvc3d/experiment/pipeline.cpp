@@ -48,12 +48,11 @@ AnalyzedTrial analyze(const TrialConfig& t, const WorldDescription& world, const
             p.name, AnalyzedPopulation{analysis::analyze_trial<float>(positions, cells, a.params), a.params});
     }
     // A multiscale model's scales fused (docs/model-reference.md#multiscale-models): its place cells and each recorded
-    // population of kind "place", side by side, each scale's rate vector scaled to unit length per sample.
+    // further scale (ModelSpec::place_scales), side by side, each scale's rate vector scaled to unit length per sample.
     std::vector<std::pair<const float*, std::size_t>> scales{{rec.rates.data(), static_cast<std::size_t>(rec.n_place)}};
-    for (const PopulationSpec& spec : t.model.populations)
+    for (const std::string& name : t.model.place_scales())
         for (const PopulationRecord& p : rec.populations)
-            if (spec.kind == "place" && p.name == spec.name && p.recorded && p.cells > 0)
-                scales.emplace_back(p.rates.data(), p.cells);
+            if (p.name == name && p.recorded && p.cells > 0) scales.emplace_back(p.rates.data(), p.cells);
     if (scales.size() > 1) {
         std::size_t total = 0;
         for (const auto& sc : scales) total += sc.second;

@@ -65,6 +65,7 @@ public:
     const std::vector<std::int64_t>& recruited_at() const { return recruited_at_; }
     // Membrane and rates back to zero; weights and cells kept.
     void reset();
+    void reset_activity() override { reset(); }
 
     std::size_t size() const override { return static_cast<std::size_t>(g_.budget); }
     void step(const StepBlock& block, std::span<const std::span<const double>> inputs, std::span<double> out) override;

@@ -21,6 +21,7 @@ public:
     std::vector<StateArray> state() const override;
     void restore(const std::vector<StateArray>& state) override;
     std::vector<StateArray> kept() const override;
+    void reset_activity() override { net_.reset(); }
 
 private:
     PlaceCellNetwork net_;

@@ -57,6 +57,9 @@ public:
     // Everything a checkpoint needs to continue exactly, and setting it back (InputError if it does not fit).
     virtual std::vector<StateArray> state() const { return {}; }
     virtual void restore(const std::vector<StateArray>&) {}
+    // Back to rest for a new episode (navigation's next start): activity cleared, what was learned kept. The
+    // default: nothing to clear (a population whose rates follow from its inputs alone).
+    virtual void reset_activity() {}
     // What a trial keeps of the population at its end (a network's weights).
     virtual std::vector<StateArray> kept() const { return {}; }
     // Counts a trial reports (name, count), e.g. the BVC layer's full-scan fallbacks.

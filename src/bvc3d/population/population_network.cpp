@@ -60,6 +60,7 @@ PopulationNetwork::PopulationNetwork(std::vector<PopulationNode> nodes, std::siz
         if (!placed[i]) throw InputError("population '" + nodes_[i].name + "' is in a cycle of inputs");
     due_.resize(n);
     recorded_.resize(n);
+    latest_.resize(n);
     for (std::size_t i = 0; i < n; ++i) due_[i].reserve(block_ * nodes_[i].population->size());
 }
 
@@ -105,6 +106,8 @@ void PopulationNetwork::flush() {
                     for (std::size_t c = 0; c < size; ++c)
                         recorded_[i].push_back(static_cast<float>(due_[i][k * size + c]));
         }
+        const std::size_t size = nodes_[i].population->size();
+        latest_[i].assign(due_[i].end() - static_cast<std::ptrdiff_t>(size), due_[i].end());
         due_[i].clear();
     }
     steps_.clear();

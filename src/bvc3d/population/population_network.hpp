@@ -36,6 +36,9 @@ public:
     // Model step `index`; the rates of each recorded node are kept if `record`.
     void step(const ModelStep& s, std::int64_t index, bool learn, bool record);
     void flush();  // steps the waiting steps now (before a checkpoint, and at the end)
+    // Node i's rates at the last step flushed (its size; empty before the first): a closed loop steps with block 1
+    // and reads each step's rates here.
+    std::span<const double> latest(std::size_t i) const { return latest_[i]; }
     // The kept rates of a recorded node (recorded steps × its size, float32 as trial files store them).
     std::vector<float>& recorded(std::size_t i) { return recorded_[i]; }
     void reserve(std::size_t samples);  // room for this many recorded steps
@@ -55,6 +58,7 @@ private:
     std::int64_t first_index_ = 0;
     std::vector<std::vector<double>> due_;  // per node: its rates for the due steps
     std::vector<std::vector<float>> recorded_;
+    std::vector<std::vector<double>> latest_;  // per node: its rates at the last step flushed
     void step_node(std::size_t i, const StepBlock& block, std::size_t from);
 };
 

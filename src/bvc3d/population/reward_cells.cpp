@@ -16,8 +16,26 @@ const params::Table<RewardParams>& RewardParams::table() {
          real("amplitude", &RewardParams::amplitude, closed(0, 1e6), "A of replay; 0: 5/λ"),
          integer("rollout_steps", &RewardParams::rollout_steps, closed(1, 100), "steps of each direction's rollout"),
          real("discount", &RewardParams::discount, closed(0, 1), "γ of the rollout's return"),
-         real("beta", &RewardParams::beta, closed(0, 1e6), "directions are preferred by softmax(β·R)")});
+         real("beta", &RewardParams::beta, closed(0, 1e6), "directions are preferred by softmax(β·R)"),
+         reals("scale_lambdas", &RewardParams::scale_lambdas, closed(0.1, 1e4),
+               "λ of a multiscale model's second, third, ... scale (the first takes lambda)")
+             .quiet_at_default(),
+         real("scale_beta", &RewardParams::scale_beta, closed(0, 1e6), "scales are weighted by softmax(β·score)")
+             .quiet_at_default(),
+         real("scale_smoothing", &RewardParams::scale_smoothing, closed(0, 1),
+              "a scale's score = mean return / entropy, averaged over decisions with this weight on the newest")
+             .quiet_at_default()});
     return t;
+}
+
+RewardParams RewardParams::for_scale(std::size_t s) const {
+    RewardParams p = *this;
+    if (s == 0) return p;
+    if (s > scale_lambdas.size())
+        table().fail("scale_lambdas",
+                     "gives λ for " + std::to_string(scale_lambdas.size() + 1) + " scales, but the model has more");
+    p.lambda = scale_lambdas[s - 1];
+    return p;
 }
 
 std::vector<double> replay(const HdAdjacency& adj, int goal_cell, const RewardParams& p) {
@@ -74,6 +92,33 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
             g *= p.discount;
         }
     }
+    return out;
+}
+
+std::vector<double> combine_scales(const std::vector<std::vector<double>>& returns, const std::vector<char>& allowed,
+                                   const RewardParams& p, std::vector<double>& scores) {
+    const std::size_t n_scales = returns.size();
+    std::vector<std::vector<double>> prob(n_scales);
+    std::vector<double> fresh(n_scales, 0.0);
+    for (std::size_t s = 0; s < n_scales; ++s) {
+        prob[s] = softmax(returns[s], p.beta, allowed);
+        double mean = 0.0, entropy = 0.0;
+        std::size_t offered = 0;
+        for (std::size_t d = 0; d < prob[s].size(); ++d) {
+            if (!allowed[d]) continue;
+            ++offered, mean += returns[s][d];
+            if (prob[s][d] > 0) entropy -= prob[s][d] * std::log(prob[s][d]);
+        }
+        fresh[s] = offered ? mean / double(offered) / std::max(entropy, 1e-3) : 0.0;
+    }
+    if (scores.size() != n_scales) scores = fresh;
+    else
+        for (std::size_t s = 0; s < n_scales; ++s)
+            scores[s] = (1 - p.scale_smoothing) * scores[s] + p.scale_smoothing * fresh[s];
+    const auto weight = softmax(scores, p.scale_beta, std::vector<char>(n_scales, 1));
+    std::vector<double> out(allowed.size(), 0.0);
+    for (std::size_t s = 0; s < n_scales; ++s)
+        for (std::size_t d = 0; d < out.size(); ++d) out[d] += weight[s] * prob[s][d];
     return out;
 }
 

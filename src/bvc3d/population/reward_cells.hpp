@@ -13,6 +13,16 @@
 // per direction; the rollout here is deterministic, so one is all 10 would be (docs/navigation.md).
 // Both read the adjacency's frozen sparse copy (hd_adjacency.hpp: weights below `prune` of the largest left out);
 // the forms taking an HdAdjacency make that copy first (O(n_hd·n²)): navigation makes it once per learning run.
+//
+// Several scales (a multiscale model: each its place cells, adjacency, reward cell and λ — 20 / 30 / 60, SPEC §17)
+// each give returns R_s; the choice combines them (combine_scales):
+//       p_s = softmax(β·R_s)                          over the offered directions
+//       c_s = mean R_s / max(H(p_s), 10⁻³)             mean over the offered directions; H the entropy in nats
+//       ĉ_s = (1 − f)·ĉ_s + f·c_s                      smoothed over a start's decisions (f = 0.25; ĉ_s = c_s first)
+//       P   = Σ_s α_s·p_s,   α = softmax(β_scale·ĉ)    β_scale = 2
+// SPEC gives "softmax(2·score), score = mean return / entropy (smoothed, factor 0.25)"; the smoothing as an
+// exponential average over decisions and the floor on the entropy (a scale sure of one direction has H → 0) are
+// bvc3d's reading. With one scale, α = 1 and P = p exactly.
 #include <span>
 #include <vector>
 
@@ -27,7 +37,14 @@ struct RewardParams {
     int rollout_steps = 3;   // T
     double discount = 0.7;   // γ
     double beta = 500.0;     // directions are preferred by softmax(β·R)
+    // Further scales of a multiscale model (the model's first scale takes `lambda`)
+    std::vector<double> scale_lambdas{30.0, 60.0};  // λ of the second, third, ... scale (A = 5/λ unless `amplitude`)
+    double scale_beta = 2.0;                        // scales are weighted by softmax(β_scale·score)
+    double scale_smoothing = 0.25;                  // f: a scale's score smoothed over a start's decisions
     double amplitude_or_default() const { return amplitude > 0 ? amplitude : 5.0 / lambda; }
+    // These parameters for scale s (0: the model's own place cells): its λ. InputError naming the key if
+    // scale_lambdas has no value for it.
+    RewardParams for_scale(std::size_t s) const;
     static const params::Table<RewardParams>& table();
     void validate() const { table().check(*this); }
 };
@@ -44,5 +61,10 @@ std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const do
                                       const RewardParams& params = {});
 // softmax(β·values) over the entries where `allowed` (others 0; all 0 if none is allowed).
 std::vector<double> softmax(std::span<const double> values, double beta, const std::vector<char>& allowed);
+
+// The choice's probabilities over directions from each scale's returns (see above). `scores`: the smoothed scores ĉ,
+// one per scale, carried from decision to decision (empty at a start's first decision; filled here).
+std::vector<double> combine_scales(const std::vector<std::vector<double>>& returns, const std::vector<char>& allowed,
+                                   const RewardParams& params, std::vector<double>& scores);
 
 }  // namespace bvc3d
