@@ -1,18 +1,23 @@
-"""Regenerates the results of docs/building-scale.md: place cells that cover a building, on the hall-lidar recording.
+"""Regenerates the results of docs/building-scale.md: place cells that cover a building, on the hall-lidar recording
+and on a Gazebo building's floor.
 
-    /usr/bin/python3 docs/building-scale/make.py --recording PATH/hall-lidar [--work DIR] [--steps ...]
+    /usr/bin/python3 docs/building-scale/make.py --recording PATH/hall-lidar [--work DIR] [--steps rates growing]
+    /usr/bin/python3 docs/building-scale/make.py --house PATH/aws-robomaker-small-house-world --steps floor
 
 Reuses the setup of docs/real-data.md's place-cell step (docs/real-data/make.py: the hall's map in the floor's
 frame, the 0.5 m template grid, the real scans as queries, the paper's random walk of a person-sized body) and its
 read-out (each scan's settled place-cell response, decoded to the most cosine-similar template). Run from the
 repository's root after building (build/bvc3d and build/python). Writes the tables (CSV) next to this script; the
 large intermediate files (the map, BVC rates along the walk) go to --work (the same default as docs/real-data's, so
-the two scripts share them). Steps (default: all, in this order):
+the two scripts share them). Steps (default: rates growing; in this order):
 
   rates    the hall's map and templates (if not there yet), and each model's BVC rates of the templates, the real
            scans and the learning walk (cached in --work)
   growing  a growing place-cell network (bvc3d.GrowingPlaceCells) learned on the walk, every real scan localized
            with it, beside the BVC decoding of the same model and the paper's 250 cells
+  floor    trials of six models (FLOOR_MODELS) × FLOOR_SEEDS seeds on the floor of the AWS RoboMaker small house
+           (--house: the world's folder as AWS publishes it), run by `bvc3d sweep` in --work/gazebo-floor (a rerun
+           skips the trials already there); every analysed population of every trial → floor.csv, floor.png
 
 A model is one line of MODELS. Sized for a shared 2-core machine: see docs/building-scale.md for what was run.
 """
@@ -20,6 +25,8 @@ import argparse
 import csv
 import importlib.util
 import pathlib
+import shutil
+import subprocess
 import sys
 import time
 
@@ -141,20 +148,156 @@ def growing(rec, work):
     log("wrote", HERE / "hall.csv")
 
 
+
+# ---------------------------------------------------------------------------------------- a Gazebo building's floor
+
+# The AWS RoboMaker small house (one furnished storey, 19 × 11.4 m), loaded as docs/buildings.md loads it: without the
+# models Gazebo fetches from its online store. The six models: the paper's single-scale presets, the authors'
+# multiscale presets and growing networks on 2-D and on 3-D BVCs (the model YAMLs next to this script). Each trial is
+# the paper's protocol (explore with learning, then sample frozen) at FLOOR_HOURS per phase; the six models of a seed
+# ride one walk (`bvc3d sweep` shares it).
+HOUSE_WORLD = "worlds/small_house.world"
+FLOOR_MODELS = ["2d", "3d-3l", "ms-2d", "ms-3d", "growing-2d.yaml", "growing-3d.yaml"]
+FLOOR_SEEDS = 5
+FLOOR_HOURS = 0.75  # h per phase: the 30 trials in about 45 min on the shared 2-core machine
+FLOOR_JOBS = 2
+FLOOR_FIGURE_METRICS = [("decode_median_m", "median decoding error (m)"),
+                        ("frac_undecoded", "fraction of samples not decoded"),
+                        ("mean_mi_active", "mean MI of active cells"),
+                        ("msai", "MSAI")]
+
+
+def floor_sweep(house, work):
+    """Writes the sweep, the world YAML and the model YAMLs into work/gazebo-floor and runs the sweep there; the
+    engine skips every trial whose file is already complete. Returns the trials' folder."""
+    world = house / HOUSE_WORLD
+    if not world.is_file():
+        sys.exit(f"--house {house}: no {HOUSE_WORLD} in it (give the small house's folder as AWS publishes it)")
+    folder = work / "gazebo-floor"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "small-house.yaml").write_text(f"sdf: {world}\nmissing_models: skip\n")
+    for model in FLOOR_MODELS:
+        if model.endswith(".yaml"):
+            shutil.copyfile(HERE / model, folder / model)
+    (folder / "sweep.yaml").write_text(
+        "name: floor\n"
+        "base:\n"
+        "  world: small-house.yaml\n"
+        f"  protocol: {{explore_hours: {FLOOR_HOURS:g}, sample_hours: {FLOOR_HOURS:g}}}\n"
+        "grid:\n"
+        f"  model: [{', '.join(FLOOR_MODELS)}]\n"
+        f"seeds: {FLOOR_SEEDS}\n")
+    trials = folder / "trials"
+    cmd = [str(ROOT / "build" / "bvc3d"), "sweep", str(folder / "sweep.yaml"), "--out", str(trials),
+           "--jobs", str(FLOOR_JOBS), "--no-report", "--verbose"]
+    log(" ".join(cmd))
+    start = time.time()
+    subprocess.run(cmd, check=True)
+    log(f"sweep in {time.time() - start:.0f} s")
+    return trials
+
+
+def population_rows(path, metric_names):
+    """One row per analysed population of a trial file: the model's own place cells (`place`, the file's main
+    metrics) and every /populations/NAME with metrics, with its number of cells (for `place-fused`, the sum of the
+    place-cell scales it concatenates) and, for a growing network, how many it recruited."""
+    import h5py
+    rows = []
+    with h5py.File(path, "r") as f:
+        model, seed = str(f.attrs["model"]), int(f.attrs["seed"])
+        groups = {"place": (f["metrics"], f["samples/rates"].shape[1], None)}
+        for name, group in f.get("populations", {}).items():
+            if "metrics" not in group:
+                continue
+            cells = group["rates"].shape[1] if "rates" in group else None
+            recruited = int(np.sum(group["recruited_at"][:] >= 0)) if "recruited_at" in group else None
+            groups[name] = (group["metrics"], cells, recruited)
+        for name, (metrics, cells, recruited) in groups.items():
+            if cells is None:  # the fused decoding: the place-cell scales side by side
+                cells = sum(c for n, (_, c, _) in groups.items() if c is not None and (n == "place" or
+                                                                                     n.startswith("place-")))
+            modality = metrics["modality"][:]
+            area = metrics["field_area"][:][modality > 0]
+            row = {"model": model, "seed": seed, "population": name, "cells": cells,
+                   "recruited": "" if recruited is None else recruited,
+                   "field_area_median_m2": float(np.median(area)) if len(area) else float("nan")}
+            row.update({k: float(metrics.attrs[k]) for k in metric_names if k in metrics.attrs})
+            rows.append(row)
+    return rows
+
+
+def floor(house, work):
+    import bvc3d
+    trials = floor_sweep(house, work)
+    names = [m["name"] for m in bvc3d.metric_table]
+    rows = [row for path in sorted(trials.glob("*.h5")) for row in population_rows(path, names)]
+    order = {m.removesuffix(".yaml"): i for i, m in enumerate(FLOOR_MODELS)}
+    pops = {p: i for i, p in enumerate(FLOOR_FIGURE_POPULATIONS)}
+    rows.sort(key=lambda r: (order.get(r["model"], len(order)), pops.get(r["population"], len(pops)), r["population"],
+                             r["seed"]))
+    fields = ["model", "seed", "population", "cells", "recruited", "field_area_median_m2"]
+    fields += [k for k in names if any(k in r for r in rows)]
+    with open(HERE / "floor.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: f"{v:.6g}" if isinstance(v, float) else v for k, v in row.items()})
+    log("wrote", HERE / "floor.csv", f"({len(rows)} rows)")
+    floor_figure(rows)
+
+
+FLOOR_FIGURE_POPULATIONS = ["place", "place-m", "place-l", "place-fused", "growing"]
+
+
+def floor_figure(rows):
+    """Each place-cell population's metrics, a dot per seed and a bar at the median, one panel per metric."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from bvc3d import figures
+    groups = []
+    for model in dict.fromkeys(r["model"] for r in rows):
+        for pop in FLOOR_FIGURE_POPULATIONS:
+            mine = [r for r in rows if r["model"] == model and r["population"] == pop]
+            if mine:
+                groups.append((f"{model} {pop}", mine))
+    fig, axes = plt.subplots(len(FLOOR_FIGURE_METRICS), 1, figsize=(9, 2.4 * len(FLOOR_FIGURE_METRICS)),
+                             sharex=True, constrained_layout=True)
+    for ax, (metric, label) in zip(axes, FLOOR_FIGURE_METRICS):
+        for i, (_, mine) in enumerate(groups):
+            values = np.array([r[metric] for r in mine])
+            ax.bar(i, np.nanmedian(values), color="0.8", width=0.7)
+            ax.plot(np.full(len(values), i), values, "o", color="C0", ms=3)
+        ax.set_ylabel(label)
+        ax.grid(axis="y", alpha=0.3)
+    axes[-1].set_xticks(range(len(groups)), [g for g, _ in groups], rotation=60, ha="right", fontsize=8)
+    axes[0].set_title(f"AWS small house: {FLOOR_SEEDS} seeds, {FLOOR_HOURS:g} h explore + {FLOOR_HOURS:g} h sample "
+                      "(bar: median over seeds)", fontsize=9)
+    figures.save(fig, HERE / "floor.png")
+    log("wrote", HERE / "floor.png")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--recording", required=True, type=pathlib.Path, help="the hall-lidar folder")
+    parser.add_argument("--recording", type=pathlib.Path, help="the hall-lidar folder (steps rates, growing)")
+    parser.add_argument("--house", type=pathlib.Path,
+                        help="the AWS RoboMaker small house's folder, holding worlds/ and models/ (step floor)")
     parser.add_argument("--work", type=pathlib.Path, default=pathlib.Path("/tmp/bvc3d-real-data"))
     parser.add_argument("--steps", nargs="*", default=["rates", "growing"])
     args = parser.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
     sys.path.insert(0, str(ROOT / "build" / "python"))
-    steps = {"rates": prepare, "growing": growing}
+    steps = {"rates": (prepare, "recording"), "growing": (growing, "recording"), "floor": (floor, "house")}
     for step in args.steps:
         if step not in steps:
             sys.exit(f"unknown step '{step}' (known: {', '.join(steps)})")
+        run, data = steps[step]
+        if getattr(args, data) is None:
+            sys.exit(f"step {step} needs --{data}")
+    for step in args.steps:
+        run, data = steps[step]
         log("step", step)
-        steps[step](args.recording.resolve(), args.work.resolve())
+        run(getattr(args, data).resolve(), args.work.resolve())
 
 
 if __name__ == "__main__":
