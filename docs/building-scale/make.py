@@ -15,7 +15,7 @@ the two scripts share them). Steps (default: rates growing; in this order):
            scans and the learning walk (cached in --work)
   growing  a growing place-cell network (bvc3d.GrowingPlaceCells) learned on the walk, every real scan localized
            with it, beside the BVC decoding of the same model and the paper's 250 cells
-  floor    trials of six models (FLOOR_MODELS) × FLOOR_SEEDS seeds on the floor of the AWS RoboMaker small house
+  floor    trials of eight models (FLOOR_MODELS) × FLOOR_SEEDS seeds on the floor of the AWS RoboMaker small house
            (--house: the world's folder as AWS publishes it), run by `bvc3d sweep` in --work/gazebo-floor (a rerun
            skips the trials already there); every analysed population of every trial → floor.csv, floor.png
 
@@ -152,14 +152,17 @@ def growing(rec, work):
 # ---------------------------------------------------------------------------------------- a Gazebo building's floor
 
 # The AWS RoboMaker small house (one furnished storey, 19 × 11.4 m), loaded as docs/buildings.md loads it: without the
-# models Gazebo fetches from its online store. The six models: the paper's single-scale presets, the authors'
-# multiscale presets and growing networks on 2-D and on 3-D BVCs (the model YAMLs next to this script). Each trial is
-# the paper's protocol (explore with learning, then sample frozen) at FLOOR_HOURS per phase; the six models of a seed
-# ride one walk (`bvc3d sweep` shares it).
+# models Gazebo fetches from its online store. The models: the paper's single-scale presets, the authors' multiscale
+# presets (and the same with their place cells reading BVCs alone, g = 0) and growing networks on 2-D and on 3-D BVCs
+# (the model YAMLs next to this script). Each trial is the paper's protocol (explore with learning, then sample
+# frozen) at FLOOR_HOURS per phase; the models of a seed ride one walk (`bvc3d sweep` shares it).
 HOUSE_WORLD = "worlds/small_house.world"
-FLOOR_MODELS = ["2d", "3d-3l", "ms-2d", "ms-3d", "growing-2d.yaml", "growing-3d.yaml"]
+# New models go at the end: a sweep numbers its conditions in this order, and the trials already run keep their names.
+FLOOR_MODELS = ["2d", "3d-3l", "ms-2d", "ms-3d", "growing-2d.yaml", "growing-3d.yaml", "ms-2d-bvc.yaml",
+                "ms-3d-bvc.yaml"]
+FLOOR_ORDER = ["2d", "3d-3l", "ms-2d", "ms-2d-bvc", "ms-3d", "ms-3d-bvc", "growing-2d", "growing-3d"]  # tables, figure
 FLOOR_SEEDS = 5
-FLOOR_HOURS = 2  # h per phase: the 30 trials in about half an hour on the shared 2-core machine
+FLOOR_HOURS = 2  # h per phase: the 40 trials in about 45 min on the shared 2-core machine
 FLOOR_JOBS = 2
 # DBSCAN's min_samples counts rate-map bins: gridsize 50 across the house's 18.1 m makes bins 1.9 times as wide as
 # across the paper's 9.5 m arena, so the paper's 20 bins within eps = 1 m are 6 here (the same area of field).
@@ -235,7 +238,7 @@ def floor(house, work):
     trials = floor_sweep(house, work)
     names = [m["name"] for m in bvc3d.metric_table]
     rows = [row for path in sorted(trials.glob("*.h5")) for row in population_rows(path, names)]
-    order = {m.removesuffix(".yaml"): i for i, m in enumerate(FLOOR_MODELS)}
+    order = {m: i for i, m in enumerate(FLOOR_ORDER)}
     pops = {p: i for i, p in enumerate(FLOOR_FIGURE_POPULATIONS)}
     rows.sort(key=lambda r: (order.get(r["model"], len(order)), pops.get(r["population"], len(pops)), r["population"],
                              r["seed"]))
