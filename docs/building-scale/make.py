@@ -264,27 +264,40 @@ def floor_table(rows):
             return "–"
         return f"{fmt.format(np.nanmedian(values))} [{fmt.format(np.nanmin(values))}, {fmt.format(np.nanmax(values))}]"
 
+    # A growing model's own 250 place cells are its base preset's, on the same walk: the table shows them once.
+    def same(a, b):
+        return [{k: v for k, v in r.items() if k != "model"} for r in a] == \
+            [{k: v for k, v in r.items() if k != "model"} for r in b]
+    for model, base in (("growing-2d", "2d"), ("growing-3d", "3d-3l")):
+        mine, theirs = ([r for r in rows if r["model"] == m and r["population"] == "place"] for m in (model, base))
+        log(f"{model}'s place cells {'are' if same(mine, theirs) else 'are NOT'} {base}'s, metric for metric")
     lines = ["| model | population | cells | active cells (MI > 0) | mean MI | multimodal of active | MSAI | "
              "decoding median | not decoded | median, undecoded at chance |",
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for model in dict.fromkeys(r["model"] for r in rows):
-        for pop in FLOOR_FIGURE_POPULATIONS:
-            mine = [r for r in rows if r["model"] == model and r["population"] == pop]
-            if not mine:
-                continue
-            cells = spread([r["recruited"] for r in mine], "{:.0f}") if mine[0]["recruited"] != "" else mine[0]["cells"]
-            active = [r["frac_active"] * r["cells"] for r in mine]
-            multi = [r["frac_multimodal"] / r["frac_active"] if r["frac_active"] > 0 else np.nan for r in mine]
-            lines.append(f"| {model} | {pop} | {cells} | {spread(active, '{:.0f}')} | "
-                         f"{spread([r['mean_mi_active'] for r in mine], '{:.2f}')} | {spread(multi, '{:.2f}')} | "
-                         f"{spread([r['msai'] for r in mine], '{:.4f}')} | "
-                         f"{spread([r['decode_median_m'] for r in mine], '{:.2f}')} m | "
-                         f"{spread([r['frac_undecoded'] for r in mine], '{:.3f}')} | "
-                         f"{spread([r['decode_median_all_m'] for r in mine], '{:.2f}')} m |")
+    for model, pop, mine in shown_groups(rows):
+        cells = spread([r["recruited"] for r in mine], "{:.0f}") if mine[0]["recruited"] != "" else mine[0]["cells"]
+        active = [r["frac_active"] * r["cells"] for r in mine]
+        multi = [r["frac_multimodal"] / r["frac_active"] if r["frac_active"] > 0 else np.nan for r in mine]
+        lines.append(f"| {model} | {pop} | {cells} | {spread(active, '{:.0f}')} | "
+                     f"{spread([r['mean_mi_active'] for r in mine], '{:.2f}')} | {spread(multi, '{:.2f}')} | "
+                     f"{spread([r['msai'] for r in mine], '{:.4f}')} | "
+                     f"{spread([r['decode_median_m'] for r in mine], '{:.2f}')} m | "
+                     f"{spread([r['frac_undecoded'] for r in mine], '{:.3f}')} | "
+                     f"{spread([r['decode_median_all_m'] for r in mine], '{:.2f}')} m |")
     return "\n".join(lines)
 
 
 FLOOR_FIGURE_POPULATIONS = ["place", "place-m", "place-l", "place-fused", "growing"]
+
+
+def shown_groups(rows):
+    """(model, population, its rows) of the table and the figure: the place-cell populations, in order; a growing
+    model's own 250 place cells are its base preset's on the same walk (floor_table checks it), shown once."""
+    for model in dict.fromkeys(r["model"] for r in rows):
+        for pop in FLOOR_FIGURE_POPULATIONS:
+            mine = [r for r in rows if r["model"] == model and r["population"] == pop]
+            if mine and not (model.startswith("growing") and pop == "place"):
+                yield model, pop, mine
 
 
 def floor_figure(rows):
@@ -293,12 +306,7 @@ def floor_figure(rows):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from bvc3d import figures
-    groups = []
-    for model in dict.fromkeys(r["model"] for r in rows):
-        for pop in FLOOR_FIGURE_POPULATIONS:
-            mine = [r for r in rows if r["model"] == model and r["population"] == pop]
-            if mine:
-                groups.append((f"{model} {pop}", mine))
+    groups = [(f"{model} {pop}", mine) for model, pop, mine in shown_groups(rows)]
     fig, axes = plt.subplots(len(FLOOR_FIGURE_METRICS), 1, figsize=(9, 2.4 * len(FLOOR_FIGURE_METRICS)),
                              sharex=True, constrained_layout=True)
     for ax, (metric, label) in zip(axes, FLOOR_FIGURE_METRICS):
