@@ -56,9 +56,10 @@ rd = load_real_data()
 log = rd.log
 
 
-def walk_and_rates(setup, name):
+def walk_and_rates(setup, name, model=None):
     """The learning walk (docs/real-data.md's) and model `name`'s BVC rates along it, float32 (the place cells take
-    their inputs as float32, so nothing is lost), cached in floor/NAME-walk-Hh.npz."""
+    their inputs as float32, so nothing is lost), cached in floor/NAME-walk-Hh.npz. `model`: a model YAML to read
+    instead of the name (default: rd.model_arg(name))."""
     import bvc3d
     cache = setup["floor"] / f"{name}-walk-{WALK_HOURS:g}h.npz"
     if not cache.exists():
@@ -67,16 +68,20 @@ def walk_and_rates(setup, name):
         path = {k: walk[k] for k in ("t", "x", "y", "heading")}
         path["z"] = np.full(len(walk["t"]), setup["height"])
         rates = bvc3d.replay_simulated(str(setup["floor"] / "hall-map.yaml"), path, setup["sensor"],
-                                       rd.model_arg(name))["bvc_rates"]
+                                       model or rd.model_arg(name))["bvc_rates"]
         np.savez(cache, bvc=rates.astype(np.float32), x=walk["x"], y=walk["y"])
         log(f"{name}: BVC rates along the {WALK_HOURS:g} h walk in {time.time() - start:.0f} s")
     return np.load(cache)
 
 
-def prepare(rec, work):
+def hall_setup(rec, work):
     if not (work / "grid.csv").exists() or not (work / "hall-map.ply").exists():
         rd.hall_map(rec, work)
-    setup = rd.floor_setup(rec, work)
+    return rd.floor_setup(rec, work)
+
+
+def prepare(rec, work):
+    setup = hall_setup(rec, work)
     for name in MODELS:
         rd.template_query_rates(setup, name)
         walk_and_rates(setup, name)
@@ -147,6 +152,91 @@ def growing(rec, work):
             w.writerow({k: f"{v:.4g}" if isinstance(v, float) else v for k, v in row.items()})
     log("wrote", HERE / "hall.csv")
 
+
+
+# The authors' multiscale model on the hall, its place cells reading the BVCs alone (ms-2d-bvc.yaml: g = 0; a real scan
+# brings no grid-cell input, so the grid cells cannot take part in its read-out). Each scale is stepped by hand as
+# NETWORKS are: its BVC layer (ms-2d's, docs/model-reference.md#multiscale-models) a 2-D model of its own, its place
+# cells a PlaceCellNetwork with the scale's size and inhibition, all learned on the same walk. Decoded per scale and
+# fused as the trials fuse them (each scale's rate vector scaled to unit length, side by side).
+MS_SCALES = [  # (scale, the BVC layer's keys beyond 8 directions to 25 m, the place cells' keys)
+    ("s", "n_per_axis: 100, sigma_r: 0.5, sigma_theta: 0.017453292519943295",
+     dict(n_place=2000, gamma_pp=1.0, gamma_pb=0.35)),
+    ("m", "n_per_axis: 50, sigma_r: 1, sigma_theta: 0.05235987755982988",
+     dict(n_place=1000, gamma_pp=0.7, gamma_pb=0.35)),
+    ("l", "n_per_axis: 75, sigma_r: 1.5, sigma_theta: 0.08726646259971647",
+     dict(n_place=500, gamma_pp=0.7, gamma_pb=0.25)),
+]
+
+
+def scale_rates(setup, label, model):
+    """BVC rates of the templates and the real queries for a model YAML, cached in floor/LABEL-bvc.npz."""
+    import bvc3d
+    cache = setup["floor"] / f"{label}-bvc.npz"
+    if not cache.exists():
+        np.savez(cache, templates=bvc3d.replay_simulated(str(setup["floor"] / "hall-map.yaml"), setup["grid_path"],
+                                                         setup["sensor"], model)["bvc_rates"],
+                 queries=setup["queries"].replay(model)["bvc_rates"])
+    return np.load(cache)
+
+
+def settled(bvc, weights, params):
+    """rd.settled_place_rates for a network with other parameters than the paper's."""
+    import bvc3d
+    net = bvc3d.PlaceCellNetwork(bvc.shape[1], **params)
+    net.weights = weights
+    out = np.empty((len(bvc), weights.shape[0]), np.float32)
+    for i, v in enumerate(np.asarray(bvc, np.float64)):
+        net.reset()
+        steps = [net.step(v, False) for _ in range(rd.SETTLE)]
+        out[i] = np.mean(steps[rd.SETTLE - rd.SETTLE // 2:], axis=0)
+    return out
+
+
+def unit_rows(parts):
+    """The scales side by side, each row of each scaled to unit length (a silent row stays 0)."""
+    out = []
+    for part in parts:
+        norm = np.linalg.norm(part, axis=1, keepdims=True)
+        out.append(np.divide(part, norm, out=np.zeros_like(part, dtype=np.float64), where=norm > 0))
+    return np.hstack(out)
+
+
+def multiscale(rec, work):
+    import bvc3d
+    setup = hall_setup(rec, work)
+    grid, qxyz = setup["grid"], setup["qxyz"]
+    rows, parts = [], {"bvc": ([], []), "place": ([], [])}
+    for i, (scale, keys, params) in enumerate(MS_SCALES):
+        label = f"ms-2d-{scale}"
+        model = setup["floor"] / f"{label}.yaml"
+        model.write_text(f"name: {label}\nbase: 2d\nbvc: {{n_dir: 8, max_dist: 25, {keys}}}\n")
+        bvc = scale_rates(setup, label, str(model))
+        walk = walk_and_rates(setup, label, str(model))
+        start = time.time()
+        W = learn_on_walk(bvc3d.PlaceCellNetwork(walk["bvc"].shape[1], seed=i, **params), walk["bvc"])
+        learned = time.time() - start
+        templates, queries = settled(bvc["templates"], W, params), settled(bvc["queries"], W, params)
+        for network, t, q, cells in (("bvc", bvc["templates"], bvc["queries"], bvc["templates"].shape[1]),
+                                     ("place", templates, queries, W.shape[0])):
+            parts[network][0].append(t)
+            parts[network][1].append(q)
+            rows.append({"model": "ms-2d-bvc", "scale": scale, "network": network, "cells": cells,
+                         "learn_s": learned if network == "place" else 0.0, **decode(t, grid, q, qxyz)})
+        log(f"ms-2d-bvc {scale}: place median {rows[-1]['median_m']:.2f} m (BVC {rows[-2]['median_m']:.2f} m)")
+    for network, (t, q) in parts.items():
+        rows.append({"model": "ms-2d-bvc", "scale": "fused", "network": network,
+                     "cells": sum(p.shape[1] for p in t), "learn_s": 0.0,
+                     **decode(unit_rows(t), grid, unit_rows(q), qxyz)})
+    for row in rows:
+        row["median_over_bvc"] = row["median_m"] / next(r["median_m"] for r in rows
+                                                        if r["scale"] == row["scale"] and r["network"] == "bvc")
+    with open(HERE / "hall-multiscale.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: f"{v:.4g}" if isinstance(v, float) else v for k, v in row.items()})
+    log("wrote", HERE / "hall-multiscale.csv")
 
 
 # ---------------------------------------------------------------------------------------- a Gazebo building's floor
@@ -333,7 +423,8 @@ def main():
     args = parser.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
     sys.path.insert(0, str(ROOT / "build" / "python"))
-    steps = {"rates": (prepare, "recording"), "growing": (growing, "recording"), "floor": (floor, "house")}
+    steps = {"rates": (prepare, "recording"), "growing": (growing, "recording"),
+             "multiscale": (multiscale, "recording"), "floor": (floor, "house")}
     for step in args.steps:
         if step not in steps:
             sys.exit(f"unknown step '{step}' (known: {', '.join(steps)})")
