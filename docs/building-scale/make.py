@@ -175,7 +175,7 @@ def scale_rates(setup, label, model):
     cache = setup["floor"] / f"{label}-bvc.npz"
     if not cache.exists():
         np.savez(cache, templates=bvc3d.replay_simulated(str(setup["floor"] / "hall-map.yaml"), setup["grid_path"],
-                                                         setup["sensor"], model)["bvc_rates"],
+                                                         setup["sensor"], model, step_per_row=True)["bvc_rates"],
                  queries=setup["queries"].replay(model)["bvc_rates"])
     return np.load(cache)
 
