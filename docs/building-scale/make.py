@@ -257,10 +257,10 @@ FLOOR_JOBS = 2
 # DBSCAN's min_samples counts rate-map bins: gridsize 50 across the house's 18.1 m makes bins 1.9 times as wide as
 # across the paper's 9.5 m arena, so the paper's 20 bins within eps = 1 m are 6 here (the same area of field).
 FLOOR_MIN_SAMPLES = 6
-FLOOR_FIGURE_METRICS = [("decode_median_m", "median decoding error (m)"),
-                        ("frac_undecoded", "fraction of samples not decoded"),
-                        ("mean_mi_active", "mean MI of active cells"),
-                        ("msai", "MSAI")]
+FLOOR_FIGURE_METRICS = [("decode_median_all_m", "median error (m),\nundecoded at chance", "log"),
+                        ("frac_undecoded", "fraction of samples\nnot decoded", "linear"),
+                        ("mean_mi_active", "mean MI of\nactive cells", "linear"),
+                        ("msai", "MSAI", "linear")]
 
 
 def floor_sweep(house, work):
@@ -399,12 +399,16 @@ def floor_figure(rows):
     groups = [(f"{model} {pop}", mine) for model, pop, mine in shown_groups(rows)]
     fig, axes = plt.subplots(len(FLOOR_FIGURE_METRICS), 1, figsize=(9, 2.4 * len(FLOOR_FIGURE_METRICS)),
                              sharex=True, constrained_layout=True)
-    for ax, (metric, label) in zip(axes, FLOOR_FIGURE_METRICS):
+    for ax, (metric, label, scale) in zip(axes, FLOOR_FIGURE_METRICS):
         for i, (_, mine) in enumerate(groups):
             values = np.array([r[metric] for r in mine])
             ax.bar(i, np.nanmedian(values), color="0.8", width=0.7)
             ax.plot(np.full(len(values), i), values, "o", color="C0", ms=3)
         ax.set_ylabel(label)
+        ax.set_yscale(scale)
+        if scale == "log":
+            ax.set_yticks([0.2, 0.5, 1, 2, 5], ["0.2", "0.5", "1", "2", "5"])
+            ax.minorticks_off()
         ax.grid(axis="y", alpha=0.3)
     axes[-1].set_xticks(range(len(groups)), [g for g, _ in groups], rotation=60, ha="right", fontsize=8)
     axes[0].set_title(f"AWS small house: {FLOOR_SEEDS} seeds, {FLOOR_HOURS:g} h explore + {FLOOR_HOURS:g} h sample "
