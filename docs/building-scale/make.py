@@ -254,12 +254,15 @@ FLOOR_ORDER = ["2d", "3d-3l", "ms-2d", "ms-2d-bvc", "ms-3d", "ms-3d-bvc", "growi
 FLOOR_SEEDS = 5
 FLOOR_HOURS = 2  # h per phase: the 40 trials in about 45 min on the shared 2-core machine
 FLOOR_JOBS = 2
-# DBSCAN's min_samples counts rate-map bins: gridsize 50 across the house's 18.1 m makes bins 1.9 times as wide as
-# across the paper's 9.5 m arena, so the paper's 20 bins within eps = 1 m are 6 here (the same area of field).
+# The modality index's DBSCAN counts rate-map bins (min_samples within eps = 1 m), and bins grow with the floor:
+# gridsize 50 across the house's 18.1 × 10.6 m gives hexagons of 0.068 m², 2.1 times the paper's 9.5 m arena's
+# (0.032 m²), so the paper's 20 bins of field are 9.4 of the house's. The trials analyse with FLOOR_MIN_SAMPLES; the
+# modality is also recomputed from their rate maps (the library's own function) at each count of MODALITY_COUNTS.
 FLOOR_MIN_SAMPLES = 6
+MODALITY_COUNTS = [9, 20]  # the paper's field area in the house's bins; the paper's count as it stands
 FLOOR_FIGURE_METRICS = [("decode_median_all_m", "median error (m),\nundecoded at chance", "log"),
                         ("frac_undecoded", "fraction of samples\nnot decoded", "linear"),
-                        ("mean_mi_active", "mean MI of\nactive cells", "linear"),
+                        (f"mean_mi_active_ms{MODALITY_COUNTS[0]}", "mean MI of active\ncells", "linear"),
                         ("msai", "MSAI", "linear")]
 
 
@@ -297,8 +300,11 @@ def floor_sweep(house, work):
 def population_rows(path, metric_names):
     """One row per analysed population of a trial file: the model's own place cells (`place`, the file's main
     metrics) and every /populations/NAME with metrics, with its number of cells (for `place-fused`, the sum of the
-    place-cell scales it concatenates) and, for a growing network, how many it recruited."""
+    place-cell scales it concatenates), for a growing network how many it recruited, and its modality recomputed
+    from its rate maps at each count K of MODALITY_COUNTS (frac_active_msK, mean_mi_active_msK,
+    frac_multimodal_msK)."""
     import h5py
+    from bvc3d import analysis
     rows = []
     with h5py.File(path, "r") as f:
         model, seed = str(f.attrs["model"]), int(f.attrs["seed"])
@@ -319,6 +325,10 @@ def population_rows(path, metric_names):
                    "recruited": "" if recruited is None else recruited,
                    "field_area_median_m2": float(np.median(area)) if len(area) else float("nan")}
             row.update({k: float(metrics.attrs[k]) for k in metric_names if k in metrics.attrs})
+            centers, maps = metrics["bin_centers"][:], metrics["rate_maps"][:]
+            for count in MODALITY_COUNTS:
+                mi = analysis.modality(centers, maps, eps=float(metrics.attrs["eps"]), min_samples=count)
+                row.update({f"{k}_ms{count}": float(v) for k, v in analysis.modality_summary(mi).items()})
             rows.append(row)
     return rows
 
@@ -334,6 +344,7 @@ def floor(house, work):
                              r["seed"]))
     fields = ["model", "seed", "population", "cells", "recruited", "field_area_median_m2"]
     fields += [k for k in names if any(k in r for r in rows)]
+    fields += [k for k in rows[0] if k not in fields]
     with open(HERE / "floor.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
@@ -346,8 +357,9 @@ def floor(house, work):
 
 def floor_table(rows):
     """docs/building-scale.md's table: per model and place-cell population, the median over seeds [smallest,
-    largest]. Counts of cells rather than fractions, and the multimodal share of the active cells, so that
-    populations of 250 to 3 500 cells (and a growing network's budget of which it recruited a part) compare."""
+    largest]; the modality at the first of MODALITY_COUNTS. Counts of cells rather than fractions, and the
+    multimodal share of the active cells, so that populations of 250 to 3 500 cells (and a growing network's budget
+    of which it recruited a part) compare."""
     def spread(values, fmt):
         values = np.asarray(values, float)
         if np.all(np.isnan(values)):
@@ -366,10 +378,11 @@ def floor_table(rows):
              "|---|---|---|---|---|---|---|---|---|---|"]
     for model, pop, mine in shown_groups(rows):
         cells = spread([r["recruited"] for r in mine], "{:.0f}") if mine[0]["recruited"] != "" else mine[0]["cells"]
-        active = [r["frac_active"] * r["cells"] for r in mine]
-        multi = [r["frac_multimodal"] / r["frac_active"] if r["frac_active"] > 0 else np.nan for r in mine]
+        k = f"_ms{MODALITY_COUNTS[0]}"
+        active = [r["frac_active" + k] * r["cells"] for r in mine]
+        multi = [r["frac_multimodal" + k] / r["frac_active" + k] if r["frac_active" + k] > 0 else np.nan for r in mine]
         lines.append(f"| {model} | {pop} | {cells} | {spread(active, '{:.0f}')} | "
-                     f"{spread([r['mean_mi_active'] for r in mine], '{:.2f}')} | {spread(multi, '{:.2f}')} | "
+                     f"{spread([r['mean_mi_active' + k] for r in mine], '{:.2f}')} | {spread(multi, '{:.2f}')} | "
                      f"{spread([r['msai'] for r in mine], '{:.4f}')} | "
                      f"{spread([r['decode_median_m'] for r in mine], '{:.2f}')} m | "
                      f"{spread([r['frac_undecoded'] for r in mine], '{:.3f}')} | "
