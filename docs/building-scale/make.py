@@ -373,15 +373,16 @@ def floor_table(rows):
     for model, base in (("growing-2d", "2d"), ("growing-3d", "3d-3l")):
         mine, theirs = ([r for r in rows if r["model"] == m and r["population"] == "place"] for m in (model, base))
         log(f"{model}'s place cells {'are' if same(mine, theirs) else 'are NOT'} {base}'s, metric for metric")
-    lines = ["| model | population | cells | active cells (MI > 0) | mean MI | multimodal of active | MSAI | "
+    lines = ["| model | population | cells | active cells (MI > 0) | field area | mean MI | multimodal of active | MSAI | "
              "decoding median | not decoded | median, undecoded at chance |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for model, pop, mine in shown_groups(rows):
         cells = spread([r["recruited"] for r in mine], "{:.0f}") if mine[0]["recruited"] != "" else mine[0]["cells"]
         k = f"_ms{MODALITY_COUNTS[0]}"
         active = [r["frac_active" + k] * r["cells"] for r in mine]
         multi = [r["frac_multimodal" + k] / r["frac_active" + k] if r["frac_active" + k] > 0 else np.nan for r in mine]
         lines.append(f"| {model} | {pop} | {cells} | {spread(active, '{:.0f}')} | "
+                     f"{spread([r['field_area_median_m2'] for r in mine], '{:.2f}')} m² | "
                      f"{spread([r['mean_mi_active' + k] for r in mine], '{:.2f}')} | {spread(multi, '{:.2f}')} | "
                      f"{spread([r['msai'] for r in mine], '{:.4f}')} | "
                      f"{spread([r['decode_median_m'] for r in mine], '{:.2f}')} m | "
