@@ -373,8 +373,8 @@ def floor_table(rows):
     for model, base in (("growing-2d", "2d"), ("growing-3d", "3d-3l")):
         mine, theirs = ([r for r in rows if r["model"] == m and r["population"] == "place"] for m in (model, base))
         log(f"{model}'s place cells {'are' if same(mine, theirs) else 'are NOT'} {base}'s, metric for metric")
-    lines = ["| model | population | cells | active cells (MI > 0) | field area | mean MI | multimodal of active | MSAI | "
-             "decoding median | not decoded | median, undecoded at chance |",
+    lines = ["| model | population | cells | active cells (MI > 0) | field area | mean MI | multimodal of active | "
+             "MSAI | decoding median | not decoded | median, undecoded at chance |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for model, pop, mine in shown_groups(rows):
         cells = spread([r["recruited"] for r in mine], "{:.0f}") if mine[0]["recruited"] != "" else mine[0]["cells"]
