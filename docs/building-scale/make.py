@@ -1,7 +1,7 @@
 """Regenerates the results of docs/building-scale.md: place cells that cover a building, on the hall-lidar recording
 and on a Gazebo building's floor.
 
-    /usr/bin/python3 docs/building-scale/make.py --recording PATH/hall-lidar [--work DIR] [--steps rates growing]
+    /usr/bin/python3 docs/building-scale/make.py --recording PATH/hall-lidar [--work DIR] [--steps rates growing ...]
     /usr/bin/python3 docs/building-scale/make.py --house PATH/aws-robomaker-small-house-world --steps floor
 
 Reuses the setup of docs/real-data.md's place-cell step (docs/real-data/make.py: the hall's map in the floor's
@@ -15,11 +15,14 @@ the two scripts share them). Steps (default: rates growing; in this order):
            scans and the learning walk (cached in --work)
   growing  a growing place-cell network (bvc3d.GrowingPlaceCells) learned on the walk, every real scan localized
            with it, beside the BVC decoding of the same model and the paper's 250 cells
+  multiscale  ms-2d's three scales with their place cells reading BVCs alone (g = 0) learned on the same walk,
+           each scale and the scales fused decoded as `growing` decodes (hall-multiscale.csv)
   floor    trials of eight models (FLOOR_MODELS) × FLOOR_SEEDS seeds on the floor of the AWS RoboMaker small house
            (--house: the world's folder as AWS publishes it), run by `bvc3d sweep` in --work/gazebo-floor (a rerun
            skips the trials already there); every analysed population of every trial → floor.csv, floor.png
 
-A model is one line of MODELS. Sized for a shared 2-core machine: see docs/building-scale.md for what was run.
+A hall model is one line of MODELS, a floor model one of FLOOR_MODELS. Sized for a shared 2-core machine: see
+docs/building-scale.md for what was run.
 """
 import argparse
 import csv
