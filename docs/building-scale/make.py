@@ -59,21 +59,22 @@ rd = load_real_data()
 log = rd.log
 
 
-def walk_and_rates(setup, name, model=None):
+def walk_and_rates(setup, name, model=None, seed=WALK_SEED):
     """The learning walk (docs/real-data.md's) and model `name`'s BVC rates along it, float32 (the place cells take
-    their inputs as float32, so nothing is lost), cached in floor/NAME-walk-Hh.npz. `model`: a model YAML to read
-    instead of the name (default: rd.model_arg(name))."""
+    their inputs as float32, so nothing is lost), cached in floor/NAME-walk-Hh.npz (NAME-walk-Hh-seedS.npz for
+    another walk than WALK_SEED's). `model`: a model YAML to read instead of the name (default: rd.model_arg(name))."""
     import bvc3d
-    cache = setup["floor"] / f"{name}-walk-{WALK_HOURS:g}h.npz"
+    suffix = "" if seed == WALK_SEED else f"-seed{seed}"
+    cache = setup["floor"] / f"{name}-walk-{WALK_HOURS:g}h{suffix}.npz"
     if not cache.exists():
         start = time.time()
-        walk = bvc3d.random_walk(setup["world"], WALK_HOURS, WALK_SEED, height=rd.BODY_HEIGHT)
+        walk = bvc3d.random_walk(setup["world"], WALK_HOURS, seed, height=rd.BODY_HEIGHT)
         path = {k: walk[k] for k in ("t", "x", "y", "heading")}
         path["z"] = np.full(len(walk["t"]), setup["height"])
         rates = bvc3d.replay_simulated(str(setup["floor"] / "hall-map.yaml"), path, setup["sensor"],
                                        model or rd.model_arg(name))["bvc_rates"]
         np.savez(cache, bvc=rates.astype(np.float32), x=walk["x"], y=walk["y"])
-        log(f"{name}: BVC rates along the {WALK_HOURS:g} h walk in {time.time() - start:.0f} s")
+        log(f"{name}: BVC rates along the {WALK_HOURS:g} h walk (seed {seed}) in {time.time() - start:.0f} s")
     return np.load(cache)
 
 
@@ -170,6 +171,7 @@ MS_SCALES = [  # (scale, the BVC layer's keys beyond 8 directions to 25 m, the p
     ("l", "n_per_axis: 75, sigma_r: 1.5, sigma_theta: 0.08726646259971647",
      dict(n_place=500, gamma_pp=0.7, gamma_pb=0.25)),
 ]
+MS_WALK_SEEDS = [0, 1, 2]  # the learning walks (seed 0: the growing step's)
 
 
 def scale_rates(setup, label, model):
@@ -206,31 +208,45 @@ def unit_rows(parts):
 
 
 def multiscale(rec, work):
+    """Every scale learned on each walk of MS_WALK_SEEDS (the place cells' weights drawn with seed 3·walk + scale);
+    the BVC decoding does not depend on the walk and is written once (walk_seed empty)."""
     import bvc3d
     setup = hall_setup(rec, work)
     grid, qxyz = setup["grid"], setup["qxyz"]
-    rows, parts = [], {"bvc": ([], []), "place": ([], [])}
-    for i, (scale, keys, params) in enumerate(MS_SCALES):
+    rows, bvc_parts = [], ([], [])
+    models = []
+    for scale, keys, params in MS_SCALES:
         label = f"ms-2d-{scale}"
         model = setup["floor"] / f"{label}.yaml"
         model.write_text(f"name: {label}\nbase: 2d\nbvc: {{n_dir: 8, max_dist: 25, {keys}}}\n")
         bvc = scale_rates(setup, label, str(model))
-        walk = walk_and_rates(setup, label, str(model))
-        start = time.time()
-        W = learn_on_walk(bvc3d.PlaceCellNetwork(walk["bvc"].shape[1], seed=i, **params), walk["bvc"])
-        learned = time.time() - start
-        templates, queries = settled(bvc["templates"], W, params), settled(bvc["queries"], W, params)
-        for network, t, q, cells in (("bvc", bvc["templates"], bvc["queries"], bvc["templates"].shape[1]),
-                                     ("place", templates, queries, W.shape[0])):
-            parts[network][0].append(t)
-            parts[network][1].append(q)
-            rows.append({"model": "ms-2d-bvc", "scale": scale, "network": network, "cells": cells,
-                         "learn_s": learned if network == "place" else 0.0, **decode(t, grid, q, qxyz)})
-        log(f"ms-2d-bvc {scale}: place median {rows[-1]['median_m']:.2f} m (BVC {rows[-2]['median_m']:.2f} m)")
-    for network, (t, q) in parts.items():
-        rows.append({"model": "ms-2d-bvc", "scale": "fused", "network": network,
-                     "cells": sum(p.shape[1] for p in t), "learn_s": 0.0,
-                     **decode(unit_rows(t), grid, unit_rows(q), qxyz)})
+        models.append((scale, label, model, params, bvc))
+        bvc_parts[0].append(bvc["templates"])
+        bvc_parts[1].append(bvc["queries"])
+        rows.append({"model": "ms-2d-bvc", "walk_seed": "", "scale": scale, "network": "bvc",
+                     "cells": bvc["templates"].shape[1], "learn_s": 0.0,
+                     **decode(bvc["templates"], grid, bvc["queries"], qxyz)})
+    rows.append({"model": "ms-2d-bvc", "walk_seed": "", "scale": "fused", "network": "bvc",
+                 "cells": sum(p.shape[1] for p in bvc_parts[0]), "learn_s": 0.0,
+                 **decode(unit_rows(bvc_parts[0]), grid, unit_rows(bvc_parts[1]), qxyz)})
+    for walk_seed in MS_WALK_SEEDS:
+        place_parts = ([], [])
+        for i, (scale, label, model, params, bvc) in enumerate(models):
+            walk = walk_and_rates(setup, label, str(model), seed=walk_seed)
+            start = time.time()
+            W = learn_on_walk(bvc3d.PlaceCellNetwork(walk["bvc"].shape[1], seed=3 * walk_seed + i, **params),
+                              walk["bvc"])
+            learned = time.time() - start
+            templates, queries = settled(bvc["templates"], W, params), settled(bvc["queries"], W, params)
+            place_parts[0].append(templates)
+            place_parts[1].append(queries)
+            rows.append({"model": "ms-2d-bvc", "walk_seed": walk_seed, "scale": scale, "network": "place",
+                         "cells": W.shape[0], "learn_s": learned, **decode(templates, grid, queries, qxyz)})
+            log(f"ms-2d-bvc walk {walk_seed} {scale}: place median {rows[-1]['median_m']:.2f} m")
+        rows.append({"model": "ms-2d-bvc", "walk_seed": walk_seed, "scale": "fused", "network": "place",
+                     "cells": sum(p.shape[1] for p in place_parts[0]), "learn_s": 0.0,
+                     **decode(unit_rows(place_parts[0]), grid, unit_rows(place_parts[1]), qxyz)})
+        log(f"ms-2d-bvc walk {walk_seed} fused: place median {rows[-1]['median_m']:.2f} m")
     for row in rows:
         row["median_over_bvc"] = row["median_m"] / next(r["median_m"] for r in rows
                                                         if r["scale"] == row["scale"] and r["network"] == "bvc")
