@@ -376,7 +376,8 @@ def summary_row(label, model, rates, result):
 def floor_setup(rec, work):
     """The map, the template grid and the recording's poses in the floor frame (under work/floor), as a dict:
     floor (the folder), world, grid (templates, n x 3), queries (the Recording), qxyz, sensor, height (the
-    sensor's), grid_path and query_path (trajectories for replay_simulated). Needs hall_map's outputs."""
+    sensor's), grid_path and query_path (places, not tracks in time: replay_simulated steps them with
+    step_per_row=True). Needs hall_map's outputs."""
     import bvc3d
     from scipy.spatial import ConvexHull
     points = read_ply(work / "hall-map.ply")
@@ -420,7 +421,7 @@ def template_query_rates(setup, name):
     if not bvc_file.exists():
         np.savez(bvc_file,
                  templates=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), setup["grid_path"], setup["sensor"],
-                                                  model_arg(name))["bvc_rates"],
+                                                  model_arg(name), step_per_row=True)["bvc_rates"],
                  queries=setup["queries"].replay(model_arg(name))["bvc_rates"])
     return np.load(bvc_file)
 
@@ -448,7 +449,7 @@ def place_cells(rec, work):
         sim_file = floor / f"{name}-simulated-queries.npz"
         if not sim_file.exists():
             np.savez(sim_file, queries=bvc3d.replay_simulated(str(floor / "hall-map.yaml"), query_path, sensor,
-                                                              model_arg(name))["bvc_rates"])
+                                                              model_arg(name), step_per_row=True)["bvc_rates"])
         bvc = template_query_rates(setup, name)
         W = np.load(cache)["weights"]
         simulated = np.load(sim_file)["queries"]
