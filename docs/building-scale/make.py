@@ -84,6 +84,20 @@ def hall_setup(rec, work):
     return rd.floor_setup(rec, work)
 
 
+def write_hall_table(rows, name, group):
+    """Each row's median over the BVC decoding's of its `group` (the row whose network is "bvc"), then the rows to
+    HERE/name, floats to 4 significant digits."""
+    for row in rows:
+        row["median_over_bvc"] = row["median_m"] / next(r["median_m"] for r in rows
+                                                        if r[group] == row[group] and r["network"] == "bvc")
+    with open(HERE / name, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: f"{v:.4g}" if isinstance(v, float) else v for k, v in row.items()})
+    log("wrote", HERE / name)
+
+
 def prepare(rec, work):
     setup = hall_setup(rec, work)
     for name in MODELS:
@@ -146,15 +160,7 @@ def growing(rec, work):
                          "learn_s": learned, **result})
             log(f"{name} {label}: {W.shape[0]} cells, median {result['median_m']:.2f} m "
                 f"(BVC {base['median_m']:.2f} m), {100 * result['silent_queries']:.0f} % silent queries")
-    for row in rows:
-        row["median_over_bvc"] = row["median_m"] / next(r["median_m"] for r in rows
-                                                        if r["model"] == row["model"] and r["network"] == "bvc")
-    with open(HERE / "hall.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: f"{v:.4g}" if isinstance(v, float) else v for k, v in row.items()})
-    log("wrote", HERE / "hall.csv")
+    write_hall_table(rows, "hall.csv", "model")
 
 
 
@@ -247,15 +253,7 @@ def multiscale(rec, work):
                      "cells": sum(p.shape[1] for p in place_parts[0]), "learn_s": 0.0,
                      **decode(unit_rows(place_parts[0]), grid, unit_rows(place_parts[1]), qxyz)})
         log(f"ms-2d-bvc walk {walk_seed} fused: place median {rows[-1]['median_m']:.2f} m")
-    for row in rows:
-        row["median_over_bvc"] = row["median_m"] / next(r["median_m"] for r in rows
-                                                        if r["scale"] == row["scale"] and r["network"] == "bvc")
-    with open(HERE / "hall-multiscale.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: f"{v:.4g}" if isinstance(v, float) else v for k, v in row.items()})
-    log("wrote", HERE / "hall-multiscale.csv")
+    write_hall_table(rows, "hall-multiscale.csv", "scale")
 
 
 # ---------------------------------------------------------------------------------------- a Gazebo building's floor
