@@ -142,10 +142,10 @@ struct ModelFootprint {
 ModelFootprint model_footprint(const ModelSpec& model, bool record_bvc) {
     std::map<std::string, std::size_t> cells{{"bvc", model.bvc.n_cells()},
                                              {"place", static_cast<std::size_t>(model.place.n_place)}};
+    std::set<std::string> recorded{"place"};
     ModelFootprint f;
     f.recorded_cells = model.place.n_place + (record_bvc ? model.bvc.n_cells() : 0);
     f.largest_analysed = model.place.n_place;
-    double fused = model.place.n_place;
     for (const PopulationSpec& spec : model.populations) {
         std::vector<std::size_t> in;
         for (const auto& name : spec.inputs) in.push_back(cells.count(name) ? cells.at(name) : 0);
@@ -153,12 +153,17 @@ ModelFootprint model_footprint(const ModelSpec& model, bool record_bvc) {
         cells[spec.name] = p.cells;
         f.state_bytes += p.state_bytes;
         if (!spec.recorded) continue;
+        recorded.insert(spec.name);
         f.recorded_cells += static_cast<double>(p.cells);
         f.largest_analysed = std::max(f.largest_analysed, static_cast<double>(p.cells));
-        if (spec.kind == "place") fused += static_cast<double>(p.cells);
     }
     if (!model.place_grid.empty()) f.state_bytes += 4.0 * model.place.n_place * cells[model.place_grid];
-    if (fused > model.place.n_place) {  // analysed as one population, beside the scales' own recorded rates
+    // The recorded scales of place cells, fused as the analysis fuses them (pipeline.cpp): one more population.
+    double fused = 0;
+    std::size_t n_fused = 0;
+    for (const std::string& name : model.place_scales())
+        if (recorded.count(name)) fused += static_cast<double>(cells.at(name)), ++n_fused;
+    if (n_fused > 1) {
         f.recorded_cells += fused;
         f.largest_analysed = std::max(f.largest_analysed, fused);
     }
