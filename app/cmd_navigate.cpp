@@ -35,7 +35,7 @@ struct NavigateOptions {
     std::uint64_t first_seed = 0;
     NavigationParams nav;
     bool dry_run = false;
-    RunOptions run;  // --out, --no-report
+    RunOptions run;  // --out, --jobs, --no-report
 };
 
 // What one command runs: models × seeds in a world with its goals, and every parameter.
@@ -262,28 +262,28 @@ void navigate_command(const NavigateOptions& o) {
         NavigationRun run;
     };
     std::vector<Done> results;
-    for (std::size_t m = 0; m < models.size(); ++m) {
-        setup.model = models[m];
-        for (int k = 0; k < plan.seeds; ++k) {
-            const std::uint64_t seed = plan.first_seed + std::uint64_t(k);
-            const std::string name =
-                (models.size() > 1 ? label_of(plan.models[m]) + " " : "") + "seed " + std::to_string(seed);
-            const auto kept = runs / ((models.size() > 1 ? label_of(plan.models[m]) + "-" : "") + "seed-" +
-                                      std::to_string(seed) + ".nav");
-            const std::string fingerprint = run_fingerprint(plan, setup, seed);
-            std::optional<NavigationRun> done = load_run(kept, fingerprint);
-            if (done) {
-                std::fprintf(stderr, "%s: already done (%s)\n", name.c_str(), kept.string().c_str());
-            } else {
-                std::fprintf(stderr, "%s: learning...\n", name.c_str());
-                done = navigate(*world, setup, seed);
-                save_run(kept, fingerprint, *done);
-                std::fprintf(stderr, "%s: learned in %.2f h (coverage %.3f); %zu starts\n", name.c_str(),
-                             done->learn_s / 3600, done->coverage, done->starts.size());
-            }
-            results.push_back({m, seed, std::move(*done)});
+    for (std::size_t m = 0; m < models.size(); ++m)
+        for (int k = 0; k < plan.seeds; ++k) results.push_back({m, plan.first_seed + std::uint64_t(k), {}});
+    // Each learning run depends on its model and seed alone: --jobs of them at once write the same files as one.
+    run_in_parallel(results.size(), o.run.jobs, [&](std::size_t t) {
+        Done& d = results[t];
+        const std::string prefix = models.size() > 1 ? label_of(plan.models[d.model]) : "";
+        const std::string name = (prefix.empty() ? "" : prefix + " ") + "seed " + std::to_string(d.seed);
+        const auto kept = runs / ((prefix.empty() ? "" : prefix + "-") + "seed-" + std::to_string(d.seed) + ".nav");
+        NavigationSetup mine = setup;
+        mine.model = models[d.model];
+        const std::string fingerprint = run_fingerprint(plan, mine, d.seed);
+        if (std::optional<NavigationRun> kept_run = load_run(kept, fingerprint)) {
+            std::fprintf(stderr, "%s: already done (%s)\n", name.c_str(), kept.string().c_str());
+            d.run = std::move(*kept_run);
+            return;
         }
-    }
+        std::fprintf(stderr, "%s: learning...\n", name.c_str());
+        d.run = navigate(*world, mine, d.seed);
+        save_run(kept, fingerprint, d.run);
+        std::fprintf(stderr, "%s: learned in %.2f h (coverage %.3f); %zu starts\n", name.c_str(), d.run.learn_s / 3600,
+                     d.run.coverage, d.run.starts.size());
+    });
 
     AtomicFile starts(out / "starts.csv"), paths(out / "paths.csv"), maps(out / "reward_map.csv"),
         learning(out / "learning.csv");
@@ -380,6 +380,7 @@ void add_navigate_command(CLI::App& app) {
     for (CLI::Option* g : given) config->excludes(g);
     cmd->add_flag("--dry-run", o->dry_run, "Read and check everything, say what would run, and exit");
     o->run.add_out(*cmd, "Output folder (runs/ in it keeps each finished learning run, to resume)");
+    o->run.add_jobs(*cmd, "Learning runs in parallel; 0 (the default): one per core (the files are the same)");
     o->run.add_no_report(*cmd);
     cmd->callback([o] { navigate_command(*o); });
 }

@@ -249,18 +249,21 @@ def test_navigate_killed_resumes_from_its_finished_runs_and_writes_the_same_file
 
 
 def test_navigate_config_runs_several_models_as_the_options_would(tmp_path):
-    """A YAML file with two models gives, for each, what the command-line options give for that model alone."""
+    """A YAML file with two models gives, for each, what the command-line options give for that model alone; and
+    its four learning runs one at a time (--jobs 1) what two at a time give (--jobs 2)."""
     (tmp_path / "nav.yaml").write_text(
         "world: cross\ngoals: [[3.5, 3.5]]\nmodels: [2d, 3d-0.2]\nseeds: 2\nfirst_seed: 4\n"
         "navigation: {starts: 1, max_learn_hours: 0.05}\n")
-    r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--out", str(tmp_path / "yaml"), "--no-report")
+    r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--out", str(tmp_path / "yaml"), "--no-report",
+            "--jobs", "1")
     assert r.returncode == 0, r.stderr
     rows = (tmp_path / "yaml" / "starts.csv").read_text().splitlines()
     assert [row.split(",")[1:3] for row in rows[1:]] == [["2d", "4"], ["2d", "5"], ["3d-0.2", "4"], ["3d-0.2", "5"]]
     for model in ("2d", "3d-0.2"):
         one = tmp_path / model
         r = run("navigate", "--world", "cross", "--goals", "3.5,3.5", "--model", model, "--seeds", "2",
-                "--first-seed", "4", "--starts", "1", "--max-learn-hours", "0.05", "--out", str(one), "--no-report")
+                "--first-seed", "4", "--starts", "1", "--max-learn-hours", "0.05", "--out", str(one), "--no-report",
+                "--jobs", "2")
         assert r.returncode == 0, r.stderr
         alone = (one / "starts.csv").read_text().splitlines()
         assert [row for row in rows if row.split(",")[1] == model] == alone[1:]

@@ -124,8 +124,9 @@ SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
       pruned_(prune > 0),
       rows_(std::size_t(adj.p_.n_hd)) {
     if (!(prune >= 0 && prune < 1)) throw InputError("adjacency: prune must lie in [0, 1)");
-    if (std::size_t(adj.n_) * std::size_t(adj.n_) > std::size_t(UINT32_MAX))
-        throw InputError("adjacency: too many place cells for the sparse copy (" + std::to_string(adj.n_) + ")");
+    if (std::size_t(adj.n_) > std::size_t(UINT16_MAX) + 1 || std::size_t(adj.n_) * std::size_t(adj.n_) > UINT32_MAX)
+        throw InputError("adjacency: too many place cells for the sparse copy (" + std::to_string(adj.n_) +
+                         "; at most 65 536)");
     for (int k = 0; k < adj.p_.n_hd; ++k) {
         const float* m = &adj.m_[adj.index(k, 0, 0)];
         float top = 0.0f;
@@ -137,7 +138,7 @@ SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
         for (int i = 0; i < n_; ++i) {
             const float* row = m + std::size_t(i) * std::size_t(n_);
             for (int j = 0; j < n_; ++j)
-                if (std::abs(row[j]) > cut) r.col.push_back(std::uint32_t(j)), r.w.push_back(row[j]);
+                if (std::abs(row[j]) > cut) r.col.push_back(std::uint16_t(j)), r.w.push_back(row[j]);
             r.start[std::size_t(i) + 1] = std::uint32_t(r.col.size());
         }
     }
@@ -177,7 +178,7 @@ std::size_t SparseAdjacency::entries() const {
 }
 
 double SparseAdjacency::bytes() const {
-    return double(entries()) * (sizeof(std::uint32_t) + sizeof(float)) +
+    return double(entries()) * (sizeof(std::uint16_t) + sizeof(float)) +
            double(rows_.size()) * double(n_ + 1) * sizeof(std::uint32_t);
 }
 

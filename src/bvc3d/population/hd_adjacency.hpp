@@ -86,7 +86,8 @@ private:
 };
 
 // A frozen copy of an adjacency for products (see above): per HD cell, the weights with |w| > prune·max|W_rec[k]|
-// in compressed rows (column index and float32 value, 8 bytes an entry). With prune 0, apply() gives the same bits
+// in compressed rows (column index as uint16 and float32 value, 6 bytes an entry: at most 65 536 place cells; the
+// products stream the entries from memory, so their size is their speed). With prune 0, apply() gives the same bits
 // as HdAdjacency::apply; pruned, the products of the matrices with the left-out weights set to 0 (its sums in the
 // order that reads fewer entries).
 class SparseAdjacency {
@@ -104,7 +105,7 @@ public:
 private:
     struct Rows {
         std::vector<std::uint32_t> start;  // n + 1 offsets into col and w
-        std::vector<std::uint32_t> col;
+        std::vector<std::uint16_t> col;
         std::vector<float> w;
     };
     int n_;
