@@ -117,6 +117,30 @@ void BM_DirectionChoiceMultiscale(benchmark::State& state) {
 }
 BENCHMARK(BM_DirectionChoiceMultiscale)->ArgsProduct({{3500}, {0, 2, 3, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
 
+// One learning step of the adjacency (traces, the active rows and columns of 8 matrices, the decay) on the synthetic
+// walk's place rates, for the multiscale sizes: what learning adds to each model step of navigation.
+void BM_AdjacencyLearn(benchmark::State& state) {
+    const int n = static_cast<int>(state.range(0));
+    const Fields fields(n);
+    const double width = n >= 2000 ? 0.5 : n >= 1000 ? 1.0 : 1.5;
+    std::vector<std::vector<double>> rates, hd;
+    Rng rng(2, Stream::walk);
+    double x = 0, y = 0, h = 0;
+    for (int t = 0; t < 256; ++t) {
+        h += rng.normal(0, 0.3);
+        x = std::clamp(x + 0.144 * std::cos(h), -10.0, 10.0), y = std::clamp(y + 0.144 * std::sin(h), -10.0, 10.0);
+        rates.push_back(fields.rates(x, y, width)), hd.push_back(hd_rates(h));
+    }
+    HdAdjacency adj(n);
+    std::size_t t = 0;
+    for (auto _ : state) {
+        adj.learn(rates[t % rates.size()], hd[t % rates.size()], false);
+        ++t;
+    }
+    state.counters["steps/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_AdjacencyLearn)->Arg(500)->Arg(1000)->Arg(2000)->Unit(benchmark::kMicrosecond);
+
 // A whole decision of the paper's 2d model: scan, BVCs, one place-cell step, the rollouts.
 void BM_DecisionWithModel(benchmark::State& state) {
     const World world = World::cross();
