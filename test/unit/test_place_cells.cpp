@@ -148,6 +148,65 @@ TEST(PlaceCellNetwork, DriveIsTheFixedOrderSumBitForBit) {
     }
 }
 
+// The products skip blocks of 8 inputs that are 0 in every step of a tile; that must leave every sum's bits as the
+// sum over all columns gives them (w·0 = −0 for w < 0 included). Weights of both signs; inputs with blocks zero in
+// every step, zero in some steps only, or with a single value not 0; blocks of several steps (tiles and the steps
+// left) with learning off, against the recursion s ← s + k·(−s + drive) in scalar code.
+TEST(PlaceCellNetwork, ZeroInputBlocksChangeNoBit) {
+    const int n_bvc = 130, n_place = 7;
+    PlaceParams p;
+    p.n_place = n_place;
+    p.gamma_pb = 0.0;  // no inhibition: s ← s + k·(−s + drive)
+    p.gamma_pp = 0.0;
+    std::mt19937_64 gen(9);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<float> w(static_cast<std::size_t>(n_place) * n_bvc);
+    for (auto& x : w) x = u(gen);
+    for (const int steps : {1, 3, 8, 11, 16}) {
+        PlaceCellNetwork net(n_bvc, p, 4);
+        net.set_weights(w);
+        std::vector<double> vb(static_cast<std::size_t>(steps) * n_bvc);
+        int zero_blocks = 0;
+        for (int t = 0; t < steps; ++t)
+            for (int j = 0; j < n_bvc; ++j) {
+                const int block = j / 8;
+                const bool zero = block % 3 == 0 || (block % 3 == 1 && t % 2 == 0) || (block == 5 && j != 43);
+                zero_blocks += zero && j % 8 == 0;
+                vb[static_cast<std::size_t>(t) * n_bvc + j] = zero ? 0.0 : 0.5 * (u(gen) + 1.0f);
+            }
+        ASSERT_GT(zero_blocks, 4 * steps);
+        net.step_block(vb, std::vector<char>(static_cast<std::size_t>(steps), 0));
+        const float k = static_cast<float>(p.dt_over_tau);
+        for (int i = 0; i < n_place; ++i) {
+            float s = 0.0f;
+            for (int t = 0; t < steps; ++t) {
+                float lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+                for (int j = 0; j < n_bvc; ++j)
+                    lane[j % 8] += w[static_cast<std::size_t>(i) * n_bvc + j] *
+                                   static_cast<float>(vb[static_cast<std::size_t>(t) * n_bvc + j]);
+                const float drive =
+                    ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
+                s = s + k * (-s + drive - 0.0f);
+            }
+            ASSERT_EQ(net.membrane()[i], s) << steps << " steps, row " << i;
+        }
+    }
+}
+
+// A weight that Oja's rule makes infinite stops the network at once (the products, which skip inputs that are 0,
+// rely on finite weights).
+TEST(PlaceCellNetwork, WeightsThatRunAwayStopTheNetwork) {
+    PlaceParams p;
+    p.n_place = 2;
+    p.gamma_pb = 0.0;
+    p.eta = 1e6;
+    PlaceCellNetwork net(16, p, 1);
+    net.set_weights(std::vector<float>(32, 1e36f));  // Oja: 1e36 − 1e6·(1e36·√2 − 0.5) = −inf
+    std::vector<double> vb(16, 0.0);
+    vb[0] = 0.5;
+    EXPECT_THROW(net.step(vb, true), InputError);
+}
+
 // Rates and weights below the smallest normal float in magnitude are taken as 0 (no subnormal number
 // enters the arithmetic): a network fed such rates behaves bit for bit like one fed zeros there, and
 // no weight is ever subnormal, even when Oja's rule is fed Gaussian tails down to 1e-300.

@@ -115,18 +115,22 @@ void PlaceCellNetwork::advance(const float* drive, const float* grid_drive, cons
                                           v_.data(), active_.data(), &finite));
     for (int i : active_) v_[i] = std::tanh(v_[i]);
     // Weights that ran away (a learning rate far too large) show up here first: stop early.
-    if (!std::isfinite(inhibition) || !finite)
-        throw InputError(
-            "place cells diverged (non-finite membrane potentials): the weights ran away; is the "
+    const auto diverged = [&] {
+        return InputError(
+            "place cells diverged (non-finite membrane potentials or weights): the weights ran away; is the "
             "learning rate eta = " +
             std::to_string(p_.eta) + " too large?");
+    };
+    if (!std::isfinite(inhibition) || !finite) throw diverged();
     if (!learn || !(p_.eta > 0)) return;
-    // Oja: W_i += (1−g)·eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
+    // Oja: W_i += (1−g)·eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change. A weight that is not
+    // finite stops the network at once: the products skip inputs that are 0, which a weight of ±inf or NaN would
+    // turn into NaN.
     const float eta = static_cast<float>((1.0 - g) * p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
     for (int i : active_) {
         const float vi = v_[i];
         if (vi == 0.0f) continue;
-        kernels::oja_row(row(i), vb, eta * vi, vi * inv_alpha, tiny_operand, stride_);
+        if (!kernels::oja_row(row(i), vb, eta * vi, vi * inv_alpha, tiny_operand, stride_)) throw diverged();
         if (learned && !is_learned_[i]) {
             is_learned_[i] = 1;
             learned->push_back(i);

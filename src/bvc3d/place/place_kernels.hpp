@@ -16,6 +16,8 @@ inline std::size_t paired_column(std::size_t j) { return (j / 8) * 16 + j % 8; }
 // v_t = v + t·v_stride (plain layout, n entries, n a multiple of 8). Each row's sum is the same
 // sequence of operations whatever `steps` (8 lanes, then reduce8): one pass over the weights serves up
 // to 8 steps (one load of a weight block feeds 8 products) and gives the bits a pass per step gives.
+// Blocks of 8 columns where the steps' inputs are all 0 are skipped (BVC rates far from every return
+// are exact zeros): with finite weights this leaves every sum's bits as they are (see nonzero_blocks).
 void paired_products(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride, std::size_t n,
                      int pairs, int steps, float* out, std::size_t out_stride);
 // Row `w` (its first block; blocks 16 floats apart) times v: the bits of paired_products for that row.
@@ -33,6 +35,7 @@ std::size_t membrane_step(float* s, const float* drive, std::size_t n, float k, 
                           int* positive, bool* finite);
 // Oja's update of one row in the paired layout (w: its first block; its blocks are 16 floats apart):
 // w[j] += a·(v[j] - c·w[j]), a result smaller than `tiny` in magnitude stored as 0; n a multiple of 8.
-void oja_row(float* w, const float* v, float a, float c, float tiny, std::size_t n);
+// Returns whether every result is finite (the products' skipping of zero inputs relies on finite weights).
+bool oja_row(float* w, const float* v, float a, float c, float tiny, std::size_t n);
 
 }  // namespace bvc3d::kernels
