@@ -34,7 +34,7 @@ namespace grid {
 
 double interference(const Cell& c, double spacing, double x, double y) {
     const double dx = x - c.tx, dy = y - c.ty;
-    const double ca = std::cos(c.orientation), sa = std::sin(c.orientation);
+    const double ca = c.cos_a, sa = c.sin_a;
     const double rx = ca * dx + sa * dy, ry = -sa * dx + ca * dy;  // R(−α)(p − t)
     const double f = 2.0 * pi / spacing, h = std::sqrt(3.0) / 2.0;
     return (std::cos(f * rx) + std::cos(f * (rx / 2 + h * ry)) + std::cos(f * (rx / 2 - h * ry))) / 3.0;
@@ -42,6 +42,9 @@ double interference(const Cell& c, double spacing, double x, double y) {
 
 double rate(double z) {
     const double zn = std::clamp((z + 0.5) / 1.5, 0.0, 1.0);
+    // Below 0.342 < 0.7³ the cube root is under 0.7 by far more than its rounding error: the rate is 0 (most cells
+    // at most places), and the cube root is not taken.
+    if (zn * zn < 0.342) return 0.0;
     return std::clamp((std::cbrt(zn * zn) - 0.7) / 0.3, 0.0, 1.0);
 }
 
@@ -68,7 +71,8 @@ std::vector<Cell> module(const GridParams& p, std::uint64_t seed) {
         double u, v;
         sobol_point(static_cast<std::uint32_t>(c / p.n_orientations), shift, u, v);
         const double lx = p.spacing * (u + v), ly = p.spacing * (u - v) / std::sqrt(3.0);  // in the cell's frame
-        cells[c] = {a, std::cos(a) * lx - std::sin(a) * ly, std::sin(a) * lx + std::cos(a) * ly};
+        cells[c] = {a, std::cos(a) * lx - std::sin(a) * ly, std::sin(a) * lx + std::cos(a) * ly, std::cos(a),
+                    std::sin(a)};
     }
     return cells;
 }

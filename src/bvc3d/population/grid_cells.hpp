@@ -45,8 +45,9 @@ struct GridParams {
 // The equations above, written once.
 namespace grid {
 struct Cell {
-    double orientation;  // α_c, rad
-    double tx, ty;       // phase t, m
+    double orientation;   // α_c, rad
+    double tx, ty;        // phase t, m
+    double cos_a, sin_a;  // cos α_c, sin α_c: computed once, not at every step
 };
 // z of a cell at (x, y).
 double interference(const Cell& c, double spacing, double x, double y);
