@@ -152,6 +152,37 @@ void paired_products(const float* W, std::size_t pair_stride, const float* v, st
 }
 
 BVC3D_DISPATCH
+void mask_products(const std::uint16_t* bits, std::size_t col_words, const float* v, std::size_t n, std::size_t rows,
+                   float* lanes, float* out) {
+    typedef float f16 __attribute__((vector_size(64)));
+    typedef std::int32_t i16 __attribute__((vector_size(64)));
+    const std::size_t stride = 16 * col_words;  // floats per lane
+    for (std::size_t i = 0; i < 8 * stride; ++i) lanes[i] = 0.0f;
+    const i16 shift = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+    for (std::size_t j = 0; j < n; ++j) {
+        const float x = v[j];
+        if (x == 0.0f) continue;
+        const i16 xs = i16{} + __builtin_bit_cast(std::int32_t, x);  // x's bits in every lane
+        float* lane = lanes + (j % 8) * stride;
+        const std::uint16_t* column = bits + j * col_words;
+        for (std::size_t r = 0; r < col_words; ++r) {
+            // x where the bit is set, +0 where it is clear (adding +0 leaves the lane's sum as it is); made with
+            // shifts and an AND: GCC 12 lowers a comparison or a select lane by lane on AVX2.
+            const i16 set = -((static_cast<std::int32_t>(column[r]) + i16{}) >> shift & 1);  // lane k: bit k
+            f16 a;
+            simd::load(a, lane + 16 * r);
+            a += __builtin_bit_cast(f16, xs & set);
+            simd::store(lane + 16 * r, a);
+        }
+    }
+    for (std::size_t i = 0; i < rows; ++i) {
+        const float* l = lanes + i;
+        out[i] = ((l[0] + l[stride]) + (l[2 * stride] + l[3 * stride])) +
+                 ((l[4 * stride] + l[5 * stride]) + (l[6 * stride] + l[7 * stride]));
+    }
+}
+
+BVC3D_DISPATCH
 float paired_row_product(const float* w, const float* v, std::size_t n) {
     f8 acc = {0, 0, 0, 0, 0, 0, 0, 0};
     for (std::size_t b = 0; b < n; b += 8) {
