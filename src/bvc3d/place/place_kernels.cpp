@@ -186,6 +186,9 @@ BVC3D_DISPATCH
 float paired_row_product(const float* w, const float* v, std::size_t n) {
     f8 acc = {0, 0, 0, 0, 0, 0, 0, 0};
     for (std::size_t b = 0; b < n; b += 8) {
+        bits8 bits;
+        simd::load(bits, v + b);
+        if (simd::all_zero(bits & 0x7fffffff)) continue;  // w·0 = ±0 changes no sum (see nonzero_blocks)
         f8 a, x;
         simd::load(a, w + 2 * b);
         simd::load(x, v + b);
