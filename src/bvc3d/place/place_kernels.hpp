@@ -28,8 +28,7 @@ void paired_products(const float* W, std::size_t pair_stride, const float* v, st
 // and a skipped 0·x = +0 changes no sum). `lanes`: room for 8·16·col_words floats. v finite, n any.
 void mask_products(const std::uint16_t* bits, std::size_t col_words, const float* v, std::size_t n, std::size_t rows,
                    float* lanes, float* out);
-// Row `w` (its first block; blocks 16 floats apart) times v: the bits of paired_products for that row (blocks
-// of v that are 0 skipped likewise).
+// Row `w` (its first block; blocks 16 floats apart) times v: the bits of paired_products for that row.
 float paired_row_product(const float* w, const float* v, std::size_t n);
 // out[j] = (float)in[j] for j < n, a result smaller than `tiny` in magnitude stored as 0; returns the
 // index of the first non-finite in[j] (then out is unspecified), or n.
