@@ -6,7 +6,7 @@
 //                                          (BLOCK: default 16; 1 steps the place cells one call per step;
 //                                          DUMP: a file for every step's BVC rates, float64, then every
 //                                          step's place-cell rates, float32, to compare two builds' numbers)
-//   valgrind --tool=callgrind --collect-atstart=no model_steps PRESET STEPS
+//   valgrind --tool=callgrind --instr-atstart=no model_steps PRESET STEPS
 //                                          instructions of the steps only (callgrind_annotate
 //                                          --inclusive=yes splits them by stage)
 // The digest (FNV-1a over the 32-bit words of every step's BVC rates, then of every step's place-cell

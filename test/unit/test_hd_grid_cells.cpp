@@ -3,8 +3,10 @@
 // `populations:` list of a model's YAML running in a trial.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/population_kinds.hpp"
@@ -113,6 +115,42 @@ TEST(GridCells, FieldsPeakAtThePhaseAndOnTheLatticeAndVanishBetween) {
     // z' = 0.7^(3/2) is the threshold: z = 1.5·0.7^1.5 − 0.5.
     EXPECT_NEAR(grid::rate(1.5 * std::pow(0.7, 1.5) - 0.5 + 1e-9), 0.0, 1e-6);
     EXPECT_NEAR(grid::rate(1.5 * std::pow(0.85, 1.5) - 0.5), 0.5, 1e-12);
+}
+
+// The module's rates are the equations evaluated in full (cos α and sin α at each call, the cube root always taken),
+// bit for bit, at random points and at z just around the threshold, where the cube root is skipped below 0.342.
+TEST(GridCells, RatesAreTheEquationsBitForBit) {
+    GridParams p;
+    p.spacing = 4.0;
+    p.n = 64;
+    const GridCells module(p, 3);
+    const auto full = [&](const grid::Cell& c, double x, double y) {
+        const double dx = x - c.tx, dy = y - c.ty;
+        const double rx = std::cos(c.orientation) * dx + std::sin(c.orientation) * dy;
+        const double ry = -std::sin(c.orientation) * dx + std::cos(c.orientation) * dy;
+        const double f = 2.0 * kPi / p.spacing, h = std::sqrt(3.0) / 2.0;
+        const double z = (std::cos(f * rx) + std::cos(f * (rx / 2 + h * ry)) + std::cos(f * (rx / 2 - h * ry))) / 3.0;
+        const double zn = std::min(std::max((z + 0.5) / 1.5, 0.0), 1.0);
+        return std::min(std::max((std::cbrt(zn * zn) - 0.7) / 0.3, 0.0), 1.0);
+    };
+    std::mt19937_64 gen(4);
+    std::uniform_real_distribution<double> u(-20, 20);
+    std::vector<double> out(64);
+    int firing = 0;
+    for (int k = 0; k < 2000; ++k) {
+        const double x = u(gen), y = u(gen);
+        module.rates(x, y, out);
+        for (int c = 0; c < 64; ++c) {
+            ASSERT_EQ(out[c], full(module.cells()[c], x, y)) << k << " " << c;
+            firing += out[c] > 0;
+        }
+    }
+    EXPECT_GT(firing, 2000);
+    // Around the threshold z' = 0.7^1.5 (the rate's 0), and across the skip's bound z'² = 0.342.
+    for (double zn = std::sqrt(0.340); zn < std::sqrt(0.345); zn += 1e-6) {
+        const double z = 1.5 * zn - 0.5, zq = std::min(std::max((z + 0.5) / 1.5, 0.0), 1.0);
+        ASSERT_EQ(grid::rate(z), std::min(std::max((std::cbrt(zq * zq) - 0.7) / 0.3, 0.0), 1.0)) << z;
+    }
 }
 
 TEST(GridCells, EachOrientationsPhasesFormANet) {

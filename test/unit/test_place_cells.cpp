@@ -148,6 +148,110 @@ TEST(PlaceCellNetwork, DriveIsTheFixedOrderSumBitForBit) {
     }
 }
 
+// The products skip blocks of 8 inputs that are 0 in every step of a tile; that must leave every sum's bits as the
+// sum over all columns gives them (w·0 = −0 for w < 0 included). Weights of both signs; inputs with blocks zero in
+// every step, zero in some steps only, or with a single value not 0; blocks of several steps (tiles and the steps
+// left) with learning off, against the recursion s ← s + k·(−s + drive) in scalar code.
+TEST(PlaceCellNetwork, ZeroInputBlocksChangeNoBit) {
+    const int n_bvc = 130, n_place = 7;
+    PlaceParams p;
+    p.n_place = n_place;
+    p.gamma_pb = 0.0;  // no inhibition: s ← s + k·(−s + drive)
+    p.gamma_pp = 0.0;
+    std::mt19937_64 gen(9);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<float> w(static_cast<std::size_t>(n_place) * n_bvc);
+    for (auto& x : w) x = u(gen);
+    for (const int steps : {1, 3, 8, 11, 16}) {
+        PlaceCellNetwork net(n_bvc, p, 4);
+        net.set_weights(w);
+        std::vector<double> vb(static_cast<std::size_t>(steps) * n_bvc);
+        int zero_blocks = 0;
+        for (int t = 0; t < steps; ++t)
+            for (int j = 0; j < n_bvc; ++j) {
+                const int block = j / 8;
+                const bool zero = block % 3 == 0 || (block % 3 == 1 && t % 2 == 0) || (block == 5 && j != 43);
+                zero_blocks += zero && j % 8 == 0;
+                vb[static_cast<std::size_t>(t) * n_bvc + j] = zero ? 0.0 : 0.5 * (u(gen) + 1.0f);
+            }
+        ASSERT_GT(zero_blocks, 4 * steps);
+        net.step_block(vb, std::vector<char>(static_cast<std::size_t>(steps), 0));
+        const float k = static_cast<float>(p.dt_over_tau);
+        for (int i = 0; i < n_place; ++i) {
+            float s = 0.0f;
+            for (int t = 0; t < steps; ++t) {
+                float lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+                for (int j = 0; j < n_bvc; ++j)
+                    lane[j % 8] += w[static_cast<std::size_t>(i) * n_bvc + j] *
+                                   static_cast<float>(vb[static_cast<std::size_t>(t) * n_bvc + j]);
+                const float drive =
+                    ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
+                s = s + k * (-s + drive - 0.0f);
+            }
+            ASSERT_EQ(net.membrane()[i], s) << steps << " steps, row " << i;
+        }
+    }
+}
+
+// The grid drive W_g·c (W_g a 0/1 mask, read by columns where a grid cell fires) is the fixed-order 8-lane sum over
+// every column, bit for bit: grid rates mostly 0 as a module's are, cell and grid counts that are not multiples of 8
+// or 16, several steps in a block (learning off), against s ← s + k·(−s + (1−g)·W_b·b + g·W_g·c) in scalar code.
+TEST(PlaceCellNetwork, GridDriveIsTheFixedOrderSumBitForBit) {
+    const int n_bvc = 24, n_grid = 37, n_place = 19, steps = 11;
+    PlaceParams p;
+    p.n_place = n_place;
+    p.gamma_pb = p.gamma_pg = p.gamma_pp = 0.0;  // no inhibition
+    p.grid_influence = 0.3;
+    PlaceCellNetwork net(n_bvc, p, 6, n_grid);
+    std::mt19937_64 gen(2);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<double> vb(static_cast<std::size_t>(steps) * n_bvc), vg(static_cast<std::size_t>(steps) * n_grid);
+    for (auto& x : vb) x = u(gen) < 0.5 ? 0.0 : u(gen);
+    int firing = 0;
+    for (auto& x : vg) {
+        x = u(gen) < 0.7 ? 0.0 : u(gen);
+        firing += x > 0;
+    }
+    ASSERT_GT(firing, 40);
+    const auto w = net.weights();
+    const auto m = net.grid_mask();
+    int ones = 0;
+    for (float x : m) ones += x == 1.0f;
+    ASSERT_GT(ones, 100);
+    net.step_block(vb, vg, std::vector<char>(steps, 0));
+    const auto sum = [](const float* row, const double* x, int n) {
+        float lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+        for (int j = 0; j < n; ++j) lane[j % 8] += row[j] * static_cast<float>(x[j]);
+        return ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
+    };
+    const float k = static_cast<float>(p.dt_over_tau), kb = static_cast<float>(1.0 - p.grid_influence),
+                kg = static_cast<float>(p.grid_influence);
+    for (int i = 0; i < n_place; ++i) {
+        float s = 0.0f;
+        for (int t = 0; t < steps; ++t) {
+            const float drive =
+                kb * sum(&w[static_cast<std::size_t>(i) * n_bvc], &vb[static_cast<std::size_t>(t) * n_bvc], n_bvc) +
+                kg * sum(&m[static_cast<std::size_t>(i) * n_grid], &vg[static_cast<std::size_t>(t) * n_grid], n_grid);
+            s = s + k * (-s + drive - 0.0f);
+        }
+        ASSERT_EQ(net.membrane()[i], s) << "row " << i;
+    }
+}
+
+// A weight that Oja's rule makes infinite stops the network at once (the products, which skip inputs that are 0,
+// rely on finite weights).
+TEST(PlaceCellNetwork, WeightsThatRunAwayStopTheNetwork) {
+    PlaceParams p;
+    p.n_place = 2;
+    p.gamma_pb = 0.0;
+    p.eta = 1e6;
+    PlaceCellNetwork net(16, p, 1);
+    net.set_weights(std::vector<float>(32, 1e36f));  // Oja: 1e36 − 1e6·(1e36·√2 − 0.5) = −inf
+    std::vector<double> vb(16, 0.0);
+    vb[0] = 0.5;
+    EXPECT_THROW(net.step(vb, true), InputError);
+}
+
 // Rates and weights below the smallest normal float in magnitude are taken as 0 (no subnormal number
 // enters the arithmetic): a network fed such rates behaves bit for bit like one fed zeros there, and
 // no weight is ever subnormal, even when Oja's rule is fed Gaussian tails down to 1e-300.

@@ -133,10 +133,10 @@ PopulationSpec grid_place_spec(const std::string& name, const PlaceParams& p, st
         return std::make_unique<PlacePopulation>(static_cast<int>(c.input_sizes[0]), p, hash_u64(c.seed, tag, 0),
                                                  static_cast<int>(c.input_sizes[1]));
     };
-    // A float weight per cell and BVC, and per cell and grid cell (the fixed mask, stored as weights).
+    // A float weight per cell and BVC, and a bit per cell and grid cell (the fixed mask).
     s.footprint = [p](const std::vector<std::size_t>& in) {
-        const double n_in = in.size() > 1 ? static_cast<double>(in[0] + in[1]) : 0;
-        return PopulationFootprint{static_cast<std::size_t>(p.n_place), 4.0 * p.n_place * n_in};
+        const double bytes_per_cell = in.size() > 1 ? 4.0 * static_cast<double>(in[0]) + in[1] / 8.0 : 0;
+        return PopulationFootprint{static_cast<std::size_t>(p.n_place), p.n_place * bytes_per_cell};
     };
     return s;
 }

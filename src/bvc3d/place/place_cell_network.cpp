@@ -62,13 +62,15 @@ PlaceCellNetwork::PlaceCellNetwork(int n_bvc, const PlaceParams& params, std::ui
     vb_.assign(stride_, 0.0f);
     grid_stride_ = (static_cast<std::size_t>(n_grid) + 7) / 8 * 8;
     if (n_grid > 0) {
-        gw_.assign(static_cast<std::size_t>(pairs()) * 2 * grid_stride_, 0.0f);
+        grid_words_ = (static_cast<std::size_t>(p_.n_place) + 15) / 16;
+        grid_bits_.assign(static_cast<std::size_t>(n_grid) * grid_words_, 0);
         Rng mask(seed, Stream::grid_mask);
-        for (int i = 0; i < p_.n_place; ++i) {
-            float* r = gw_.data() + static_cast<std::size_t>(i / 2) * 2 * grid_stride_ + 8 * (i % 2);
+        for (int i = 0; i < p_.n_place; ++i)
             for (int j = 0; j < n_grid; ++j)
-                r[kernels::paired_column(j)] = mask.bernoulli(p_.grid_p_connect) ? 1.0f : 0.0f;
-        }
+                if (mask.bernoulli(p_.grid_p_connect))
+                    grid_bits_[static_cast<std::size_t>(j) * grid_words_ + i / 16] |=
+                        static_cast<std::uint16_t>(1u << (i % 16));
+        grid_lanes_.assign(8 * 16 * grid_words_, 0.0f);
         vg_.assign(grid_stride_, 0.0f);
     }
 }
@@ -115,18 +117,22 @@ void PlaceCellNetwork::advance(const float* drive, const float* grid_drive, cons
                                           v_.data(), active_.data(), &finite));
     for (int i : active_) v_[i] = std::tanh(v_[i]);
     // Weights that ran away (a learning rate far too large) show up here first: stop early.
-    if (!std::isfinite(inhibition) || !finite)
-        throw InputError(
-            "place cells diverged (non-finite membrane potentials): the weights ran away; is the "
+    const auto diverged = [&] {
+        return InputError(
+            "place cells diverged (non-finite membrane potentials or weights): the weights ran away; is the "
             "learning rate eta = " +
             std::to_string(p_.eta) + " too large?");
+    };
+    if (!std::isfinite(inhibition) || !finite) throw diverged();
     if (!learn || !(p_.eta > 0)) return;
-    // Oja: W_i += (1−g)·eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change.
+    // Oja: W_i += (1−g)·eta·v_i·(v_b - v_i·W_i/alpha). Silent cells (v_i = 0) do not change. A weight that is not
+    // finite stops the network at once: the products skip inputs that are 0, which a weight of ±inf or NaN would
+    // turn into NaN.
     const float eta = static_cast<float>((1.0 - g) * p_.eta), inv_alpha = static_cast<float>(1.0 / p_.alpha_pb);
     for (int i : active_) {
         const float vi = v_[i];
         if (vi == 0.0f) continue;
-        kernels::oja_row(row(i), vb, eta * vi, vi * inv_alpha, tiny_operand, stride_);
+        if (!kernels::oja_row(row(i), vb, eta * vi, vi * inv_alpha, tiny_operand, stride_)) throw diverged();
         if (learned && !is_learned_[i]) {
             is_learned_[i] = 1;
             learned->push_back(i);
@@ -141,8 +147,8 @@ std::span<const float> PlaceCellNetwork::step(std::span<const double> bvc_rates,
     kernels::paired_products(w_.data(), pair_stride(), vb_.data(), stride_, stride_, pairs(), 1, drive_.data(), 0);
     if (n_grid_ > 0) {
         grid_drive_.resize(drive_.size());
-        kernels::paired_products(gw_.data(), 2 * grid_stride_, vg_.data(), grid_stride_, grid_stride_, pairs(), 1,
-                                 grid_drive_.data(), 0);
+        kernels::mask_products(grid_bits_.data(), grid_words_, vg_.data(), static_cast<std::size_t>(n_grid_), s_.size(),
+                               grid_lanes_.data(), grid_drive_.data());
     }
     advance(drive_.data(), n_grid_ > 0 ? grid_drive_.data() : nullptr, vb_.data(), vg_.data(), learn, nullptr);
     return v_;
@@ -165,13 +171,14 @@ std::span<const float> PlaceCellNetwork::step_block(std::span<const double> bvc_
     drive_.resize(std::max<std::size_t>(steps, 1) * drive_stride);
     kernels::paired_products(w_.data(), pair_stride(), vb_.data(), stride_, stride_, pairs(), static_cast<int>(steps),
                              drive_.data(), drive_stride);
-    if (n_grid_ > 0) {  // W_g never changes: one pass serves the block
+    if (n_grid_ > 0) {  // by W_g's columns, only where a grid cell fires
         vg_.resize(std::max<std::size_t>(steps, 1) * grid_stride_, 0.0f);
         for (std::size_t t = 0; t < steps; ++t)
             grid_inputs(grid_rates.subspan(t * ng, ng), vg_.data() + t * grid_stride_);
         grid_drive_.resize(std::max<std::size_t>(steps, 1) * drive_stride);
-        kernels::paired_products(gw_.data(), 2 * grid_stride_, vg_.data(), grid_stride_, grid_stride_, pairs(),
-                                 static_cast<int>(steps), grid_drive_.data(), drive_stride);
+        for (std::size_t t = 0; t < steps; ++t)
+            kernels::mask_products(grid_bits_.data(), grid_words_, vg_.data() + t * grid_stride_, ng, s_.size(),
+                                   grid_lanes_.data(), grid_drive_.data() + t * drive_stride);
     }
     block_rates_.resize(steps * static_cast<std::size_t>(p_.n_place));
     learned_.clear();
@@ -200,7 +207,8 @@ std::vector<float> PlaceCellNetwork::grid_mask() const {
     std::vector<float> out(static_cast<std::size_t>(p_.n_place) * n_grid_);
     for (int i = 0; i < p_.n_place; ++i)
         for (int j = 0; j < n_grid_; ++j)
-            out[static_cast<std::size_t>(i) * n_grid_ + j] = grid_row(i)[kernels::paired_column(j)];
+            out[static_cast<std::size_t>(i) * n_grid_ + j] =
+                grid_bits_[static_cast<std::size_t>(j) * grid_words_ + i / 16] >> (i % 16) & 1u ? 1.0f : 0.0f;
     return out;
 }
 

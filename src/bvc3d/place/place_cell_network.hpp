@@ -89,9 +89,6 @@ private:
     float* row(int i) { return w_.data() + static_cast<std::size_t>(i / 2) * pair_stride() + 8 * (i % 2); }
     const float* row(int i) const { return w_.data() + static_cast<std::size_t>(i / 2) * pair_stride() + 8 * (i % 2); }
     int pairs() const { return (p_.n_place + 1) / 2; }
-    const float* grid_row(int i) const {
-        return gw_.data() + static_cast<std::size_t>(i / 2) * 2 * grid_stride_ + 8 * (i % 2);
-    }
     // BVC rates as the network's float inputs (vb: stride_ entries, padding 0); throws on a non-finite rate.
     void inputs(std::span<const double> bvc_rates, float* vb) const;
     // Grid rates likewise (vg: grid_stride_ entries).
@@ -105,7 +102,11 @@ private:
     std::size_t stride_,
         grid_stride_;  // n_bvc rounded up to a multiple of 8; padding (and an odd count's last row) stays 0
     PlaceParams p_;
-    std::vector<float, CacheAligned<float>> w_, gw_;  // W_b, W_g (paired layout)
+    std::vector<float, CacheAligned<float>> w_;  // W_b (paired layout)
+    // W_g by columns, one bit per row (kernels::mask_products): column j's rows at grid_bits_[j·grid_words_ ...].
+    std::vector<std::uint16_t> grid_bits_;
+    std::size_t grid_words_ = 0;
+    std::vector<float> grid_lanes_;  // mask_products' lanes
     std::vector<float> s_, v_, vb_, drive_;
     std::vector<float> vg_, grid_drive_, combined_;  // with grid cells only
     std::vector<int> active_;         // the cells whose rate may be other than ±0 (s > 0 at the last step)

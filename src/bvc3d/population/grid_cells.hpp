@@ -45,13 +45,16 @@ struct GridParams {
 // The equations above, written once.
 namespace grid {
 struct Cell {
-    double orientation;  // α_c, rad
-    double tx, ty;       // phase t, m
+    double orientation;   // α_c, rad
+    double tx, ty;        // phase t, m
+    double cos_a, sin_a;  // cos α_c, sin α_c: computed once, not at every step
 };
 // z of a cell at (x, y).
 double interference(const Cell& c, double spacing, double x, double y);
 // The rate for z.
 double rate(double z);
+// rate(interference(c, spacing, x, y)), bit for bit, with less work where the rate is 0.
+double rate_at(const Cell& c, double spacing, double x, double y);
 // The module's cells for a seed.
 std::vector<Cell> module(const GridParams& p, std::uint64_t seed);
 // Point k of the 2-D Sobol sequence (direction numbers of x and x + 1), each coordinate's bits XORed with `shift`'s
