@@ -95,8 +95,8 @@ NavigatePlan plan_of_options(const NavigateOptions& o) {
 // tables navigation:, adjacency:, reward:. Any other key: InputError naming it.
 NavigatePlan plan_of_yaml(const std::string& file) {
     const auto v = config::YamlView::load_file(file);
-    v.expect_map({"world", "tilt", "lean", "goals", "models", "seeds", "first_seed", "navigation", "adjacency", "reward",
-                  "flight"});
+    v.expect_map({"world", "tilt", "lean", "goals", "models", "seeds", "first_seed", "navigation", "adjacency",
+                  "reward", "flight"});
     NavigatePlan p;
     p.world = config::path_in_file(v, v["world"].as_string());
     if (v.has("tilt")) p.tilt = v["tilt"].as_double();

@@ -218,6 +218,33 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         bvc3d.navigate(world, [[30.0, 0.0]])
 
 
+def test_navigate_flies_to_goals_in_3d_seeded_with_3d_paths():
+    world = bvc3d.World.preset("flight-room")
+    goal = [1.5, 1.0, 1.6]
+    kw = dict(max_learn_hours=0.15, coverage=0.8, goal_visits=2, starts=2, min_start_distance=3.0)
+    a = bvc3d.navigate(world, [goal], model="fly-5l", seed=2, **kw)
+    b = bvc3d.navigate(world, [goal], model="fly-5l", seed=2, **kw)
+    for key in ("start_x", "start_y", "start_z", "path_m", "shortest_m", "time_s", "success"):
+        np.testing.assert_array_equal(a[key], b[key])
+    np.testing.assert_array_equal(a["goal_z"], [1.6, 1.6])
+    for i, path in enumerate(a["paths"]):
+        assert path.shape[1] == 3
+        start = np.array([a["start_x"][i], a["start_y"][i], a["start_z"][i]])
+        np.testing.assert_array_equal(path[0], start)
+        assert np.linalg.norm(start - goal) >= 3.0 and a["shortest_m"][i] >= np.linalg.norm(start - goal) - 1e-9
+        steps = np.linalg.norm(np.diff(path, axis=0), axis=1)
+        assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
+        assert np.ptp(path[:, 2]) > 0  # it flies up and down, not in a plane
+        if a["success"][i]:
+            assert np.linalg.norm(path[-1] - goal) <= 1.0 + 1e-9
+    with pytest.raises(ValueError, match=r"goal 1 \(1, 1\).*no walkable floor"):
+        bvc3d.navigate(world, [[1.0, 1.0]], model="fly-5l")
+    with pytest.raises(ValueError, match=r"goal 1 \(0, 0, 9\).*flight volume"):
+        bvc3d.navigate(world, [[0.0, 0.0, 9.0]], model="fly-5l")
+    with pytest.raises(ValueError, match="fly-5l"):
+        bvc3d.navigate(bvc3d.World.cross(), [[3.5, 3.5]], model="fly-5l")
+
+
 def test_navigate_killed_resumes_from_its_finished_runs_and_writes_the_same_files(tmp_path):
     """A navigate run killed (SIGKILL) after its first learning run and started again takes that run from
     runs/seed-0.nav and writes byte for byte what an uninterrupted run writes; other options start afresh."""

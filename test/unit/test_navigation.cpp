@@ -403,8 +403,7 @@ namespace {
 
 // A 6 × 6 × 3 m room whose walls, floor and ceiling bound its flight volume exactly, with a box floating at
 // `box_center` of `box_size` (none if its size is 0) and, if `divided`, a floor-to-ceiling wall across it at x = 1.9.
-World flight_box(const std::filesystem::path& dir, const Vec3& box_center, const Vec3& box_size,
-                 bool divided = false) {
+World flight_box(const std::filesystem::path& dir, const Vec3& box_center, const Vec3& box_size, bool divided = false) {
     const auto file = dir / "flight-box.yaml";
     std::ofstream out(file);
     out << "name: flight-box\nobjects:\n"
@@ -526,7 +525,7 @@ TEST(Navigation, FlyingAgentReachesAGoalInSightInAnOpenVolumeTheSameForTheSameSe
         reached += s.success;
         if (s.success) {
             EXPECT_LE((s.path.back() - goal).norm(), setup.nav.success_radius + 1e-9);
-            EXPECT_GT(height, 0.1);  // it flies: the goal is 2 m up, the starts elsewhere
+            EXPECT_GT(height, 0.1);                   // it flies: the goal is 2 m up, the starts elsewhere
             EXPECT_LT(s.path_m / s.shortest_m, 4.0);  // a blind flight (β = 0) reaches none of the four at 10×
         }
     }

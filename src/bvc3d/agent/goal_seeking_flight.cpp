@@ -11,7 +11,11 @@ namespace bvc3d {
 
 FlyingGoalSeeker::FlyingGoalSeeker(std::shared_ptr<const SphereCollider> body, const FlightParams& flight,
                                    FlyingSeekingParams params, DirectionPolicy& policy, const Pose& start)
-    : body_(std::move(body)), flight_(flight), p_(std::move(params)), policy_(policy), pose_(start),
+    : body_(std::move(body)),
+      flight_(flight),
+      p_(std::move(params)),
+      policy_(policy),
+      pose_(start),
       pitch_(start.pitch) {
     if (p_.directions.empty() || !(p_.step > 0))
         throw InputError("navigation: need at least one direction and a step > 0");

@@ -26,8 +26,8 @@ struct FlyingSeekingParams {
 
 class FlyingGoalSeeker : public GoalSeeker {
 public:
-    FlyingGoalSeeker(std::shared_ptr<const SphereCollider> body, const FlightParams& flight,
-                     FlyingSeekingParams params, DirectionPolicy& policy, const Pose& start);
+    FlyingGoalSeeker(std::shared_ptr<const SphereCollider> body, const FlightParams& flight, FlyingSeekingParams params,
+                     DirectionPolicy& policy, const Pose& start);
 
     std::optional<ModelStep> next(double t_end) override;
     double time() const override { return t_; }

@@ -17,8 +17,8 @@ namespace bvc3d {
 
 struct VoxelGrid3 {
     int nx = 0, ny = 0, nz = 0;
-    double cell = 0.1;       // m
-    std::vector<char> free;  // x fastest, then y, then z
+    double cell = 0.1;           // m
+    std::vector<char> free;      // x fastest, then y, then z
     Vec3 origin = Vec3::Zero();  // the corner of voxel (0, 0, 0)
     bool inside(int x, int y, int z) const { return x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < nz; }
     std::size_t index(int x, int y, int z) const { return (std::size_t(z) * ny + y) * nx + x; }

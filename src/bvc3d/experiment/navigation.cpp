@@ -98,8 +98,10 @@ public:
 class FloorSpace : public NavigationSpace {
 public:
     FloorSpace(const World& world, const NavigationSetup& s)
-        : s_(s), body_(std::make_shared<const BodyCollider>(world.description(), s.robot.radius, s.robot.height)),
-          path_grid_(*body_, s.nav.path_cell), cover_grid_(*body_, s.nav.coverage_cell) {
+        : s_(s),
+          body_(std::make_shared<const BodyCollider>(world.description(), s.robot.radius, s.robot.height)),
+          path_grid_(*body_, s.nav.path_cell),
+          cover_grid_(*body_, s.nav.coverage_cell) {
         int n = 0;
         parts_ = path_grid_.parts(s.robot.radius, n);
         main_ = largest_part(parts_, n);
@@ -146,14 +148,15 @@ public:
         throw InputError("navigation: no start at least " + format_number(min_distance) + " m from " +
                          goal_text(g, goal) + " on its floor");
     }
-    Pose start_pose(const Vec3& p, Rng& rng) const override { return Pose::on_floor(p.x(), p.y(), rng.uniform(-pi, pi)); }
+    Pose start_pose(const Vec3& p, Rng& rng) const override {
+        return Pose::on_floor(p.x(), p.y(), rng.uniform(-pi, pi));
+    }
     double shortest(const Vec3& from, const Vec3& to) const override {
         return shortest_path(path_grid_, xy(from), xy(to), s_.nav.path_inflate).length;
     }
     std::unique_ptr<GoalSeeker> seeker(DirectionPolicy& policy, const Pose& start) const override {
-        return std::make_unique<GoalSeekingWalk>(body_, s_.robot,
-                                                 GoalSeekingParams{s_.adjacency.n_hd, s_.nav.step, s_.nav.clearance},
-                                                 policy, start);
+        return std::make_unique<GoalSeekingWalk>(
+            body_, s_.robot, GoalSeekingParams{s_.adjacency.n_hd, s_.nav.step, s_.nav.clearance}, policy, start);
     }
     std::vector<Vec2> map_points(double cell) const override {
         std::vector<Vec2> out;
@@ -180,7 +183,8 @@ private:
 class FlightSpace : public NavigationSpace {
 public:
     FlightSpace(const World& world, const NavigationSetup& s)
-        : s_(s), body_(std::make_shared<const SphereCollider>(world.description(), s.flight.radius)),
+        : s_(s),
+          body_(std::make_shared<const SphereCollider>(world.description(), s.flight.radius)),
           occupancy_(voxel_occupancy(*body_, s.nav.path_cell, s.nav.path_inflate)) {
         int n = 0;
         parts_ = voxel_parts(occupancy_, n);
@@ -207,8 +211,9 @@ public:
                              " lies in or against geometry or the flight volume's bounds (the flying body, radius " +
                              format_number(s_.flight.radius) + " m, does not fit there)");
         if (!body_->can_start_at(g) || part_of_voxel(g) != main_)
-            throw InputError("navigation: " + goal_text(i, goal) +
-                             " cannot be reached from the space the agent flies (inside a solid, or a closed-off pocket)");
+            throw InputError(
+                "navigation: " + goal_text(i, goal) +
+                " cannot be reached from the space the agent flies (inside a solid, or a closed-off pocket)");
     }
     int n_dir() const override { return 20; }
     std::vector<double> learning_hd(const ModelStep& step) override {
@@ -441,6 +446,7 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
     const auto space = make_space(world, s);
     for (std::size_t i = 0; i < s.goals.size(); ++i) space->check_goal(i, s.goals[i]);
     check_scales(s.model, s.reward);
+    check_model(s.model, s);
     const NavigationParams& nav = s.nav;
     const auto agent = space_kind(s.dims()).agent(s);
     Senses senses(world, s.model, agent, seed);
@@ -512,7 +518,8 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
         run.reward_maps.emplace_back();
         for (const Vec2& q : map_points) {
             senses.reset();
-            for (int k = 0; k < std::max(1, nav.settle_steps); ++k) senses.step(Pose::on_floor(q.x(), q.y(), 0.0), false);
+            for (int k = 0; k < std::max(1, nav.settle_steps); ++k)
+                senses.step(Pose::on_floor(q.x(), q.y(), 0.0), false);
             run.reward_maps.back().push_back({q, reward(w, senses.rates().front())});
         }
         Rng rng(hash_u64(seed, 0x6e617669676174ULL, g), Stream::walk);
