@@ -1,6 +1,7 @@
 """Navigation to goals (docs/navigation.md) against a numpy transcription of SPEC §16-§17: the HD-conditioned
 adjacency's update on a hand-made sequence, replay and the reward read-out on a hand-made chain of cells, the
 direction choice, the shortest path against the arena's geometry, and `bvc3d navigate` on bad input."""
+import hashlib
 import math
 import signal
 import subprocess
@@ -216,6 +217,18 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
     with pytest.raises(ValueError, match="goal 1"):
         bvc3d.navigate(world, [[30.0, 0.0]])
+
+
+def test_navigate_on_the_floor_keeps_the_bytes_it_wrote_before_goals_in_3d(tmp_path):
+    """The floor's navigation went behind a NavigationSpace when the flying agent's came (issue 30): a small run's
+    starts.csv and paths.csv keep the digests the code before that change wrote (same options, same machine)."""
+    out = tmp_path / "out"
+    r = run("navigate", "--world", "cross", "--tilt", "60", "--goals", "3.5,3.5;-3.5,-3.5", "--max-learn-hours",
+            "0.2", "--starts", "3", "--seeds", "2", "--out", str(out), "--no-report")
+    assert r.returncode == 0, r.stderr
+    digests = {name: hashlib.sha256((out / name).read_bytes()).hexdigest() for name in ("starts.csv", "paths.csv")}
+    assert digests == {"starts.csv": "e600565f279eff431d74855ac1dffb396389c3d8aeb0576f6799413a55a27b71",
+                       "paths.csv": "cb27ac3dfb4df6bea6b86551c483eb056cad94b502bd8cfa4d806dfd2eda082a"}
 
 
 def test_navigate_flies_to_goals_in_3d_seeded_with_3d_paths():
