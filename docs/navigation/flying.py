@@ -4,8 +4,10 @@ into docs/navigation/flying-starts.csv and the per-goal summaries into docs/navi
 docs/navigation/flying-paths.png (the first learning run's paths, seen from the side, x–z, and from above, x–y).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/flying.py [--seeds N] [--starts N]
-[--learn-hours H] [--models fly-up,fly-5l,fly-9l]. Each model's own folder (with runs/: a run again with the same
-options skips the finished learning runs) is kept in build/navigation/flying-atrium-MODEL/.
+[--learn-hours H] [--models fly-up,fly-5l,fly-9l] [--beta B --prefix P]. `--beta 0 --prefix flying-blind` is the
+blind baseline (directions drawn uniformly from those offered), written to flying-blind-*.csv. Each model's own
+folder (with runs/: a run again with the same options skips the finished learning runs) is kept in
+build/navigation/PREFIX-atrium-MODEL/.
 """
 import argparse
 import csv
@@ -31,15 +33,18 @@ def main():
     ap.add_argument("--starts", type=int, default=10)
     ap.add_argument("--learn-hours", type=float, default=15)
     ap.add_argument("--models", default="fly-up,fly-5l,fly-9l")
+    ap.add_argument("--beta", type=float, help="reward.beta (0: a blind agent); default SPEC's 500")
+    ap.add_argument("--prefix", default="flying", help="prefix of the files and folders written")
     ap.add_argument("--bvc3d", default=str(ROOT / "build" / "bvc3d"), help="the program to run")
     a = ap.parse_args()
     rows, summary, folders = [], [], {}
     for model in a.models.split(","):
-        out = ROOT / "build" / "navigation" / f"flying-atrium-{model}"
+        out = ROOT / "build" / "navigation" / f"{a.prefix}-atrium-{model}"
         out.mkdir(parents=True, exist_ok=True)
-        config = out.parent / f"flying-atrium-{model}.yaml"
+        config = out.parent / f"{a.prefix}-atrium-{model}.yaml"
         config.write_text(f"world: atrium\ngoals: {GOALS}\nmodels: [{model}]\nseeds: {a.seeds}\n"
-                          f"navigation: {{starts: {a.starts}, max_learn_hours: {a.learn_hours}}}\n")
+                          f"navigation: {{starts: {a.starts}, max_learn_hours: {a.learn_hours}}}\n" +
+                          (f"reward: {{beta: {a.beta}}}\n" if a.beta is not None else ""))
         cmd = [a.bvc3d, "navigate", "--config", str(config), "--out", str(out), "--no-report"]
         print(" ".join(cmd), file=sys.stderr, flush=True)
         subprocess.run(cmd, check=True)
@@ -47,12 +52,12 @@ def main():
         for name, table in (("starts.csv", rows), ("summary.csv", summary)):
             with open(out / name, newline="") as f:
                 table += list(csv.DictReader(f))
-    for name, table in (("flying-starts.csv", rows), ("flying-summary.csv", summary)):
+    for name, table in ((f"{a.prefix}-starts.csv", rows), (f"{a.prefix}-summary.csv", summary)):
         with open(HERE / name, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(table[0].keys()), lineterminator="\n")
             w.writeheader()
             w.writerows(table)
-    figure(folders, rows)
+    figure(folders, rows, HERE / f"{a.prefix}-paths.png")
     print_table(rows)
 
 
@@ -70,7 +75,7 @@ def print_table(rows):
               f"{q[0]:.2f} [{q[1]:.2f}, {q[2]:.2f}] |")
 
 
-def figure(folders, rows):
+def figure(folders, rows, file):
     """Per model (rows) the first learning run's paths to each goal, side view (x–z) and top view (x–y)."""
     models = list(folders)
     fig, axes = plt.subplots(len(models), 2, figsize=(11, 4.6 * len(models)), squeeze=False)
@@ -108,7 +113,7 @@ def figure(folders, rows):
             ax.set_title(f"{model}, seed {seed}: {'side (x–z)' if label == 'z' else 'top (x–y)'}; "
                          "blue reached, red failed")
     fig.tight_layout()
-    fig.savefig(HERE / "flying-paths.png", dpi=90)
+    fig.savefig(file, dpi=90)
 
 
 if __name__ == "__main__":
