@@ -28,9 +28,10 @@ const params::Table<NavigationParams>& NavigationParams::table() {
     static const Table<P> t(
         "navigation",
         {real("coverage", &P::coverage, closed(0, 1), "learning ends once this fraction of free cells is visited"),
-         real("coverage_cell", &P::coverage_cell, closed(0.05, 100), "m, cells counted for coverage"),
+         real("coverage_cell", &P::coverage_cell, closed(0.05, 100), "m, cells (voxels in 3-D) counted for coverage"),
          integer("goal_visits", &P::goal_visits, closed(0, 1000000), "and each goal has been entered this often"),
-         real("goal_radius", &P::goal_radius, closed(0.01, 100), "m, a goal's radius while learning"),
+         real("goal_radius", &P::goal_radius, closed(0.01, 100),
+              "m, a goal's radius while learning (3-D distance in flight)"),
          real("max_learn_hours", &P::max_learn_hours, open_closed(0, max_agent_hours), "or after this much time"),
          integer("starts", &P::starts, closed(1, 1000000), "starts per goal"),
          real("min_start_distance", &P::min_start_distance, closed(0, 1e4), "m, a start's least distance to goal"),
@@ -40,8 +41,9 @@ const params::Table<NavigationParams>& NavigationParams::table() {
          real("step", &P::step, closed(0.01, 10), "m per decision"),
          real("clearance", &P::clearance, closed(0, 100), "m of free travel a direction needs"),
          integer("settle_steps", &P::settle_steps, closed(0, 1000), "place-cell steps at a start before moving"),
-         real("path_cell", &P::path_cell, closed(0.01, 10), "m, the shortest path's grid"),
-         real("path_inflate", &P::path_inflate, closed(0, 100), "m, obstacles inflated for the shortest path"),
+         real("path_cell", &P::path_cell, closed(0.01, 10), "m, the shortest path's grid (voxels in 3-D)"),
+         real("path_inflate", &P::path_inflate, closed(0, 100),
+              "m, obstacles (in 3-D all geometry) inflated for the shortest path"),
          real("reward_map_cell", &P::reward_map_cell, closed(0, 100), "m between reward-map points; 0: no map")});
     return t;
 }
