@@ -1,7 +1,8 @@
 """The flying agent's navigation result for docs/navigation.md#flying-to-goals-in-3-d: runs `bvc3d navigate` in the
 atrium with goals at two heights (one above the mezzanine slab, one near the floor) per model, gathers every start
 into docs/navigation/flying-starts.csv and the per-goal summaries into docs/navigation/flying-summary.csv, and draws
-docs/navigation/flying-paths.png (the first learning run's paths, seen from the side, x–z, and from above, x–y).
+docs/navigation/flying-paths.png (the first learning run's first two paths to each goal,
+seen from the side, x–z, and from above, x–y).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/flying.py [--seeds N] [--starts N]
 [--learn-hours H] [--models fly-up,fly-5l,fly-9l] [--beta B --prefix P]. `--beta 0 --prefix flying-blind` is the
@@ -75,8 +76,8 @@ def print_table(rows):
               f"{q[0]:.2f} [{q[1]:.2f}, {q[2]:.2f}] |")
 
 
-def figure(folders, rows, file):
-    """Per model (rows) the first learning run's paths to each goal, side view (x–z) and top view (x–y)."""
+def figure(folders, rows, file, shown=2):
+    """Per model (rows) the first learning run's first `shown` paths to each goal, side (x–z) and top (x–y) views."""
     models = list(folders)
     fig, axes = plt.subplots(len(models), 2, figsize=(11, 4.6 * len(models)), squeeze=False)
     for m, model in enumerate(models):
@@ -85,6 +86,9 @@ def figure(folders, rows, file):
         mine = [r for r in rows if r["model"] == model]
         seed = mine[0]["seed"]
         runs = [r for r in mine if r["seed"] == seed]
+        index = {id(r): s for s, r in enumerate(runs)}  # a start's number in its run (paths.csv's start)
+        goals = sorted({(r["goal_x"], r["goal_y"], r["goal_z"]) for r in runs})
+        picked = [r for g in goals for r in [r for r in runs if (r["goal_x"], r["goal_y"], r["goal_z"]) == g][:shown]]
         for view, (i, j, label) in enumerate(((0, 2, "z"), (0, 1, "y"))):
             ax = axes[m, view]
             # The mezzanine slab (x −5 to −3.5 and 3.5 to 5 seen from the side) and the pillars seen from above.
@@ -98,7 +102,8 @@ def figure(folders, rows, file):
                 for cx, cy in ((-1.5, 1.0), (2.0, -1.5)):
                     ax.add_patch(plt.Rectangle((cx - 0.3, cy - 0.3), 0.6, 0.6, color="0.4"))
                 ax.set_ylim(-5, 5)
-            for s, r in enumerate(runs):
+            for r in picked:
+                s = index[id(r)]
                 pts = np.array([[float(p["x"]), float(p["y"]), float(p["z"])] for p in paths
                                  if p["seed"] == seed and p["start"] == str(s)])
                 ok = r["success"] == "1"
@@ -113,7 +118,7 @@ def figure(folders, rows, file):
             ax.set_title(f"{model}, seed {seed}: {'side (x–z)' if label == 'z' else 'top (x–y)'}; "
                          "blue reached, red failed")
     fig.tight_layout()
-    fig.savefig(file, dpi=90)
+    fig.savefig(file, dpi=60)
 
 
 if __name__ == "__main__":
