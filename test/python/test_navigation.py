@@ -258,6 +258,28 @@ def test_navigate_flies_to_goals_in_3d_seeded_with_3d_paths():
         bvc3d.navigate(bvc3d.World.cross(), [[3.5, 3.5]], model="fly-5l")
 
 
+def test_navigate_in_3d_writes_z_and_resumes_its_runs_to_the_same_bytes(tmp_path):
+    out = tmp_path / "out"
+    args = ["navigate", "--world", "atrium", "--model", "fly-5l", "--goals", "2.5,2.5,0.8", "--starts", "1",
+            "--max-learn-hours", "0.05", "--out", str(out), "--no-report"]
+    first = run(*args)
+    assert first.returncode == 0, first.stderr
+    starts, paths = ((out / n).read_text() for n in ("starts.csv", "paths.csv"))
+    header = starts.splitlines()[0].split(",")
+    assert header == ("world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s,"
+                      "goal_z,start_z").split(",")
+    assert paths.splitlines()[0] == "model,seed,start,x,y,z"
+    row = dict(zip(header, starts.splitlines()[1].split(",")))
+    assert float(row["goal_z"]) == 0.8 and 0.4 < float(row["start_z"]) < 5.6
+    z = [float(line.split(",")[5]) for line in paths.splitlines()[1:]]
+    assert z[0] == float(row["start_z"]) and len(set(z)) > 1
+    for name in ("starts.csv", "paths.csv"):
+        (out / name).unlink()
+    again = run(*args)
+    assert again.returncode == 0 and "already done" in again.stderr, again.stderr
+    assert (out / "starts.csv").read_text() == starts and (out / "paths.csv").read_text() == paths
+
+
 def test_navigate_killed_resumes_from_its_finished_runs_and_writes_the_same_files(tmp_path):
     """A navigate run killed (SIGKILL) after its first learning run and started again takes that run from
     runs/seed-0.nav and writes byte for byte what an uninterrupted run writes; other options start afresh."""
