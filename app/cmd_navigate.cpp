@@ -42,27 +42,37 @@ struct NavigateOptions {
 struct NavigatePlan {
     std::string world, lean = "+x+y";
     std::optional<double> tilt;
-    std::vector<Vec2> goals;
+    std::vector<NavigationGoal> goals;
     std::vector<std::string> models;  // as given: a preset name or a model file
     int seeds = 1;
     std::uint64_t first_seed = 0;
     NavigationParams nav;
     AdjacencyParams adjacency;
     RewardParams reward;
+    FlightParams flight;
 };
 
-// "x,y;x,y": the goals (InputError naming the bad one).
-std::vector<Vec2> parse_goals(const std::string& text) {
-    std::vector<Vec2> out;
+// A goal of 2 numbers (on the floor) or 3 (in the air, the flying agent); else nothing.
+std::optional<NavigationGoal> goal_of(const std::vector<double>& v) {
+    if (v.size() == 2) return NavigationGoal(v[0], v[1]);
+    if (v.size() == 3) return NavigationGoal(v[0], v[1], v[2]);
+    return std::nullopt;
+}
+
+// "x,y;x,y" or "x,y,z;x,y,z": the goals (InputError naming the bad one).
+std::vector<NavigationGoal> parse_goals(const std::string& text) {
+    std::vector<NavigationGoal> out;
     std::stringstream all(text);
     std::string item;
     while (std::getline(all, item, ';')) {
         if (item.find_first_not_of(" \t") == std::string::npos) continue;
-        const auto comma = item.find(',');
-        if (comma == std::string::npos || item.find(',', comma + 1) != std::string::npos)
-            throw InputError("--goals: '" + item + "' is not x,y (give goals as x,y;x,y)");
-        out.emplace_back(parse_number(item.substr(0, comma), "--goals"),
-                         parse_number(item.substr(comma + 1), "--goals"));
+        std::vector<double> v;
+        std::stringstream numbers(item);
+        for (std::string n; std::getline(numbers, n, ',');) v.push_back(parse_number(n, "--goals"));
+        const auto goal = goal_of(v);
+        if (!goal || item.back() == ',')
+            throw InputError("--goals: '" + item + "' is not x,y or x,y,z (give goals as x,y;x,y or x,y,z;x,y,z)");
+        out.push_back(*goal);
     }
     return out;
 }
@@ -85,17 +95,18 @@ NavigatePlan plan_of_options(const NavigateOptions& o) {
 // tables navigation:, adjacency:, reward:. Any other key: InputError naming it.
 NavigatePlan plan_of_yaml(const std::string& file) {
     const auto v = config::YamlView::load_file(file);
-    v.expect_map(
-        {"world", "tilt", "lean", "goals", "models", "seeds", "first_seed", "navigation", "adjacency", "reward"});
+    v.expect_map({"world", "tilt", "lean", "goals", "models", "seeds", "first_seed", "navigation", "adjacency",
+                  "reward", "flight"});
     NavigatePlan p;
     p.world = config::path_in_file(v, v["world"].as_string());
     if (v.has("tilt")) p.tilt = v["tilt"].as_double();
     p.lean = v.get("lean", p.lean);
     const auto goals = v["goals"];
-    if (!goals.is_sequence()) goals.fail("must be a list of [x, y]");
+    if (!goals.is_sequence()) goals.fail("must be a list of [x, y] or of [x, y, z]");
     for (std::size_t i = 0; i < goals.size(); ++i) {
-        const auto xy = goals.at(i).as_doubles(2);
-        p.goals.emplace_back(xy[0], xy[1]);
+        const auto goal = goal_of(goals.at(i).as_doubles());
+        if (!goal) goals.at(i).fail("must be [x, y] (on the floor) or [x, y, z] (flying)");
+        p.goals.push_back(*goal);
     }
     if (v.has("models")) {
         const auto m = v["models"];
@@ -115,6 +126,7 @@ NavigatePlan plan_of_yaml(const std::string& file) {
     if (v.has("navigation")) config::read_table(v["navigation"], p.nav, NavigationParams::table());
     if (v.has("adjacency")) config::read_table(v["adjacency"], p.adjacency, AdjacencyParams::table());
     if (v.has("reward")) config::read_table(v["reward"], p.reward, RewardParams::table());
+    if (v.has("flight")) config::read_table(v["flight"], p.flight, FlightParams::table());
     return p;
 }
 
@@ -141,7 +153,12 @@ std::string number_text(double v) {
     return {buf, std::to_chars(buf, buf + sizeof buf, v).ptr};
 }
 
-void save_run(const std::filesystem::path& file, const std::string& fingerprint, const NavigationRun& r) {
+// Points as x y (on the floor) or x y z (a flying run: `dims` 3).
+void save_run(const std::filesystem::path& file, const std::string& fingerprint, const NavigationRun& r, int dims) {
+    const auto point = [&](std::ostream& o, const Vec3& p) {
+        o << number_text(p.x()) << ' ' << number_text(p.y());
+        if (dims == 3) o << ' ' << number_text(p.z());
+    };
     AtomicFile f(file);
     auto& o = f.stream();
     o << run_magic << '\n' << fingerprint << "\nend-fingerprint\n";
@@ -153,17 +170,18 @@ void save_run(const std::filesystem::path& file, const std::string& fingerprint,
     }
     o << r.starts.size() << '\n';
     for (const auto& st : r.starts) {
-        o << st.goal << ' ' << number_text(st.start.x()) << ' ' << number_text(st.start.y()) << ' ' << st.success << ' '
-          << number_text(st.path_m) << ' ' << number_text(st.shortest_m) << ' ' << number_text(st.time_s) << ' '
-          << st.path.size() << '\n';
-        for (const Vec2& p : st.path) o << number_text(p.x()) << ' ' << number_text(p.y()) << '\n';
+        o << st.goal << ' ';
+        point(o, st.start);
+        o << ' ' << st.success << ' ' << number_text(st.path_m) << ' ' << number_text(st.shortest_m) << ' '
+          << number_text(st.time_s) << ' ' << st.path.size() << '\n';
+        for (const Vec3& p : st.path) point(o, p), o << '\n';
     }
     o << "end\n";
     f.commit();
 }
 
 // The run kept in `file` if it is whole and was made with `fingerprint`; else nothing.
-std::optional<NavigationRun> load_run(const std::filesystem::path& file, const std::string& fingerprint) {
+std::optional<NavigationRun> load_run(const std::filesystem::path& file, const std::string& fingerprint, int dims) {
     std::ifstream in(file);
     std::string line, fp;
     if (!std::getline(in, line) || line != run_magic) return std::nullopt;
@@ -180,6 +198,11 @@ std::optional<NavigationRun> load_run(const std::filesystem::path& file, const s
         long long v = 0;
         ok = ok && (in >> v) && v >= 0;
         return static_cast<std::size_t>(std::max(v, 0LL));
+    };
+    auto point = [&] {
+        Vec3 p = Vec3::Zero();
+        for (int d = 0; d < dims; ++d) p[d] = real();
+        return p;
     };
     NavigationRun r;
     r.learn_s = real();
@@ -198,14 +221,10 @@ std::optional<NavigationRun> load_run(const std::filesystem::path& file, const s
     for (std::size_t n = count(); ok && n > 0; --n) {
         NavigationStart st;
         ok = ok && (in >> st.goal);
-        const double x = real(), y = real();
-        st.start = Vec2(x, y);
+        st.start = point();
         ok = ok && (in >> st.success);
         st.path_m = real(), st.shortest_m = real(), st.time_s = real();
-        for (std::size_t m = count(); ok && m > 0; --m) {
-            const double px = real();
-            st.path.emplace_back(px, real());
-        }
+        for (std::size_t m = count(); ok && m > 0; --m) st.path.push_back(point());
         r.starts.push_back(std::move(st));
     }
     if (!ok || !(in >> word) || word != "end") return std::nullopt;
@@ -216,7 +235,9 @@ std::optional<NavigationRun> load_run(const std::filesystem::path& file, const s
 std::string run_fingerprint(const NavigatePlan& o, const NavigationSetup& s, std::uint64_t seed) {
     std::string fp = "world: " + WorldSpec{o.world, o.tilt, o.lean}.fingerprint() + "\nmodel:\n" +
                      config::model_to_yaml(s.model) + "goals:";
-    for (const Vec2& g : s.goals) fp += " " + number_text(g.x()) + "," + number_text(g.y());
+    for (const NavigationGoal& g : s.goals)
+        fp += " " + number_text(g.x()) + "," + number_text(g.y()) + (g.dims == 3 ? "," + number_text(g.z()) : "");
+    if (s.dims() == 3) fp += "\nflight:\n" + params::yaml_lines(FlightParams::table(), s.flight, "  ");
     fp += "\nnavigation:\n" + params::yaml_lines(NavigationParams::table(), s.nav, "  ") + "adjacency:\n" +
           params::yaml_lines(AdjacencyParams::table(), s.adjacency, "  ") + "reward:\n" +
           params::yaml_lines(RewardParams::table(), s.reward, "  ") + "seed: " + std::to_string(seed);
@@ -227,7 +248,7 @@ void navigate_command(const NavigateOptions& o) {
     o.run.check();
     const NavigatePlan plan = o.config.empty() ? plan_of_options(o) : plan_of_yaml(o.config);
     NavigationSetup setup;
-    setup.nav = plan.nav, setup.adjacency = plan.adjacency, setup.reward = plan.reward;
+    setup.nav = plan.nav, setup.adjacency = plan.adjacency, setup.reward = plan.reward, setup.flight = plan.flight;
     setup.goals = plan.goals;
     std::vector<ModelSpec> models;
     std::optional<World> world;
@@ -238,6 +259,7 @@ void navigate_command(const NavigateOptions& o) {
         }
         world.emplace(config::resolve_world(plan.world, plan.tilt, plan.lean));
         check_goals(*world, setup);
+        for (const ModelSpec& m : models) check_model(m, setup);
     } catch (const InputError& e) {
         if (o.config.empty()) throw;
         throw InputError(o.config + ": " + e.what());
@@ -273,22 +295,25 @@ void navigate_command(const NavigateOptions& o) {
         NavigationSetup mine = setup;
         mine.model = models[d.model];
         const std::string fingerprint = run_fingerprint(plan, mine, d.seed);
-        if (std::optional<NavigationRun> kept_run = load_run(kept, fingerprint)) {
+        if (std::optional<NavigationRun> kept_run = load_run(kept, fingerprint, mine.dims())) {
             std::fprintf(stderr, "%s: already done (%s)\n", name.c_str(), kept.string().c_str());
             d.run = std::move(*kept_run);
             return;
         }
         std::fprintf(stderr, "%s: learning...\n", name.c_str());
         d.run = navigate(*world, mine, d.seed);
-        save_run(kept, fingerprint, d.run);
+        save_run(kept, fingerprint, d.run, mine.dims());
         std::fprintf(stderr, "%s: learned in %.2f h (coverage %.3f); %zu starts\n", name.c_str(), d.run.learn_s / 3600,
                      d.run.coverage, d.run.starts.size());
     });
 
     AtomicFile starts(out / "starts.csv"), paths(out / "paths.csv"), maps(out / "reward_map.csv"),
         learning(out / "learning.csv");
-    starts.stream() << "world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s\n";
-    paths.stream() << "model,seed,start,x,y\n";
+    // A flying run (goals x,y,z) appends goal_z,start_z to starts.csv and z to paths.csv and summary.csv (goal_z).
+    const bool flying = setup.dims() == 3;
+    starts.stream() << "world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s"
+                    << (flying ? ",goal_z,start_z\n" : "\n");
+    paths.stream() << "model,seed,start,x,y" << (flying ? ",z\n" : "\n");
     maps.stream() << "model,seed,goal,x,y,reward\n";
     learning.stream() << "model,seed,learn_s,coverage,goal,visits,goal_cell\n";
     // Per model and goal: the path ratios of the successes, successes, starts, learning times.
@@ -308,13 +333,18 @@ void navigate_command(const NavigateOptions& o) {
         }
         for (std::size_t i = 0; i < r.starts.size(); ++i) {
             const auto& s = r.starts[i];
-            const Vec2 goal = setup.goals[std::size_t(s.goal)];
+            const NavigationGoal& goal = setup.goals[std::size_t(s.goal)];
             const double ratio = s.path_m / s.shortest_m;
             starts.stream() << world_name << ',' << model << ',' << d.seed << ',' << goal.x() << ',' << goal.y() << ','
                             << s.start.x() << ',' << s.start.y() << ',' << (s.success ? 1 : 0) << ',' << s.path_m << ','
-                            << s.shortest_m << ',' << ratio << ',' << s.time_s << '\n';
-            for (const Vec2& p : s.path)
-                paths.stream() << model << ',' << d.seed << ',' << i << ',' << p.x() << ',' << p.y() << '\n';
+                            << s.shortest_m << ',' << ratio << ',' << s.time_s;
+            if (flying) starts.stream() << ',' << goal.z() << ',' << s.start.z();
+            starts.stream() << '\n';
+            for (const Vec3& p : s.path) {
+                paths.stream() << model << ',' << d.seed << ',' << i << ',' << p.x() << ',' << p.y();
+                if (flying) paths.stream() << ',' << p.z();
+                paths.stream() << '\n';
+            }
             const std::size_t c = d.model * n_goals + std::size_t(s.goal);
             ++tried[c];
             if (s.success) ++reached[c], ratios[c].push_back(ratio);
@@ -322,23 +352,28 @@ void navigate_command(const NavigateOptions& o) {
     }
     AtomicFile csv(out / "summary.csv"), md(out / "summary.md");
     csv.stream() << "world,model,goal_x,goal_y,seeds,starts,success_rate,path_ratio_median,path_ratio_q25,"
-                    "path_ratio_q75,learn_h_mean\n";
+                    "path_ratio_q75,learn_h_mean"
+                 << (flying ? ",goal_z\n" : "\n");
     md.stream()
         << "# Navigation: " << world_name << ", " << plan.seeds << " learning run(s) per model\n\n"
         << "| model | goal | starts | success | path ratio median [q25, q75] (successes) | learning h (mean) |\n"
         << "|---|---|---|---|---|---|\n";
     for (std::size_t c = 0; c < n_cells; ++c) {
         const std::string& model = plan.models[c / n_goals];
-        const Vec2 goal = setup.goals[c % n_goals];
+        const NavigationGoal& goal = setup.goals[c % n_goals];
         double mean_learn = 0;
         for (double t : learn_s[c]) mean_learn += t / 3600 / double(learn_s[c].size());
         const double rate = tried[c] ? double(reached[c]) / tried[c] : 0.0;
         const double med = quantile(ratios[c], 0.5), q25 = quantile(ratios[c], 0.25), q75 = quantile(ratios[c], 0.75);
         csv.stream() << world_name << ',' << model << ',' << goal.x() << ',' << goal.y() << ',' << plan.seeds << ','
-                     << tried[c] << ',' << rate << ',' << med << ',' << q25 << ',' << q75 << ',' << mean_learn << '\n';
-        char line[256];
-        std::snprintf(line, sizeof line, "| (%g, %g) | %d | %.0f %% | %.2f [%.2f, %.2f] | %.2f |\n", goal.x(), goal.y(),
-                      tried[c], 100 * rate, med, q25, q75, mean_learn);
+                     << tried[c] << ',' << rate << ',' << med << ',' << q25 << ',' << q75 << ',' << mean_learn;
+        if (flying) csv.stream() << ',' << goal.z();
+        csv.stream() << '\n';
+        char where[96], line[256];
+        if (flying) std::snprintf(where, sizeof where, "(%g, %g, %g)", goal.x(), goal.y(), goal.z());
+        else std::snprintf(where, sizeof where, "(%g, %g)", goal.x(), goal.y());
+        std::snprintf(line, sizeof line, "| %s | %d | %.0f %% | %.2f [%.2f, %.2f] | %.2f |\n", where, tried[c],
+                      100 * rate, med, q25, q75, mean_learn);
         md.stream() << "| " << model << " " << line;
     }
     for (AtomicFile* f : {&starts, &paths, &maps, &learning, &csv, &md}) f->commit();
@@ -362,7 +397,9 @@ void add_navigate_command(CLI::App& app) {
     given.push_back(cmd->add_option("--world", o->world, "World preset or YAML file (configs/worlds/nav-*.yaml)"));
     given.push_back(cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees"));
     given.push_back(cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str());
-    given.push_back(cmd->add_option("--goals", o->goals, "Goals on the floor: x,y[;x,y...] (m)"));
+    given.push_back(cmd->add_option("--goals", o->goals,
+                                    "Goals on the floor, x,y[;x,y...], or in the air for the flying agent, "
+                                    "x,y,z[;x,y,z...] (m)"));
     given.push_back(cmd->add_option("--model", o->model, "Model preset or YAML file")->capture_default_str());
     given.push_back(cmd->add_option("--seeds", o->seeds, "Learning runs (seeds first-seed, first-seed+1, ...)")
                         ->capture_default_str());

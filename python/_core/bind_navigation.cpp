@@ -167,30 +167,40 @@ HdAdjacency(n_place, **params); params and their defaults:
             NavigationSetup s;
             s.model = config::resolve_model(model);
             const auto g = real_array(goals, "goals");
-            if (g.ndim() != 2 || g.shape(1) != 2) throw InputError("goals must be an (N, 2) array of x, y");
-            for (pyb::ssize_t i = 0; i < g.shape(0); ++i) s.goals.emplace_back(g.at(i, 0), g.at(i, 1));
+            if (g.ndim() != 2 || (g.shape(1) != 2 && g.shape(1) != 3))
+                throw InputError("goals must be an (N, 2) array of x, y (on the floor) or (N, 3) of x, y, z (flying)");
+            for (pyb::ssize_t i = 0; i < g.shape(0); ++i)
+                s.goals.push_back(g.shape(1) == 3 ? NavigationGoal(g.at(i, 0), g.at(i, 1), g.at(i, 2))
+                                                  : NavigationGoal(g.at(i, 0), g.at(i, 1)));
+            const int dims = s.dims();
             apply_navigation(s, kwargs);
             const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
             const auto run = interruptible([&](const std::atomic<bool>&) { return navigate(w, s, seed_value); });
             pyb::dict d;
             const auto n = pyb::ssize_t(run.starts.size());
-            std::vector<double> gx, gy, sx, sy, path, shortest, time;
+            std::vector<double> gx, gy, gz, sx, sy, sz, path, shortest, time;
             std::vector<int> goal, success;
             pyb::list paths;
             for (const auto& st : run.starts) {
                 goal.push_back(st.goal), success.push_back(st.success);
                 gx.push_back(s.goals[std::size_t(st.goal)].x()), gy.push_back(s.goals[std::size_t(st.goal)].y());
-                sx.push_back(st.start.x()), sy.push_back(st.start.y());
+                gz.push_back(s.goals[std::size_t(st.goal)].z());
+                sx.push_back(st.start.x()), sy.push_back(st.start.y()), sz.push_back(st.start.z());
                 path.push_back(st.path_m), shortest.push_back(st.shortest_m), time.push_back(st.time_s);
                 std::vector<double> xy;
-                for (const Vec2& q : st.path) xy.push_back(q.x()), xy.push_back(q.y());
-                paths.append(to_numpy(xy.data(), {pyb::ssize_t(st.path.size()), 2}));
+                for (const Vec3& q : st.path)
+                    for (int k = 0; k < dims; ++k) xy.push_back(q[k]);
+                paths.append(to_numpy(xy.data(), {pyb::ssize_t(st.path.size()), dims}));
             }
             d["goal"] = to_numpy(goal.data(), {n});
             d["goal_x"] = to_numpy(gx.data(), {n});
             d["goal_y"] = to_numpy(gy.data(), {n});
             d["start_x"] = to_numpy(sx.data(), {n});
             d["start_y"] = to_numpy(sy.data(), {n});
+            if (dims == 3) {
+                d["goal_z"] = to_numpy(gz.data(), {n});
+                d["start_z"] = to_numpy(sz.data(), {n});
+            }
             d["success"] = to_numpy(success.data(), {n}).attr("astype")("bool");
             d["path_m"] = to_numpy(path.data(), {n});
             d["shortest_m"] = to_numpy(shortest.data(), {n});
@@ -203,9 +213,11 @@ HdAdjacency(n_place, **params); params and their defaults:
             return d;
         },
         pyb::arg("world"), pyb::arg("goals"), pyb::arg("model") = "2d", pyb::arg("seed") = 0,
-        ("One navigation run (docs/navigation.md): learning, then starts per goal. dict of arrays, one entry per "
-         "start (goal, goal_x, goal_y, start_x, start_y, success, path_m, shortest_m, time_s, paths), and learn_s, "
-         "coverage, visits, goal_cells. Keywords (navigation, reward and adjacency parameters):\n" +
+        ("One navigation run (docs/navigation.md): learning, then starts per goal. goals: (N, 2) on the floor or "
+         "(N, 3) for the flying agent (docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per "
+         "start (goal, goal_x, goal_y, start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, "
+         "time_s, paths of (M, 2) or (M, 3)), and learn_s, coverage, visits, goal_cells. Keywords (navigation, reward "
+         "and adjacency parameters):\n" +
          describe(NavigationParams::table(), NavigationParams{}) + describe(RewardParams::table(), RewardParams{}))
             .c_str());
 }

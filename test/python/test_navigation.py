@@ -1,6 +1,7 @@
 """Navigation to goals (docs/navigation.md) against a numpy transcription of SPEC §16-§17: the HD-conditioned
 adjacency's update on a hand-made sequence, replay and the reward read-out on a hand-made chain of cells, the
 direction choice, the shortest path against the arena's geometry, and `bvc3d navigate` on bad input."""
+import hashlib
 import math
 import signal
 import subprocess
@@ -216,6 +217,67 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
     with pytest.raises(ValueError, match="goal 1"):
         bvc3d.navigate(world, [[30.0, 0.0]])
+
+
+def test_navigate_on_the_floor_keeps_the_bytes_it_wrote_before_goals_in_3d(tmp_path):
+    """The floor's navigation went behind a NavigationSpace when the flying agent's came (issue 30): a small run's
+    starts.csv and paths.csv keep the digests the code before that change wrote (same options, same machine)."""
+    out = tmp_path / "out"
+    r = run("navigate", "--world", "cross", "--tilt", "60", "--goals", "3.5,3.5;-3.5,-3.5", "--max-learn-hours",
+            "0.2", "--starts", "3", "--seeds", "2", "--out", str(out), "--no-report")
+    assert r.returncode == 0, r.stderr
+    digests = {name: hashlib.sha256((out / name).read_bytes()).hexdigest() for name in ("starts.csv", "paths.csv")}
+    assert digests == {"starts.csv": "e600565f279eff431d74855ac1dffb396389c3d8aeb0576f6799413a55a27b71",
+                       "paths.csv": "cb27ac3dfb4df6bea6b86551c483eb056cad94b502bd8cfa4d806dfd2eda082a"}
+
+
+def test_navigate_flies_to_goals_in_3d_seeded_with_3d_paths():
+    world = bvc3d.World.preset("flight-room")
+    goal = [1.5, 1.0, 1.6]
+    kw = dict(max_learn_hours=0.15, coverage=0.8, goal_visits=2, starts=2, min_start_distance=3.0)
+    a = bvc3d.navigate(world, [goal], model="fly-5l", seed=2, **kw)
+    b = bvc3d.navigate(world, [goal], model="fly-5l", seed=2, **kw)
+    for key in ("start_x", "start_y", "start_z", "path_m", "shortest_m", "time_s", "success"):
+        np.testing.assert_array_equal(a[key], b[key])
+    np.testing.assert_array_equal(a["goal_z"], [1.6, 1.6])
+    for i, path in enumerate(a["paths"]):
+        assert path.shape[1] == 3
+        start = np.array([a["start_x"][i], a["start_y"][i], a["start_z"][i]])
+        np.testing.assert_array_equal(path[0], start)
+        assert np.linalg.norm(start - goal) >= 3.0 and a["shortest_m"][i] >= np.linalg.norm(start - goal) - 1e-9
+        steps = np.linalg.norm(np.diff(path, axis=0), axis=1)
+        assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
+        assert np.ptp(path[:, 2]) > 0  # it flies up and down, not in a plane
+        if a["success"][i]:
+            assert np.linalg.norm(path[-1] - goal) <= 1.0 + 1e-9
+    with pytest.raises(ValueError, match=r"goal 1 \(1, 1\).*no walkable floor"):
+        bvc3d.navigate(world, [[1.0, 1.0]], model="fly-5l")
+    with pytest.raises(ValueError, match=r"goal 1 \(0, 0, 9\).*flight volume"):
+        bvc3d.navigate(world, [[0.0, 0.0, 9.0]], model="fly-5l")
+    with pytest.raises(ValueError, match="fly-5l"):
+        bvc3d.navigate(bvc3d.World.cross(), [[3.5, 3.5]], model="fly-5l")
+
+
+def test_navigate_in_3d_writes_z_and_resumes_its_runs_to_the_same_bytes(tmp_path):
+    out = tmp_path / "out"
+    args = ["navigate", "--world", "atrium", "--model", "fly-5l", "--goals", "2.5,2.5,0.8", "--starts", "1",
+            "--max-learn-hours", "0.05", "--out", str(out), "--no-report"]
+    first = run(*args)
+    assert first.returncode == 0, first.stderr
+    starts, paths = ((out / n).read_text() for n in ("starts.csv", "paths.csv"))
+    header = starts.splitlines()[0].split(",")
+    assert header == ("world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s,"
+                      "goal_z,start_z").split(",")
+    assert paths.splitlines()[0] == "model,seed,start,x,y,z"
+    row = dict(zip(header, starts.splitlines()[1].split(",")))
+    assert float(row["goal_z"]) == 0.8 and 0.4 < float(row["start_z"]) < 5.6
+    z = [float(line.split(",")[5]) for line in paths.splitlines()[1:]]
+    assert z[0] == float(row["start_z"]) and len(set(z)) > 1
+    for name in ("starts.csv", "paths.csv"):
+        (out / name).unlink()
+    again = run(*args)
+    assert again.returncode == 0 and "already done" in again.stderr, again.stderr
+    assert (out / "starts.csv").read_text() == starts and (out / "paths.csv").read_text() == paths
 
 
 def test_navigate_killed_resumes_from_its_finished_runs_and_writes_the_same_files(tmp_path):

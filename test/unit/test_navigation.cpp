@@ -255,7 +255,7 @@ TEST(Navigation, ReachesAGoalInSightInAnOpenRoomTheSameForTheSameSeed) {
         reached += s.success;
         EXPECT_GT(s.shortest_m, 4.0 - 1e-9);
         if (s.success) {
-            EXPECT_LE((s.path.back() - setup.goals[0]).norm(), setup.nav.success_radius + 1e-9);
+            EXPECT_LE((s.path.back() - setup.goals[0].p).norm(), setup.nav.success_radius + 1e-9);
             EXPECT_LT(s.path_m / s.shortest_m, 2.5);  // a blind walk (β = 0) fails all four at 10×
         }
     }
@@ -397,4 +397,172 @@ TEST(VoxelPath, MatchesBruteForceAndGoesRoundASlab) {
     EXPECT_NEAR(*voxel_shortest_path(g, {0, 0, 0}, {4, 0, 0}), 6 + 2 * std::sqrt(2.0), 1e-9);
     g.free[g.index(2, 0, 3)] = 0;
     EXPECT_FALSE(voxel_shortest_path(g, {0, 0, 0}, {4, 0, 0}).has_value());
+}
+
+namespace {
+
+// A 6 × 6 × 3 m room whose walls, floor and ceiling bound its flight volume exactly, with a box floating at
+// `box_center` of `box_size` (none if its size is 0) and, if `divided`, a floor-to-ceiling wall across it at x = 1.9.
+World flight_box(const std::filesystem::path& dir, const Vec3& box_center, const Vec3& box_size, bool divided = false) {
+    const auto file = dir / "flight-box.yaml";
+    std::ofstream out(file);
+    out << "name: flight-box\nobjects:\n"
+           "  - box: {center: [0, 0, -0.05], size: [6, 6, 0.1]}\n"
+           "  - box: {center: [0, 0, 3.05], size: [6, 6, 0.1]}\n"
+           "  - box: {center: [-3.1, 0, 1.5], size: [0.2, 6.4, 3]}\n"
+           "  - box: {center: [3.1, 0, 1.5], size: [0.2, 6.4, 3]}\n"
+           "  - box: {center: [0, -3.1, 1.5], size: [6.4, 0.2, 3]}\n"
+           "  - box: {center: [0, 3.1, 1.5], size: [6.4, 0.2, 3]}\n";
+    if (box_size.minCoeff() > 0)
+        out << "  - box: {center: [" << box_center.x() << ", " << box_center.y() << ", " << box_center.z()
+            << "], size: [" << box_size.x() << ", " << box_size.y() << ", " << box_size.z() << "]}\n";
+    if (divided) out << "  - box: {center: [1.9, 0, 1.5], size: [0.2, 6, 3]}\n";
+    out << "flight_volume: {rect: [-3, -3, 3, 3], z_min: 0, z_max: 3}\n";
+    out.close();
+    return World(config::load_world_file(file.string()));
+}
+
+// Distance from p to an axis-aligned box (0 inside).
+double box_distance(const Vec3& p, const Vec3& center, const Vec3& size) {
+    return ((p - center).cwiseAbs() - size / 2).cwiseMax(0.0).norm();
+}
+
+}  // namespace
+
+TEST(VoxelOccupancy, FreeVoxelsAreThoseWithHalfAMetreToTheBoxAndTheVolumesBounds) {
+    test::TempDir dir;
+    const Vec3 center(0.4, -0.3, 1.2), size(1.0, 0.8, 0.6);
+    const World world = flight_box(dir.path(), center, size);
+    const SphereCollider body(world.description(), 0.2);
+    const VoxelGrid3 g = voxel_occupancy(body, 0.1, 0.5);
+    // Over the box of centre positions: 5.6 × 5.6 × 2.6 m.
+    ASSERT_EQ(g.nx, 56);
+    ASSERT_EQ(g.ny, 56);
+    ASSERT_EQ(g.nz, 26);
+    std::size_t free = 0, checked = 0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+        const Vec3 c = g.center(g.voxel_at(i));
+        // Analytic: the nearest geometry is the volume's boundary (the room's inner faces) or the box.
+        const double to_bounds = std::min({3 - std::abs(c.x()), 3 - std::abs(c.y()), c.z(), 3 - c.z()});
+        const double nearest = std::min(to_bounds, box_distance(c, center, size));
+        if (std::abs(nearest - 0.5) < 1e-9) continue;  // on the inflated surface: either answer is right
+        ++checked;
+        EXPECT_EQ(bool(g.free[i]), nearest > 0.5) << c.transpose() << " nearest " << nearest;
+        free += g.free[i];
+    }
+    EXPECT_GT(checked, g.size() * 9 / 10);
+    EXPECT_GT(free, 20000u);
+    // Voxels of the box itself and beside it are taken, the room's middle above it is free.
+    EXPECT_FALSE(g.free[g.index(40, 25, 10)]);  // (1.25, -0.25, 1.25): 0.35 m from the box's +x face
+    EXPECT_TRUE(g.free[g.index(28, 28, 22)]);   // (0.05, 0.05, 2.45)
+}
+
+TEST(VoxelOccupancy, ShortestPathGoesStraightInTheOpenAndRoundAnObstacle) {
+    test::TempDir dir;
+    // A box from x = -0.5 to 0.5, y = -1 to 1 and z = 1 to 2: inflated by 0.5 it fills the free height (z 0.5 to
+    // 2.5) over |x| < 1, |y| < 1.5, so a path from x = -2 to x = 2 at y = 0 goes round it.
+    const World world = flight_box(dir.path(), Vec3(0, 0, 1.5), Vec3(1, 2, 1));
+    const SphereCollider body(world.description(), 0.2);
+    const VoxelGrid3 g = voxel_occupancy(body, 0.1, 0.5);
+    // In the open (y = -2.2, clear of the box's inflation): no shorter than the straight line, and no longer than
+    // 26-neighbour moves make it (at most 13 % for any direction) plus half a voxel's diagonal at each end.
+    const Vec3 a(-2, -2.2, 0.8), b(2, -2.2, 2.2);
+    const auto open = voxel_path_between(g, a, b);
+    ASSERT_TRUE(open.has_value());
+    EXPECT_GE(*open, (b - a).norm() - 1e-9);
+    EXPECT_LE(*open, (b - a).norm() * 1.13 + 0.1 * std::sqrt(3.0));
+    // Round the box: the path crosses x = 0 at |y| >= 1.5, so it is at least 2·hypot(2, 1.5) = 5 m long.
+    const auto round = voxel_path_between(g, Vec3(-2, 0, 1.5), Vec3(2, 0, 1.5));
+    ASSERT_TRUE(round.has_value());
+    EXPECT_GE(*round, 5.0);
+    EXPECT_LE(*round, 5.0 * 1.13 + 1.0);
+    // Ends inside the inflation are joined to their nearest free voxel by a straight segment, which counts.
+    const auto near = voxel_path_between(g, Vec3(-0.8, 0, 1.5), Vec3(-2, 0, 1.5));
+    ASSERT_TRUE(near.has_value());
+    EXPECT_GE(*near, 1.2 - 1e-9);
+    int parts = 0;
+    voxel_parts(g, parts);
+    EXPECT_EQ(parts, 1);
+}
+
+namespace {
+
+NavigationSetup flight_setup() {
+    NavigationSetup s;
+    s.model = model_preset("fly-5l");
+    s.goals = {{1.5, 1.5, 2.0}};
+    s.nav.max_learn_hours = 0.5;
+    s.nav.goal_visits = 3;
+    s.nav.coverage = 0.9;
+    s.nav.starts = 4;
+    s.nav.reward_map_cell = 0;
+    return s;
+}
+
+}  // namespace
+
+TEST(Navigation, FlyingAgentReachesAGoalInSightInAnOpenVolumeTheSameForTheSameSeed) {
+    test::TempDir dir;
+    const World world = flight_box(dir.path(), Vec3::Zero(), Vec3::Zero());
+    const auto setup = flight_setup();
+    const auto run = navigate(world, setup, 1);
+    ASSERT_GE(run.goal_cells[0], 0);
+    EXPECT_GE(run.visits[0], 3);
+    EXPECT_GE(run.coverage, 0.9);
+    ASSERT_EQ(run.starts.size(), 4u);
+    int reached = 0;
+    for (const auto& s : run.starts) {
+        const Vec3 goal = setup.goals[0].p;
+        EXPECT_GE((s.start - goal).norm(), setup.nav.min_start_distance);
+        EXPECT_GE(s.shortest_m, (s.start - goal).norm() - 1e-9);
+        double length = 0, height = 0;
+        for (std::size_t i = 1; i < s.path.size(); ++i) {
+            EXPECT_LE((s.path[i] - s.path[i - 1]).norm(), setup.nav.step + 1e-9);
+            length += (s.path[i] - s.path[i - 1]).norm();
+            height = std::max(height, std::abs(s.path[i].z() - s.start.z()));
+        }
+        EXPECT_NEAR(length, s.path_m, 1e-9);
+        reached += s.success;
+        if (s.success) {
+            EXPECT_LE((s.path.back() - goal).norm(), setup.nav.success_radius + 1e-9);
+            EXPECT_GT(height, 0.1);                   // it flies: the goal is 2 m up, the starts elsewhere
+            EXPECT_LT(s.path_m / s.shortest_m, 4.0);  // a blind flight (β = 0) fails this test (checked)
+        }
+    }
+    EXPECT_GE(reached, 3) << "of " << run.starts.size();
+    const auto again = navigate(world, setup, 1);
+    ASSERT_EQ(again.starts.size(), run.starts.size());
+    for (std::size_t i = 0; i < run.starts.size(); ++i) EXPECT_EQ(again.starts[i].path, run.starts[i].path) << i;
+    EXPECT_EQ(again.rewards, run.rewards);
+}
+
+TEST(Navigation, RefusesGoalsIn3DOutsideInGeometryUnreachableOrMixed) {
+    test::TempDir dir;
+    const World world = flight_box(dir.path(), Vec3(0, 0, 1.5), Vec3(1, 1, 1));
+    auto setup = flight_setup();
+    const auto refused = [&](const World& w, std::vector<NavigationGoal> goals, const std::string& named,
+                             const std::string& why) {
+        setup.goals = std::move(goals);
+        try {
+            check_goals(w, setup);
+            ADD_FAILURE() << named << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    };
+    refused(world, {{-2, -2, 1}, {0.1, 0, 2.1}}, "goal 2 (0.1, 0, 2.1)", "in or against geometry");
+    refused(world, {{0.1, 0, 1.6}}, "goal 1 (0.1, 0, 1.6)", "inside a solid");
+    refused(world, {{0, 0, 5}}, "goal 1 (0, 0, 5)", "outside the world's flight volume");
+    refused(world, {{9, 0, 1}}, "goal 1 (9, 0, 1)", "outside the world's flight volume");
+    refused(world, {{-2, -2, 1}, {2, 2}}, "goal 2 (2, 2)", "has 2 coordinates but goal 1 has 3");
+    refused(world, {{2, 2}}, "goal 1 (2, 2)", "has no walkable floor");
+    refused(open_room(dir.path()), {{2, 2, 1}}, "goal 1 (2, 2, 1)", "has no flight volume");
+    const World divided = flight_box(dir.path(), Vec3::Zero(), Vec3::Zero(), true);
+    refused(divided, {{2.5, 0, 1.5}}, "goal 1 (2.5, 0, 1.5)", "cannot be reached");
+    setup.goals = {{-2, -2, 1}};
+    EXPECT_NO_THROW(check_goals(divided, setup));
+    // A ground model on a flying run, as a trial refuses it.
+    EXPECT_THROW(check_model(model_preset("2d"), setup), InputError);
+    EXPECT_NO_THROW(check_model(model_preset("fly-5l"), setup));
 }

@@ -26,13 +26,21 @@ public:
     virtual int choose(const Pose& pose, std::span<const char> allowed) = 0;
 };
 
+// An agent that goes where a DirectionPolicy says: on the floor (GoalSeekingWalk) or flying
+// (goal_seeking_flight.hpp). Navigation sees only this.
+class GoalSeeker : public Agent {
+public:
+    virtual const Pose& pose() const = 0;
+    virtual double travelled() const = 0;  // m
+};
+
 struct GoalSeekingParams {
     int n_dir = 8;           // directions 2πd/n_dir
     double step = 0.25;      // m per decision
     double clearance = 1.0;  // m of free travel a direction needs to be offered
 };
 
-class GoalSeekingWalk : public Agent {
+class GoalSeekingWalk : public GoalSeeker {
 public:
     // `robot` gives the body, the speed and the turn rate.
     GoalSeekingWalk(std::shared_ptr<const BodyCollider> body, const RobotParams& robot, const GoalSeekingParams& params,
@@ -40,8 +48,8 @@ public:
 
     std::optional<ModelStep> next(double t_end) override;
     double time() const override { return t_; }
-    const Pose& pose() const { return pose_; }
-    double travelled() const { return travelled_; }  // m
+    const Pose& pose() const override { return pose_; }
+    double travelled() const override { return travelled_; }  // m
     // The directions offered at p (see above).
     std::vector<char> allowed(const Vec2& p) const;
     std::string save_state() const override;

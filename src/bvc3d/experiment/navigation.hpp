@@ -1,8 +1,13 @@
 #pragma once
 // Experiment stage: navigation to goals (SPEC §17, docs/navigation.md), the closed loop from place cells to
-// motion. Takes: a world, a model (its sensor, BVC layer and place cells), goals on the floor and a seed.
-// Gives: per goal, its reward cell; per start, whether and how the agent reached the goal, against the
-// shortest path (agent/shortest_path.hpp).
+// motion. Takes: a world, a model (its sensor, BVC layer and place cells), goals on the floor (x, y) or in the
+// air (x, y, z: the flying agent) and a seed. Gives: per goal, its reward cell; per start, whether and how the
+// agent reached the goal, against the shortest path (agent/shortest_path.hpp; in 3-D agent/voxel_path.hpp).
+//
+// Where the agent moves is a NavigationSpace (navigation.cpp), picked by the goals' dimension: on the floor (the
+// paper's robot, its random walk, 8 HD cells of the heading, the floor's grid) or flying (SPEC §12's body and walk,
+// the 20 flying HD cells of the direction of motion, 0.5 m voxels for coverage, voxels for the shortest path; see
+// docs/navigation.md#flying-to-goals-in-3-d). The loop below sees only the space.
 //
 // Learning: the paper's random walk (agent/random_walk.hpp) while the place cells learn (Oja) and the
 // HD-conditioned adjacency learns (population/hd_adjacency.hpp), until `coverage` of the free cells of
@@ -22,8 +27,10 @@
 // reports the first scale's reward cells and reward map.
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
+#include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/core/params.hpp"
@@ -57,12 +64,25 @@ struct NavigationParams {
     void validate() const { table().check(*this); }
 };
 
+// A goal: on the floor (x, y; dims 2) or in the air (x, y, z; dims 3: the flying agent). All goals of a run have
+// the same dimension.
+struct NavigationGoal {
+    Vec3 p = Vec3::Zero();
+    int dims = 2;
+    NavigationGoal() = default;
+    NavigationGoal(double x, double y) : p(x, y, 0.0), dims(2) {}
+    NavigationGoal(double x, double y, double z) : p(x, y, z), dims(3) {}
+    double x() const { return p.x(); }
+    double y() const { return p.y(); }
+    double z() const { return p.z(); }
+};
+
 struct NavigationStart {
     int goal = 0;  // index into the goals
-    Vec2 start{0, 0};
+    Vec3 start{0, 0, 0};
     bool success = false;
     double path_m = 0, shortest_m = 0, time_s = 0;
-    std::vector<Vec2> path;  // positions after each move, from the start
+    std::vector<Vec3> path;  // positions after each move, from the start (z = 0 on the floor)
 };
 
 struct NavigationRun {
@@ -72,8 +92,9 @@ struct NavigationRun {
     std::vector<int> goal_cells;               // per goal, -1 if never visited (the first scale's)
     std::vector<std::vector<double>> rewards;  // per goal, the reward cell's weights after replay (the first scale's)
     std::vector<NavigationStart> starts;
-    std::vector<Vec2> learn_path;  // positions of the learning walk (every 8th step)
-    // Per goal, the reward read-out r at points of a grid over the free floor, the place cells settled there.
+    std::vector<Vec3> learn_path;  // positions of the learning walk (every 8th step)
+    // Per goal, the reward read-out r at points of a grid over the free floor, the place cells settled there (none
+    // for a flying run).
     struct MapPoint {
         Vec2 p;
         double reward;
@@ -83,16 +104,27 @@ struct NavigationRun {
 
 struct NavigationSetup {
     ModelSpec model;
-    std::vector<Vec2> goals;
+    std::vector<NavigationGoal> goals;
     NavigationParams nav;
-    AdjacencyParams adjacency;
+    AdjacencyParams adjacency;  // a flying run has the 20 flying HD cells (n_hd is the floor's)
     RewardParams reward;
-    RobotParams robot;
+    RobotParams robot;    // the agent on the floor
+    FlightParams flight;  // the flying agent
+    int dims() const { return goals.empty() ? 2 : goals.front().dims; }
 };
 
-// InputError naming each goal outside the walkable floor, where the body does not fit, or that cannot be
-// reached from the others' part of the floor; and for no goals.
+// "goal 2 (1, 2)" or "goal 2 (1, 2, 3)": how messages name goal i.
+std::string goal_text(std::size_t i, const NavigationGoal& g);
+
+// InputError naming each goal outside the walkable floor (in 3-D: the flight volume), where the body does not fit,
+// or that cannot be reached from the part of the floor (the flight volume) the learning walk roams; a goal whose
+// dimension differs from the first's, or that the world has no room for (x, y in a flight-only world, x, y, z in
+// a world without a flight volume); and for no goals.
 void check_goals(const World& world, const NavigationSetup& setup);
+
+// InputError if `model` is a preset for the other way of moving (a ground model with goals in 3-D, a flying one on
+// the floor), as a trial refuses it.
+void check_model(const ModelSpec& model, const NavigationSetup& setup);
 
 // ParamError naming reward.scale_lambdas if the model has more scales of place cells than λs are given for.
 void check_scales(const ModelSpec& model, const RewardParams& reward);
