@@ -201,6 +201,11 @@ TEST(RewardCells, ReplayValueFallsAlongTheChainAndTheChoiceHeadsToTheGoal) {
     auto closed = std::vector<char>(8, 1);
     closed[0] = 0;  // east blocked: never chosen
     EXPECT_EQ(softmax(returns, p.beta, closed)[0], 0.0);
+    // Only the offered directions rolled out: their returns bit for bit, 0 for the others.
+    const SparseAdjacency copy(adj);
+    const auto offered = direction_returns(copy, w, v, p, closed);
+    for (int k = 0; k < 8; ++k) EXPECT_EQ(offered[std::size_t(k)], k == 0 ? 0.0 : returns[std::size_t(k)]) << k;
+    EXPECT_THROW(direction_returns(copy, w, v, p, std::vector<char>(3, 1)), InputError);
     // The goal at the chain's start: west wins.
     v.assign(n, 0.0);
     v[9] = 1.0;

@@ -396,7 +396,7 @@ public:
         std::vector<std::vector<double>> returns;
         for (std::size_t s = 0; s < scales_.size(); ++s)
             returns.push_back(direction_returns(scales_[s].adjacency, scales_[s].rewards[goal_], senses_.rates()[s],
-                                                scales_[s].reward));
+                                                scales_[s].reward, allowed));
         const auto prob = combine_scales(returns, {allowed.begin(), allowed.end()}, p_, scores_);
         const double u = rng_.uniform();
         double sum = 0;

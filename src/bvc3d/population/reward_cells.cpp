@@ -79,10 +79,14 @@ std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const do
 }
 
 std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<const double> w, std::span<const double> v,
-                                      const RewardParams& p) {
+                                      const RewardParams& p, std::span<const char> offered) {
     const auto n = std::size_t(adj.n_place());
+    if (!offered.empty() && offered.size() != std::size_t(adj.n_hd()))
+        throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " +
+                         std::to_string(adj.n_hd()) + " directions");
     std::vector<double> out(std::size_t(adj.n_hd()), 0.0), x(n), y(n);
     for (int k = 0; k < adj.n_hd(); ++k) {
+        if (!offered.empty() && !offered[std::size_t(k)]) continue;
         x.assign(v.begin(), v.end());
         double g = 1.0;
         for (int t = 0; t < p.rollout_steps; ++t) {

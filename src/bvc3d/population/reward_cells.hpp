@@ -54,9 +54,10 @@ std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const Rewa
 std::vector<double> replay(const HdAdjacency& adj, int goal_cell, const RewardParams& params = {});
 // r(v) = w·v / max(|v|₁, 10⁻⁴).
 double reward(std::span<const double> w, std::span<const double> v);
-// R_k for each HD direction k.
+// R_k for each HD direction k; with `offered` (one flag per direction), 0 without a rollout where the flag is 0
+// (a direction the choice does not offer: the softmaxes and the scales' scores read only the offered ones).
 std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<const double> w, std::span<const double> v,
-                                      const RewardParams& params = {});
+                                      const RewardParams& params = {}, std::span<const char> offered = {});
 std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const double> w, std::span<const double> v,
                                       const RewardParams& params = {});
 // softmax(β·values) over the entries where `allowed` (others 0; all 0 if none is allowed).
