@@ -3,6 +3,7 @@ and on a Gazebo building's floor.
 
     /usr/bin/python3 docs/building-scale/make.py --recording PATH/hall-lidar [--work DIR] [--steps rates growing ...]
     /usr/bin/python3 docs/building-scale/make.py --house PATH/aws-robomaker-small-house-world --steps floor
+    /usr/bin/python3 docs/building-scale/make.py --steps arenas
 
 Reuses the setup of docs/real-data.md's place-cell step (docs/real-data/make.py: the hall's map in the floor's
 frame, the 0.5 m template grid, the real scans as queries, the paper's random walk of a person-sized body) and its
@@ -20,6 +21,8 @@ the two scripts share them). Steps (default: rates growing; in this order):
   floor    trials of eight models (FLOOR_MODELS) × FLOOR_SEEDS seeds on the floor of the AWS RoboMaker small house
            (--house: the world's folder as AWS publishes it), run by `bvc3d sweep` in --work/gazebo-floor (a rerun
            skips the trials already there); every analysed population of every trial → floor.csv, floor.png
+  arenas   the paper's experiment (`bvc3d paper`, the tilted cross arenas, 4 h + 4 h) of 2d, 3d-3l, ms-2d and ms-3d
+           × ARENA_SEEDS seeds in --work/arenas (resumable); every place-cell population → arenas.csv, arenas.png
 
 A hall model is one line of MODELS, a floor model one of FLOOR_MODELS. Sized for a shared 2-core machine: see
 docs/building-scale.md for what was run.
@@ -314,7 +317,7 @@ def floor_sweep(house, work):
     return trials
 
 
-def population_rows(path, metric_names):
+def population_rows(path, metric_names, modality_counts=MODALITY_COUNTS):
     """One row per analysed population of a trial file: the model's own place cells (`place`, the file's main
     metrics) and every /populations/NAME with metrics, with its number of cells (for `place-fused`, the sum of the
     place-cell scales it concatenates), for a growing network how many it recruited, and its modality recomputed
@@ -325,6 +328,7 @@ def population_rows(path, metric_names):
     rows = []
     with h5py.File(path, "r") as f:
         model, seed = str(f.attrs["model"]), int(f.attrs["seed"])
+        tilt = float(f.attrs["tilt_deg"]) if "tilt_deg" in f.attrs else float("nan")
         groups = {"place": (f["metrics"], f["samples/rates"].shape[1], None)}
         for name, group in f.get("populations", {}).items():
             if "metrics" not in group:
@@ -338,12 +342,12 @@ def population_rows(path, metric_names):
                                                                                      n.startswith("place-")))
             modality = metrics["modality"][:]
             area = metrics["field_area"][:][modality > 0]
-            row = {"model": model, "seed": seed, "population": name, "cells": cells,
+            row = {"model": model, "seed": seed, "tilt_deg": tilt, "population": name, "cells": cells,
                    "recruited": "" if recruited is None else recruited,
                    "field_area_median_m2": float(np.median(area)) if len(area) else float("nan")}
             row.update({k: float(metrics.attrs[k]) for k in metric_names if k in metrics.attrs})
             centers, maps = metrics["bin_centers"][:], metrics["rate_maps"][:]
-            for count in MODALITY_COUNTS:
+            for count in modality_counts:
                 mi = analysis.modality(centers, maps, eps=float(metrics.attrs["eps"]), min_samples=count)
                 row.update({f"{k}_ms{count}": float(v) for k, v in analysis.modality_summary(mi).items()})
             rows.append(row)
@@ -448,6 +452,78 @@ def floor_figure(rows):
     log("wrote", HERE / "floor.png")
 
 
+ARENA_MODELS = ["2d", "3d-3l", "ms-2d", "ms-3d"]
+ARENA_TILTS = [0, 30, 45, 60]
+ARENA_SEEDS = 1  # the paper's 4 h + 4 h: 16 trials in about 20 min on the shared 2-core machine
+ARENA_SHOWN = [("2d", "place", "2d"), ("3d-3l", "place", "3d-3l"), ("ms-2d", "place-fused", "ms-2d, fused"),
+               ("ms-2d", "place-l", "ms-2d, large scale"), ("ms-3d", "place-fused", "ms-3d, fused"),
+               ("ms-3d", "place-l", "ms-3d, large scale")]  # the figure's lines
+ARENA_TABLE_ROWS = [("2d", "place", "2d"), ("3d-3l", "place", "3d-3l")] + [
+    (m, p, f"{m}, {label}") for m in ("ms-2d", "ms-3d") for p, label in
+    (("place-fused", "fused"), ("place", "small scale"), ("place-m", "medium scale"), ("place-l", "large scale"))]
+ARENA_COLORS = {"2d": "C0", "3d-3l": "C1", "ms-2d": "C2", "ms-3d": "C3"}
+ARENA_METRICS = [("decode_median_all_m", "median decoding error (m),\nundecoded at chance"),
+                 ("frac_undecoded", "samples undecoded"), ("msai", "MSAI"), ("frac_multimodal", "multimodal fields")]
+
+
+def arena_table(rows):
+    """docs/building-scale.md's table: per model and population, each metric at 0° / 30° / 45° / 60° (seed means)."""
+    def at(mine, metric, fmt):
+        return " / ".join(fmt.format(np.mean([r[metric] for r in mine if r["tilt_deg"] == t])) for t in ARENA_TILTS)
+    lines = []
+    for model, population, label in ARENA_TABLE_ROWS:
+        mine = [r for r in rows if r["model"] == model and r["population"] == population]
+        if mine:
+            lines.append(f"| {label} | {mine[0]['cells']} | {at(mine, 'decode_median_all_m', '{:.2f}')} | "
+                         f"{at(mine, 'frac_undecoded', '{:.1%}')} | {at(mine, 'msai', '{:.4f}')} | "
+                         f"{at(mine, 'frac_multimodal', '{:.2f}')} |")
+    return "\n".join(lines)
+
+
+def arenas(_, work):
+    """The paper's experiment (`bvc3d paper`: the tilted cross arenas, 4 h + 4 h) with the multiscale models beside
+    the paper's 2d and 3d-3l; every analysed population of every trial into arenas.csv, and arenas.png."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    import bvc3d
+    out = work / "arenas"
+    cmd = [str(ROOT / "build" / "bvc3d"), "paper", "--models", ",".join(ARENA_MODELS), "--tilts",
+           ",".join(map(str, ARENA_TILTS)), "--seeds", str(ARENA_SEEDS), "--out", str(out), "--jobs", "1",
+           "--no-report"]
+    log(" ".join(cmd))
+    subprocess.run(cmd, check=True)
+    names = [m["name"] for m in bvc3d.metric_table]
+    rows = [r for path in sorted(out.glob("*.h5")) for r in population_rows(path, names, modality_counts=())
+            if r["population"].startswith("place") and r["seed"] < ARENA_SEEDS]  # a folder may hold more seeds
+    rows.sort(key=lambda r: (ARENA_MODELS.index(r["model"]), r["population"], r["tilt_deg"], r["seed"]))
+    fields = ["model", "tilt_deg", "seed", "population", "cells", "field_area_median_m2"] + [
+        k for k in names if any(k in r for r in rows)]
+    with open(HERE / "arenas.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: f"{v:.6g}" if isinstance(v, float) else v for k, v in row.items()})
+    log("wrote", HERE / "arenas.csv", f"({len(rows)} rows)")
+    print(arena_table(rows))
+    fig, axes = plt.subplots(1, len(ARENA_METRICS), figsize=(4.2 * len(ARENA_METRICS), 3.8))
+    for model, population, label in ARENA_SHOWN:
+        mine = [r for r in rows if r["model"] == model and r["population"] == population]
+        for ax, (metric, title) in zip(axes, ARENA_METRICS):
+            means = [np.mean([r[metric] for r in mine if r["tilt_deg"] == t]) for t in ARENA_TILTS]
+            style = {"place-fused": "-o", "place-l": ":^"}.get(population, "--s")
+            ax.plot(ARENA_TILTS, means, style, color=ARENA_COLORS[model], label=label)
+            ax.set_title(title, fontsize=10)
+            ax.set_xlabel("wall tilt (°)")
+            ax.set_xticks(ARENA_TILTS)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"The paper's arenas, 4 h + 4 h, mean of {ARENA_SEEDS} seed(s)")
+    fig.tight_layout()
+    fig.savefig(HERE / "arenas.png", dpi=90)
+    log("wrote", HERE / "arenas.png")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--recording", type=pathlib.Path, help="the hall-lidar folder (steps rates, growing)")
@@ -459,17 +535,17 @@ def main():
     args.work.mkdir(parents=True, exist_ok=True)
     sys.path.insert(0, str(ROOT / "build" / "python"))
     steps = {"rates": (prepare, "recording"), "growing": (growing, "recording"),
-             "multiscale": (multiscale, "recording"), "floor": (floor, "house")}
+             "multiscale": (multiscale, "recording"), "floor": (floor, "house"), "arenas": (arenas, None)}
     for step in args.steps:
         if step not in steps:
             sys.exit(f"unknown step '{step}' (known: {', '.join(steps)})")
         run, data = steps[step]
-        if getattr(args, data) is None:
+        if data and getattr(args, data) is None:
             sys.exit(f"step {step} needs --{data}")
     for step in args.steps:
         run, data = steps[step]
         log("step", step)
-        run(getattr(args, data).resolve(), args.work.resolve())
+        run(getattr(args, data).resolve() if data else None, args.work.resolve())
 
 
 if __name__ == "__main__":
