@@ -25,11 +25,7 @@ FlyingGoalSeeker::FlyingGoalSeeker(std::shared_ptr<const SphereCollider> body, c
 std::vector<char> FlyingGoalSeeker::allowed(const Vec3& p) const {
     std::vector<double> free(p_.directions.size());
     for (std::size_t d = 0; d < free.size(); ++d) free[d] = body_->free_distance(p, p_.directions[d], p_.clearance);
-    const double most = *std::max_element(free.begin(), free.end());
-    const double need = std::min(p_.clearance, most);
-    std::vector<char> ok(free.size());
-    for (std::size_t d = 0; d < free.size(); ++d) ok[d] = most > 0 && free[d] >= need;
-    return ok;
+    return offered_directions(free, p_.clearance);
 }
 
 std::optional<ModelStep> FlyingGoalSeeker::next(double t_end) {

@@ -15,17 +15,21 @@ GoalSeekingWalk::GoalSeekingWalk(std::shared_ptr<const BodyCollider> body, const
     if (p_.n_dir < 1 || !(p_.step > 0)) throw InputError("navigation: need at least one direction and a step > 0");
 }
 
+std::vector<char> offered_directions(std::span<const double> free, double clearance) {
+    const double most = *std::max_element(free.begin(), free.end());
+    const double need = std::min(clearance, most);
+    std::vector<char> ok(free.size());
+    for (std::size_t d = 0; d < free.size(); ++d) ok[d] = most > 0 && free[d] >= need;
+    return ok;
+}
+
 std::vector<char> GoalSeekingWalk::allowed(const Vec2& p) const {
     std::vector<double> free(std::size_t(p_.n_dir));
     for (int d = 0; d < p_.n_dir; ++d) {
         const double a = 2 * pi * d / p_.n_dir;
         free[std::size_t(d)] = body_->free_distance(p, Vec2(std::cos(a), std::sin(a)), p_.clearance);
     }
-    const double most = *std::max_element(free.begin(), free.end());
-    const double need = std::min(p_.clearance, most);
-    std::vector<char> ok(free.size());
-    for (std::size_t d = 0; d < free.size(); ++d) ok[d] = most > 0 && free[d] >= need;
-    return ok;
+    return offered_directions(free, p_.clearance);
 }
 
 std::optional<ModelStep> GoalSeekingWalk::next(double t_end) {

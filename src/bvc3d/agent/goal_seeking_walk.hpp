@@ -34,6 +34,10 @@ public:
     virtual double travelled() const = 0;  // m
 };
 
+// The directions offered, given each direction's free travel (m): those with at least `clearance`, or, where
+// none has it, those going as far as the farthest; none when every direction is blocked.
+std::vector<char> offered_directions(std::span<const double> free, double clearance);
+
 struct GoalSeekingParams {
     int n_dir = 8;           // directions 2πd/n_dir
     double step = 0.25;      // m per decision
