@@ -328,7 +328,6 @@ def population_rows(path, metric_names, modality_counts=MODALITY_COUNTS):
     rows = []
     with h5py.File(path, "r") as f:
         model, seed = str(f.attrs["model"]), int(f.attrs["seed"])
-        tilt = float(f.attrs["tilt_deg"]) if "tilt_deg" in f.attrs else float("nan")
         groups = {"place": (f["metrics"], f["samples/rates"].shape[1], None)}
         for name, group in f.get("populations", {}).items():
             if "metrics" not in group:
@@ -342,7 +341,7 @@ def population_rows(path, metric_names, modality_counts=MODALITY_COUNTS):
                                                                                      n.startswith("place-")))
             modality = metrics["modality"][:]
             area = metrics["field_area"][:][modality > 0]
-            row = {"model": model, "seed": seed, "tilt_deg": tilt, "population": name, "cells": cells,
+            row = {"model": model, "seed": seed, "population": name, "cells": cells,
                    "recruited": "" if recruited is None else recruited,
                    "field_area_median_m2": float(np.median(area)) if len(area) else float("nan")}
             row.update({k: float(metrics.attrs[k]) for k in metric_names if k in metrics.attrs})
@@ -495,8 +494,13 @@ def arenas(_, work):
     log(" ".join(cmd))
     subprocess.run(cmd, check=True)
     names = [m["name"] for m in bvc3d.metric_table]
-    rows = [r for path in sorted(out.glob("*.h5")) for r in population_rows(path, names, modality_counts=())
-            if r["population"].startswith("place") and r["seed"] < ARENA_SEEDS]  # a folder may hold more seeds
+    import h5py
+    rows = []
+    for path in sorted(out.glob("*.h5")):
+        with h5py.File(path, "r") as f:
+            tilt = float(f.attrs["tilt_deg"])
+        rows += [dict(r, tilt_deg=tilt) for r in population_rows(path, names, modality_counts=())
+                 if r["population"].startswith("place") and r["seed"] < ARENA_SEEDS]  # a folder may hold more seeds
     rows.sort(key=lambda r: (ARENA_MODELS.index(r["model"]), r["population"], r["tilt_deg"], r["seed"]))
     fields = ["model", "tilt_deg", "seed", "population", "cells", "field_area_median_m2"] + [
         k for k in names if any(k in r for r in rows)]
