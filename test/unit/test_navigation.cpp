@@ -19,6 +19,7 @@
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/navigation.hpp"
+#include "bvc3d/population/adjacency_kernels.hpp"
 #include "bvc3d/population/reward_cells.hpp"
 
 using namespace bvc3d;
@@ -162,6 +163,42 @@ TEST(HdAdjacency, SparseCopyIsExactAtPruneZeroAndDropsOnlySmallWeights) {
                 EXPECT_NEAR(b[std::size_t(i)], kept, 1e-6 * top) << "k " << k << " i " << i;
             }
         }
+    }
+}
+
+// A pruned copy's products with a dense state (kernels::row_sums16): entry o of a row goes to lane o mod 16, each lane
+// sums in order, lanes l and l + 8 are added, then the eight in pairs — restated here lane by lane, and the bits must
+// match on whatever instruction set runs the test (scripts/check-dispatch compares the baseline build's navigation).
+// Rows of every length 0–70 (whole blocks of 16 and every tail), against long double sums too.
+TEST(HdAdjacency, PrunedRowSumsAddSixteenLanesInAFixedOrder) {
+    std::mt19937 gen(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const int n = 300, rows = 71;
+    std::vector<std::uint32_t> start{0};
+    std::vector<std::uint16_t> col;
+    std::vector<float> w;
+    for (int i = 0; i < rows; ++i) {
+        const std::size_t end = col.size() + std::size_t(i);  // row i has i entries, at ascending columns
+        for (int j = 0; j < n && col.size() < end; j += 1 + int(gen() % 7))
+            col.push_back(std::uint16_t(j)), w.push_back(float(u(gen)));
+        start.push_back(std::uint32_t(col.size()));
+    }
+    std::vector<double> x(n), out(rows);
+    for (double& v : x) v = u(gen);
+    const double scale = 0.37;
+    kernels::row_sums16(start.data(), col.data(), w.data(), rows, x.data(), scale, out.data());
+    for (int i = 0; i < rows; ++i) {
+        double lane[16] = {};
+        long double exact = 0;
+        for (std::uint32_t e = start[std::size_t(i)]; e < start[std::size_t(i) + 1]; ++e) {
+            lane[(e - start[std::size_t(i)]) % 16] += double(w[e]) * x[col[e]];
+            exact += static_cast<long double>(w[e]) * x[col[e]];
+        }
+        double half[8];
+        for (int l = 0; l < 8; ++l) half[l] = lane[l] + lane[l + 8];
+        const double sum = ((half[0] + half[1]) + (half[2] + half[3])) + ((half[4] + half[5]) + (half[6] + half[7]));
+        EXPECT_EQ(out[std::size_t(i)], scale * sum) << "row " << i;
+        EXPECT_NEAR(out[std::size_t(i)], double(scale * exact), 1e-14) << "row " << i;
     }
 }
 

@@ -7,7 +7,7 @@
 #include "bvc3d/bvc/return_check.hpp"
 #include "bvc3d/bvc/truncation_bound.hpp"
 #include "bvc3d/core/angles.hpp"
-#include "bvc3d/core/vector_exp.hpp"
+#include "bvc3d/core/vector_math.hpp"
 
 namespace bvc3d {
 

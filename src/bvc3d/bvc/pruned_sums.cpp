@@ -5,7 +5,7 @@
 
 #include "bvc3d/bvc/return_check.hpp"
 #include "bvc3d/core/angles.hpp"
-#include "bvc3d/core/vector_exp.hpp"
+#include "bvc3d/core/vector_math.hpp"
 
 namespace bvc3d {
 

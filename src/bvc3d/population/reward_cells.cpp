@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/vector_math.hpp"
 
 namespace bvc3d {
 
@@ -62,7 +63,8 @@ std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const Rewa
             adj.apply(k, x, y);
             for (std::size_t i = 0; i < n; ++i) best[i] = std::max(best[i], y[i]);
         }
-        for (std::size_t i = 0; i < n; ++i) x[i] = std::tanh(std::max(best[i] + x[i], 0.0));
+        for (std::size_t i = 0; i < n; ++i) x[i] = std::max(best[i] + x[i], 0.0);
+        vector_tanh(x.data(), x.data(), n);
     }
     return w;
 }
@@ -91,7 +93,8 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
         double g = 1.0;
         for (int t = 0; t < p.rollout_steps; ++t) {
             adj.apply(k, x, y);
-            for (std::size_t i = 0; i < n; ++i) x[i] = std::tanh(std::max(y[i] - x[i], 0.0));
+            for (std::size_t i = 0; i < n; ++i) x[i] = std::max(y[i] - x[i], 0.0);
+            vector_tanh(x.data(), x.data(), n);
             out[std::size_t(k)] += g * reward(w, x);
             g *= p.discount;
         }
