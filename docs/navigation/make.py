@@ -3,7 +3,9 @@ docs/navigation/starts.csv and the per-goal summaries into docs/navigation/summa
 docs/navigation/results.png (success rate and path ratio per world and model).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/make.py [--seeds N] [--starts N]
-[--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P] [--prefix P]. Each run's own
+[--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P] [--prefix P]
+[--house DIR]. The world `floor` is the AWS RoboMaker small house's floor (Gazebo), read from the folder given by
+--house (holding worlds/ and models/ as AWS publishes it); the other worlds are in configs/worlds/. Each run's own
 folder (paths, reward maps, figures, and runs/ with each finished learning run: a run again with the same options
 skips those) is kept in build/navigation/PREFIXWORLD-MODEL/; the learning runs' times go to PREFIXlearning.csv.
 """
@@ -22,10 +24,21 @@ import numpy as np  # noqa: E402
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HERE = ROOT / "docs" / "navigation"
 GOALS = {"nav-open": "7,7;-7,7;-7,-7;7,-7", "nav-cross": "7,7;-7,7;-7,-7;7,-7", "nav-maze": "7,7;-7,7;-7,-7;7,-7",
-         "nav-wall": "-2,2", "cross-0": "3.5,3.5;-3.5,-3.5", "cross-60": "3.5,3.5;-3.5,-3.5"}
+         "nav-wall": "-2,2", "cross-0": "3.5,3.5;-3.5,-3.5", "cross-60": "3.5,3.5;-3.5,-3.5",
+         "floor": "5,2;-5,-2"}
+HOUSE_WORLD = "worlds/small_house.world"  # in the folder given by --house
 
 
-def world_arg(name):
+def world_arg(name, house, folder):
+    """The world's file: configs/worlds/NAME.yaml, or for `floor` a world YAML written into folder pointing at the
+    small house (its furniture models are in the house's models/ folder; skip those it does not ship)."""
+    if name == "floor":
+        if house is None or not (house / HOUSE_WORLD).is_file():
+            sys.exit(f"world floor needs --house: the small house's folder holding {HOUSE_WORLD}")
+        file = folder / "floor.yaml"
+        file.write_text(f"sdf: {(house / HOUSE_WORLD).resolve()}\nmodel_path: [{(house / 'models').resolve()}]\n"
+                        "missing_models: skip\n")
+        return str(file)
     file = ROOT / "configs" / "worlds" / f"{name}.yaml"
     return str(file) if file.exists() else name
 
@@ -40,6 +53,7 @@ def main():
     ap.add_argument("--prefix", default="", help="prefix of the files written (a partial run beside the main one)")
     ap.add_argument("--prune", type=float, default=0.0, help="adjacency.prune (0.01 for the multiscale sizes)")
     ap.add_argument("--bvc3d", default=str(ROOT / "build" / "bvc3d"), help="the program to run")
+    ap.add_argument("--house", type=pathlib.Path, help="the small house's folder (world floor)")
     a = ap.parse_args()
     rows, summary, learning = [], [], []
     for world in a.worlds.split(","):
@@ -49,7 +63,8 @@ def main():
             # A YAML file: the options of the command line and the adjacency's pruning, which has no option.
             config = out.parent / f"{a.prefix}{world}-{model}.yaml"
             goals = [[float(c) for c in g.split(",")] for g in GOALS[world].split(";")]
-            config.write_text(f"world: {world_arg(world)}\ngoals: {goals}\nmodels: [{model}]\nseeds: {a.seeds}\n"
+            config.write_text(f"world: {world_arg(world, a.house, out.parent)}\ngoals: {goals}\nmodels: [{model}]\n"
+                              f"seeds: {a.seeds}\n"
                               f"navigation: {{starts: {a.starts}, max_learn_hours: {a.learn_hours}}}\n"
                               f"adjacency: {{prune: {a.prune}}}\n")
             cmd = [a.bvc3d, "navigate", "--config", str(config), "--out", str(out)]
