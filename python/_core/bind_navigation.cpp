@@ -38,7 +38,11 @@ void apply_navigation(NavigationSetup& s, const pyb::kwargs& kwargs) {
     pyb::kwargs a, b, c;
     for (const auto& [k, v] : kwargs) {
         const std::string key = pyb::str(k);
-        if (RewardParams::table().find(key)) b[k] = v;
+        if (key == "flight") {  // the flying agent's parameters, as a YAML file's `flight:` section
+            if (!pyb::isinstance<pyb::dict>(v))
+                throw InputError("flight must be a dict of the flying agent's parameters");
+            apply_kwargs(s.flight, FlightParams::table(), pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v)));
+        } else if (RewardParams::table().find(key)) b[k] = v;
         else if (AdjacencyParams::table().find(key) && !NavigationParams::table().find(key)) c[k] = v;
         else a[k] = v;
     }
@@ -217,8 +221,9 @@ HdAdjacency(n_place, **params); params and their defaults:
          "(N, 3) for the flying agent (docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per "
          "start (goal, goal_x, goal_y, start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, "
          "time_s, paths of (M, 2) or (M, 3)), and learn_s, coverage, visits, goal_cells. Keywords (navigation, reward "
-         "and adjacency parameters):\n" +
-         describe(NavigationParams::table(), NavigationParams{}) + describe(RewardParams::table(), RewardParams{}))
+         "and adjacency parameters; flight=dict of the flying agent's, below them):\n" +
+         describe(NavigationParams::table(), NavigationParams{}) + describe(RewardParams::table(), RewardParams{}) +
+         "flight:\n" + describe(FlightParams::table(), FlightParams{}))
             .c_str());
 }
 

@@ -256,6 +256,15 @@ def test_navigate_flies_to_goals_in_3d_seeded_with_3d_paths():
         bvc3d.navigate(world, [[0.0, 0.0, 9.0]], model="fly-5l")
     with pytest.raises(ValueError, match="fly-5l"):
         bvc3d.navigate(bvc3d.World.cross(), [[3.5, 3.5]], model="fly-5l")
+    # The flying agent's parameters as YAML's `flight:` section: a start's time is its path at the flight's speed plus
+    # its turns, and the learning walk (0.288 s a step) ends at another time when the speed changes.
+    assert np.all(a["time_s"] >= a["path_m"] - 1e-9)
+    fast = bvc3d.navigate(world, [goal], model="fly-5l", seed=2, flight={"speed": 2.0}, **kw)
+    assert np.all(fast["time_s"] >= fast["path_m"] / 2 - 1e-9) and fast["learn_s"] != a["learn_s"]
+    with pytest.raises(ValueError, match="unknown argument 'sped'"):
+        bvc3d.navigate(world, [goal], model="fly-5l", flight={"sped": 2.0})
+    with pytest.raises(ValueError, match="flight must be a dict"):
+        bvc3d.navigate(world, [goal], model="fly-5l", flight=2.0)
 
 
 def test_navigate_in_3d_writes_z_and_resumes_its_runs_to_the_same_bytes(tmp_path):
