@@ -63,8 +63,7 @@ std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const Rewa
             adj.apply(k, x, y);
             for (std::size_t i = 0; i < n; ++i) best[i] = std::max(best[i], y[i]);
         }
-        for (std::size_t i = 0; i < n; ++i) x[i] = std::max(best[i] + x[i], 0.0);
-        vector_tanh(x.data(), x.data(), n);
+        for (std::size_t i = 0; i < n; ++i) x[i] = std::tanh(std::max(best[i] + x[i], 0.0));
     }
     return w;
 }

@@ -11,7 +11,9 @@
 //       x_{t+1} = tanh([W_rec[k]·x_t − x_t]+),   R_k = Σ_{t=0}^{T−1} γ^t r(x_{t+1})
 // with λ = 20 and A = 5/λ (the authors' smallest scale), T = 3, γ = 0.7. The authors sample 10 rollouts
 // per direction; the rollout here is deterministic, so one is all 10 would be (docs/navigation.md).
-// tanh is SLEEF's (core/vector_math.hpp: within 1 ulp, the same bits on every instruction set), many cells at a time.
+// The rollouts' tanh is SLEEF's (core/vector_math.hpp: within 3.5 ulp, the same bits on every instruction set), many
+// cells at a time; replay (once per goal) keeps libm's: its ⌈8λ⌉ steps of a recurrent map amplify last-place
+// differences (to ~10⁻⁵ on a chain of cells), and its weights stay as they were.
 // Both read the adjacency's frozen sparse copy (hd_adjacency.hpp: weights below `prune` of the largest left out);
 // the forms taking an HdAdjacency make that copy first (O(n_hd·n²)): navigation makes it once per learning run.
 //
