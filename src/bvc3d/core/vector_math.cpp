@@ -32,8 +32,9 @@ struct Tail {
     double x[8] = {}, y[8] = {};
 };
 
-// SLEEF's function `name` of accuracy `u` (u10: 1.0 ulp, u35: 3.5 ulp) in each instruction set's form, as static members (a template takes these; their
-// declarations' attributes keep the functions themselves from being template arguments).
+// SLEEF's function `name` of accuracy `u` (u10: 1.0 ulp, u35: 3.5 ulp) in each instruction set's form, as static
+// members (a template takes these; their declarations' attributes keep the functions themselves from being template
+// arguments).
 #if BVC3D_HAVE_DISPATCH
 #define BVC3D_SLEEF_WIDE(name, u)                                                                       \
     BVC3D_TARGET_V4 static __m512d v4(__m512d x) { return Sleef_cinz_##name##d8_##u##avx512fnofma(x); } \
