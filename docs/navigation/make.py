@@ -4,7 +4,7 @@ docs/navigation/results.png (success rate and path ratio per world and model).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/make.py [--seeds N] [--starts N]
 [--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P] [--prefix P]
-[--house DIR]. The world `floor` is the AWS RoboMaker small house's floor (Gazebo), read from the folder given by
+[--house DIR] [--gather]. The world `floor` is the AWS RoboMaker small house's floor (Gazebo), read from the folder given by
 --house (holding worlds/ and models/ as AWS publishes it); the other worlds are in configs/worlds/. Each run's own
 folder (paths, reward maps, figures, and runs/ with each finished learning run: a run again with the same options
 skips those) is kept in build/navigation/PREFIXWORLD-MODEL/; the learning runs' times go to PREFIXlearning.csv.
@@ -43,6 +43,13 @@ def world_arg(name, house, folder):
     return str(file) if file.exists() else name
 
 
+def gather(out, world, rows, summary, learning):
+    """Adds a run's starts, per-goal summary and learning times (these with the world) to the tables."""
+    for name, table in (("starts.csv", rows), ("summary.csv", summary), ("learning.csv", learning)):
+        with open(out / name, newline="") as f:
+            table += [dict(r, world=world) if name == "learning.csv" else r for r in csv.DictReader(f)]
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=5)
@@ -54,11 +61,19 @@ def main():
     ap.add_argument("--prune", type=float, default=0.0, help="adjacency.prune (0.01 for the multiscale sizes)")
     ap.add_argument("--bvc3d", default=str(ROOT / "build" / "bvc3d"), help="the program to run")
     ap.add_argument("--house", type=pathlib.Path, help="the small house's folder (world floor)")
+    ap.add_argument("--gather", action="store_true",
+                    help="run nothing: gather the worlds and models whose runs are finished (their starts.csv)")
     a = ap.parse_args()
     rows, summary, learning = [], [], []
     for world in a.worlds.split(","):
         for model in a.models.split(","):
             out = ROOT / "build" / "navigation" / f"{a.prefix}{world}-{model}"
+            if a.gather:
+                if (out / "starts.csv").exists():
+                    gather(out, world, rows, summary, learning)
+                else:
+                    print(f"{world} {model}: not run, left out", file=sys.stderr)
+                continue
             out.mkdir(parents=True, exist_ok=True)
             # A YAML file: the options of the command line and the adjacency's pruning, which has no option.
             config = out.parent / f"{a.prefix}{world}-{model}.yaml"
@@ -70,9 +85,7 @@ def main():
             cmd = [a.bvc3d, "navigate", "--config", str(config), "--out", str(out)]
             print(" ".join(cmd), file=sys.stderr, flush=True)
             subprocess.run(cmd, check=True)
-            for name, table in (("starts.csv", rows), ("summary.csv", summary), ("learning.csv", learning)):
-                with open(out / name, newline="") as f:
-                    table += [dict(r, world=world) if name == "learning.csv" else r for r in csv.DictReader(f)]
+            gather(out, world, rows, summary, learning)
     for name, table in (("starts.csv", rows), ("summary.csv", summary), ("learning.csv", learning)):
         with open(HERE / (a.prefix + name), "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(table[0].keys()))
