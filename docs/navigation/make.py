@@ -4,8 +4,9 @@ docs/navigation/results.png (success rate and path ratio per world and model).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/make.py [--seeds N] [--starts N]
 [--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P] [--prefix P]
-[--house DIR] [--gather]. The world `floor` is the AWS RoboMaker small house's floor (Gazebo), read from the folder given by
---house (holding worlds/ and models/ as AWS publishes it); the other worlds are in configs/worlds/. Each run's own
+[--house DIR] [--gather]. The world `floor` is the AWS RoboMaker small house's floor (Gazebo), read from the
+folder given by --house (holding worlds/ and models/ as AWS publishes it); the other worlds are in configs/worlds/.
+--gather runs nothing and gathers the worlds and models already run. Each run's own
 folder (paths, reward maps, figures, and runs/ with each finished learning run: a run again with the same options
 skips those) is kept in build/navigation/PREFIXWORLD-MODEL/; the learning runs' times go to PREFIXlearning.csv.
 """
