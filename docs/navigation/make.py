@@ -92,29 +92,37 @@ def main():
             w = csv.DictWriter(f, fieldnames=list(table[0].keys()))
             w.writeheader()
             w.writerows(table)
-    # Per world and model over all goals and learning runs: success rate, path ratio of the reached starts.
     worlds = list(dict.fromkeys(r["world"] for r in rows))
     models = list(dict.fromkeys(r["model"] for r in rows))
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
+    draw_results(rows, worlds, models, HERE / (a.prefix + "results.png"))
+
+
+def draw_results(rows, worlds, models, path, title=None, log=False):
+    """Per world and model over all goals and learning runs: success rate, and the path ratio of the reached starts
+    (median, quartiles); a world without starts of a model has no bar."""
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4))
     width = 0.8 / len(models)
     for m, model in enumerate(models):
         rate, med, lo, hi = [], [], [], []
         for world in worlds:
             mine = [r for r in rows if r["world"] == world and r["model"] == model]
             ok = [float(r["path_ratio"]) for r in mine if r["success"] == "1"]
-            rate.append(100 * len(ok) / max(len(mine), 1))
+            rate.append(100 * len(ok) / len(mine) if mine else np.nan)
             q = np.percentile(ok, [25, 50, 75]) if ok else [np.nan] * 3
             lo.append(q[1] - q[0]), med.append(q[1]), hi.append(q[2] - q[1])
         x = np.arange(len(worlds)) + m * width
         ax1.bar(x, rate, width, label=model)
         ax2.bar(x, med, width, yerr=[lo, hi], label=model, capsize=3)
-    for ax, label in ((ax1, "success (%)"), (ax2, "path ratio of reached starts\n(median, quartiles)")):
+    for ax, label in ((ax1, "starts reached (%)"), (ax2, "path ratio of reached starts\n(median, quartiles)")):
         ax.set_xticks(np.arange(len(worlds)) + 0.4 - width / 2, worlds, rotation=20)
         ax.set_ylabel(label)
-        ax.legend()
+        ax.legend(fontsize=8)
+    if log:
+        ax2.set_yscale("log")
+    if title:
+        fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(HERE / (a.prefix + "results.png"), dpi=110)
-
+    fig.savefig(path, dpi=110)
 
 if __name__ == "__main__":
     main()

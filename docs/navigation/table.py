@@ -6,14 +6,13 @@ model). Run from the repository root: /usr/bin/python3 docs/navigation/table.py
 """
 import csv
 import pathlib
+import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
 
 HERE = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+import make  # noqa: E402  (make.py beside this file: its figure of success and path ratio)
 SOURCES = ["full-starts.csv", "ms2-starts.csv", "ms-starts.csv"]
 WORLDS = ["nav-open", "nav-cross", "nav-maze", "nav-wall", "cross-0", "cross-60", "floor"]
 MODELS = ["2d", "3d-3l", "ms-2d", "ms-3d"]
@@ -50,29 +49,12 @@ def main():
             if not mine:
                 continue
             rate, q, spl, per_run = stats(mine)
-            found.append((world, model, rate, q))
+            found.append(world)
             print(f"| {world} | {model} | {len(mine)} | {100 * rate:.1f} % ({round(rate * len(mine))}) | "
                   f"{q[1]:.2f} [{q[0]:.2f}, {q[2]:.2f}] | {spl:.2f} | {', '.join(map(str, per_run))} |")
-    worlds = [w for w in WORLDS if any(f[0] == w for f in found)]
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4))
-    width = 0.8 / len(MODELS)
-    for m, model in enumerate(MODELS):
-        at = {f[0]: f for f in found if f[1] == model}
-        x = np.arange(len(worlds)) + m * width
-        rate = [100 * at[w][2] if w in at else np.nan for w in worlds]
-        q = [at[w][3] if w in at else [np.nan] * 3 for w in worlds]
-        ax1.bar(x, rate, width, label=model)
-        ax2.bar(x, [v[1] for v in q], width, yerr=[[v[1] - v[0] for v in q], [v[2] - v[1] for v in q]], capsize=3,
-                label=model)
-    for ax, label in ((ax1, "starts reached (%)"), (ax2, "path ratio of reached starts\n(median, quartiles)")):
-        ax.set_xticks(np.arange(len(worlds)) + 0.4 - width / 2, worlds, rotation=20)
-        ax.set_ylabel(label)
-        ax.legend(fontsize=8)
-    ax2.set_yscale("log")
-    fig.suptitle("5 learning runs × 20 starts per goal, prune 10⁻², learning to SPEC's criteria")
-    fig.tight_layout()
-    fig.savefig(HERE / "all-worlds.png", dpi=110)
-
+    worlds = [w for w in WORLDS if w in found]
+    make.draw_results(table, worlds, MODELS, HERE / "all-worlds.png", log=True,
+                      title="5 learning runs × 20 starts per goal, prune 10⁻², learning to SPEC's criteria")
 
 if __name__ == "__main__":
     main()
