@@ -3,9 +3,10 @@ docs/navigation/starts.csv and the per-goal summaries into docs/navigation/summa
 docs/navigation/results.png (success rate and path ratio per world and model).
 
 Run from the repository root after building: /usr/bin/python3 docs/navigation/make.py [--seeds N] [--starts N]
-[--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P] [--prefix P]
-[--house DIR] [--gather]. The world `floor` is the AWS RoboMaker small house's floor (Gazebo), read from the
-folder given by --house (holding worlds/ and models/ as AWS publishes it); the other worlds are in configs/worlds/.
+[--learn-hours H] [--models 2d,3d-3l,ms-2d,ms-3d] [--worlds nav-open,...] [--prune P]
+[--rollout-weights float32|float16] [--prefix P] [--house DIR] [--gather]. The world `floor` is the AWS RoboMaker
+small house's floor (Gazebo), read from the folder given by --house (holding worlds/ and models/ as AWS publishes
+it); the other worlds are in configs/worlds/.
 --gather runs nothing and gathers the worlds and models already run. Each run's own
 folder (paths, reward maps, figures, and runs/ with each finished learning run: a run again with the same options
 skips those) is kept in build/navigation/PREFIXWORLD-MODEL/; the learning runs' times go to PREFIXlearning.csv.
@@ -60,6 +61,8 @@ def main():
     ap.add_argument("--worlds", default="nav-open,nav-cross,nav-maze,nav-wall,cross-0,cross-60")
     ap.add_argument("--prefix", default="", help="prefix of the files written (a partial run beside the main one)")
     ap.add_argument("--prune", type=float, default=0.0, help="adjacency.prune (0.01 for the multiscale sizes)")
+    ap.add_argument("--rollout-weights", choices=["float32", "float16"], default="float32",
+                    help="adjacency.rollout_weights (float16: the rollouts read 16-bit weights)")
     ap.add_argument("--bvc3d", default=str(ROOT / "build" / "bvc3d"), help="the program to run")
     ap.add_argument("--house", type=pathlib.Path, help="the small house's folder (world floor)")
     ap.add_argument("--gather", action="store_true",
@@ -76,13 +79,14 @@ def main():
                     print(f"{world} {model}: not run, left out", file=sys.stderr)
                 continue
             out.mkdir(parents=True, exist_ok=True)
-            # A YAML file: the options of the command line and the adjacency's pruning, which has no option.
+            # A YAML file: the options of the command line and the adjacency's copy (pruning, weights), which have no
+            # option.
             config = out.parent / f"{a.prefix}{world}-{model}.yaml"
             goals = [[float(c) for c in g.split(",")] for g in GOALS[world].split(";")]
             config.write_text(f"world: {world_arg(world, a.house, out.parent)}\ngoals: {goals}\nmodels: [{model}]\n"
                               f"seeds: {a.seeds}\n"
                               f"navigation: {{starts: {a.starts}, max_learn_hours: {a.learn_hours}}}\n"
-                              f"adjacency: {{prune: {a.prune}}}\n")
+                              f"adjacency: {{prune: {a.prune}, rollout_weights: {a.rollout_weights}}}\n")
             cmd = [a.bvc3d, "navigate", "--config", str(config), "--out", str(out)]
             print(" ".join(cmd), file=sys.stderr, flush=True)
             subprocess.run(cmd, check=True)

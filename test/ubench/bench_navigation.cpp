@@ -16,6 +16,7 @@
 #include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/place/place_cell_network.hpp"
+#include "bvc3d/population/packed_adjacency.hpp"
 #include "bvc3d/population/reward_cells.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
@@ -90,15 +91,19 @@ void BM_DirectionChoice(benchmark::State& state) {
 BENCHMARK(BM_DirectionChoice)->ArgsProduct({{250, 1000, 2000}, {0, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
 
 // The authors' multiscale size: three scales of 2 000 / 1 000 / 500 place cells, each scale's rollouts and the
-// scales' combination (combine_scales: softmaxes over 8 and 3 numbers), as navigation decides.
+// scales' combination (combine_scales: softmaxes over 8 and 3 numbers), as navigation decides; through the float32
+// sparse copies (Copy = SparseAdjacency) or the packed ones (PackedAdjacency: `adjacency: {rollout_weights:
+// float16}`, one pattern for the 8 directions, 16-bit weights, every direction in one pass).
+template <class Copy>
 void BM_DirectionChoiceMultiscale(benchmark::State& state) {
     std::vector<const Learned*> scales;
-    std::vector<SparseAdjacency> sparse;
-    double bytes = 0, dense = 0;
+    std::vector<Copy> copies;
+    double bytes = 0, entries = 0, dense = 0;
     for (int n : {2000, 1000, 500}) {
         scales.push_back(&learned(n));
-        sparse.emplace_back(scales.back()->adj, prune_of(state));
-        bytes += sparse.back().bytes(), dense += HdAdjacency::bytes(n, 8);
+        copies.emplace_back(scales.back()->adj, prune_of(state));
+        bytes += copies.back().bytes(), entries += double(copies.back().entries());
+        dense += HdAdjacency::bytes(n, 8);
     }
     std::vector<std::vector<double>> v;
     for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
@@ -108,14 +113,22 @@ void BM_DirectionChoiceMultiscale(benchmark::State& state) {
     std::vector<double> scores;
     for (auto _ : state) {
         for (std::size_t s = 0; s < scales.size(); ++s)
-            returns[s] = direction_returns(sparse[s], scales[s]->w, v[s], p);
+            returns[s] = direction_returns(copies[s], scales[s]->w, v[s], p);
         benchmark::DoNotOptimize(combine_scales(returns, allowed, p, scores));
     }
     state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["MB"] = bytes / 1e6;
+    state.counters["entries"] = entries;
     state.counters["dense_MB"] = dense / 1e6;
 }
-BENCHMARK(BM_DirectionChoiceMultiscale)->ArgsProduct({{3500}, {0, 2, 3, 4}, {3, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DirectionChoiceMultiscale<SparseAdjacency>)
+    ->Name("BM_DirectionChoiceMultiscale")
+    ->ArgsProduct({{3500}, {0, 2, 3, 4}, {3, 1}})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DirectionChoiceMultiscale<PackedAdjacency>)
+    ->Name("BM_DirectionChoiceMultiscaleHalf")
+    ->ArgsProduct({{3500}, {3, 4}, {3}})
+    ->Unit(benchmark::kMicrosecond);
 
 // One learning step of the adjacency (traces, the active rows and columns of 8 matrices, the decay) on the synthetic
 // walk's place rates, for the multiscale sizes: what learning adds to each model step of navigation.

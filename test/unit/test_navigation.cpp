@@ -20,6 +20,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/navigation.hpp"
 #include "bvc3d/population/adjacency_kernels.hpp"
+#include "bvc3d/population/packed_adjacency.hpp"
 #include "bvc3d/population/reward_cells.hpp"
 
 using namespace bvc3d;
@@ -204,6 +205,136 @@ TEST(HdAdjacency, PrunedRowSumsAddSixteenLanesInAFixedOrder) {
 
 namespace {
 
+// A random binary16 with its value decoded here by its definition, ±2^(E−15)·(1 + m/2¹⁰) (E = 0: ±2⁻¹⁴·m/2¹⁰).
+std::pair<std::uint16_t, double> random_half(std::mt19937& gen) {
+    const unsigned sign = gen() % 2, exponent = gen() % 17, mantissa = gen() % 1024;  // exponents up to 2¹
+    const double value =
+        exponent == 0 ? std::ldexp(double(mantissa), -24) : std::ldexp(1.0 + mantissa / 1024.0, int(exponent) - 15);
+    return {std::uint16_t(sign << 15 | exponent << 10 | mantissa), sign ? -value : value};
+}
+
+}  // namespace
+
+// The packed copy's products (kernels::half_rows, half_columns), restated: rows — entry o of a row into accumulator
+// o mod 4 (float32), (a0 + a1) + (a2 + a3), × f_k; columns — 0 minus each entry's product, rows j in order, skipping
+// rows whose state is 0 in every direction, × f_k. Bits must match on whatever instruction set runs the test (8
+// directions: AVX2 where the CPU has it; 3: one at a time), and the sums lie within float32's rounding of the exact.
+TEST(PackedAdjacency, KernelsAddInAFixedOrder) {
+    std::mt19937 gen(5);
+    std::uniform_real_distribution<float> u(-1, 1);
+    for (int K : {8, 3}) {
+        const int n = 90;
+        std::vector<std::uint32_t> start{0};
+        std::vector<std::uint16_t> col, h;
+        std::vector<double> value;
+        for (int i = 0; i < n; ++i) {
+            for (int j = 0; j < n; j += 1 + int(gen() % (1 + unsigned(i) % 9))) {
+                col.push_back(std::uint16_t(j));
+                for (int k = 0; k < K; ++k) {
+                    const auto [bits, v] = random_half(gen);
+                    h.push_back(bits), value.push_back(v);
+                }
+            }
+            start.push_back(std::uint32_t(col.size()));
+        }
+        std::vector<float> x(std::size_t(n * K)), f(static_cast<std::size_t>(K)), y(x.size()), yc(x.size());
+        for (float& v : x) v = u(gen);
+        for (int j = 0; j < n; j += 3) std::fill_n(&x[std::size_t(j * K)], K, 0.0f);  // rows the columns form skips
+        for (float& v : f) v = u(gen);
+        kernels::half_rows(start.data(), col.data(), h.data(), n, K, x.data(), f.data(), y.data());
+        kernels::half_columns(start.data(), col.data(), h.data(), n, K, x.data(), f.data(), yc.data());
+        std::vector<float> columns(x.size(), 0.0f);
+        for (int j = 0; j < n; ++j) {
+            bool zero = true;
+            for (int k = 0; k < K; ++k) zero = zero && x[std::size_t(j * K + k)] == 0.0f;
+            if (zero) continue;
+            for (std::uint32_t e = start[std::size_t(j)]; e < start[std::size_t(j) + 1]; ++e)
+                for (int k = 0; k < K; ++k)
+                    columns[std::size_t(col[e] * K + k)] -=
+                        float(value[e * std::size_t(K) + std::size_t(k)]) * x[std::size_t(j * K + k)];
+        }
+        for (int i = 0; i < n; ++i)
+            for (int k = 0; k < K; ++k) {
+                float a[4] = {};
+                long double exact = 0, size = 0;
+                for (std::uint32_t e = start[std::size_t(i)]; e < start[std::size_t(i) + 1]; ++e) {
+                    const double w = value[e * std::size_t(K) + std::size_t(k)];
+                    const float xv = x[std::size_t(col[e] * K + k)];
+                    a[(e - start[std::size_t(i)]) % 4] += float(w) * xv;
+                    exact += static_cast<long double>(w) * xv, size += std::abs(static_cast<long double>(w) * xv);
+                }
+                const auto at = std::size_t(i * K + k);
+                EXPECT_EQ(y[at], f[std::size_t(k)] * ((a[0] + a[1]) + (a[2] + a[3]))) << "K " << K << " row " << i;
+                EXPECT_NEAR(y[at], double(f[std::size_t(k)] * exact), double(1e-6L * size))
+                    << "K " << K << " row " << i;
+                EXPECT_EQ(yc[at], f[std::size_t(k)] * columns[at]) << "K " << K << " column " << i;
+            }
+    }
+}
+
+// The packed copy keeps an entry where any direction keeps it (|w| > prune·max|W_rec[k]|, counted here), holds each
+// direction's kept weights within 2⁻¹¹ of themselves (0 where that direction leaves the entry out), and its products
+// — by columns with few active cells, by rows with many — lie within that of the kept weights' products. 8
+// directions (AVX2 where the CPU has it) and 3.
+TEST(PackedAdjacency, KeepsTheUnionOfThePatternsAndEachWeightToSixteenBits) {
+    const int n = 40;
+    std::mt19937 gen(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int n_hd : {8, 3}) {
+        AdjacencyParams params;
+        params.n_hd = n_hd;
+        HdAdjacency adj(n, params);
+        for (int t = 0; t < 300; ++t) {
+            std::vector<double> v(n, 0.0);
+            for (int c = 0; c < 3; ++c) v[std::size_t((t / 4 + c * 7) % n)] = u(gen);
+            adj.learn(v, hd_rates(6.3 * u(gen), n_hd), t % 11 == 0);
+        }
+        const double prune = 0.05;
+        const PackedAdjacency packed(adj, prune);
+        std::vector<double> top(std::size_t(n_hd), 0.0);
+        for (int k = 0; k < n_hd; ++k)
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j)
+                    top[std::size_t(k)] = std::max(top[std::size_t(k)], std::abs(adj.weight(k, i, j)));
+        const auto kept = [&](int k, int i, int j) {
+            return std::abs(adj.weight(k, i, j)) > prune * top[std::size_t(k)] * (1 + 1e-6);
+        };
+        std::size_t one_most = 0, all = 0;
+        for (int k = 0; k < n_hd; ++k) {
+            std::size_t count = 0;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) count += kept(k, i, j);
+            one_most = std::max(one_most, count);
+        }
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                bool any = false;
+                for (int k = 0; k < n_hd; ++k) any = any || kept(k, i, j);
+                all += any;
+            }
+        EXPECT_EQ(packed.entries(), all) << n_hd;
+        EXPECT_GT(packed.entries(), one_most) << n_hd;
+        for (int active : {3, 30}) {
+            std::vector<float> x(std::size_t(n * n_hd), 0.0f), y(x.size());
+            for (int c = 0; c < active; ++c)
+                for (int k = 0; k < n_hd; ++k) x[std::size_t(((c * 13) % n) * n_hd + k)] = float(u(gen));
+            packed.apply(x, y);
+            for (int k = 0; k < n_hd; ++k)
+                for (int i = 0; i < n; ++i) {
+                    double sum = 0, size = 0;
+                    for (int j = 0; j < n; ++j) {
+                        const double xj = x[std::size_t(j * n_hd + k)];
+                        if (kept(k, i, j)) sum += adj.weight(k, i, j) * xj, size += std::abs(adj.weight(k, i, j) * xj);
+                    }
+                    EXPECT_NEAR(y[std::size_t(i * n_hd + k)], sum, std::ldexp(size, -11) + 1e-6 * top[std::size_t(k)])
+                        << "n_hd " << n_hd << " active " << active << " k " << k << " i " << i;
+                }
+        }
+    }
+}
+
+namespace {
+
 // A chain of n cells along x: heading east (HD 0) cell i+1 follows cell i, heading west (HD 4) the reverse.
 HdAdjacency chain(int n) {
     HdAdjacency adj(n);
@@ -243,6 +374,13 @@ TEST(RewardCells, ReplayValueFallsAlongTheChainAndTheChoiceHeadsToTheGoal) {
     const auto offered = direction_returns(copy, w, v, p, closed);
     for (int k = 0; k < 8; ++k) EXPECT_EQ(offered[std::size_t(k)], k == 0 ? 0.0 : returns[std::size_t(k)]) << k;
     EXPECT_THROW(direction_returns(copy, w, v, p, std::vector<char>(3, 1)), InputError);
+    // The packed copy: the chain's weights (±1) are 16-bit floats, so only its float32 states differ from the above.
+    const PackedAdjacency packed(adj, 0.0);
+    const auto half = direction_returns(packed, w, v, p);
+    for (int k = 0; k < 8; ++k) EXPECT_NEAR(half[std::size_t(k)], returns[std::size_t(k)], 1e-6) << k;
+    const auto half_offered = direction_returns(packed, w, v, p, closed);
+    for (int k = 0; k < 8; ++k) EXPECT_EQ(half_offered[std::size_t(k)], k == 0 ? 0.0 : half[std::size_t(k)]) << k;
+    EXPECT_THROW(direction_returns(packed, w, v, p, std::vector<char>(3, 1)), InputError);
     // The goal at the chain's start: west wins.
     v.assign(n, 0.0);
     v[9] = 1.0;
@@ -335,15 +473,9 @@ ModelSpec two_scales() {
     return m;
 }
 
-}  // namespace
-
-TEST(Navigation, MultiscaleReachesAGoalInSightTheSameForTheSameSeed) {
-    test::TempDir dir;
-    const World world = open_room(dir.path());
-    auto setup = room_setup();
-    setup.model = two_scales();
-    ASSERT_EQ(setup.model.place_scales(), (std::vector<std::string>{"place", "place-m"}));
-    const auto run = navigate(world, setup, 3);
+// A run of `setup` that reaches at least 3 of its 4 starts by paths under 2.5 × the shortest, and again the same paths.
+NavigationRun reaches_in_sight_twice_alike(const World& world, const NavigationSetup& setup) {
+    auto run = navigate(world, setup, 3);
     int reached = 0;
     for (const auto& s : run.starts) {
         reached += s.success;
@@ -353,8 +485,21 @@ TEST(Navigation, MultiscaleReachesAGoalInSightTheSameForTheSameSeed) {
     }
     EXPECT_GE(reached, 3) << "of " << run.starts.size();
     const auto again = navigate(world, setup, 3);
-    ASSERT_EQ(again.starts.size(), run.starts.size());
-    for (std::size_t i = 0; i < run.starts.size(); ++i) EXPECT_EQ(again.starts[i].path, run.starts[i].path) << i;
+    EXPECT_EQ(again.starts.size(), run.starts.size());
+    for (std::size_t i = 0; i < std::min(run.starts.size(), again.starts.size()); ++i)
+        EXPECT_EQ(again.starts[i].path, run.starts[i].path) << i;
+    return run;
+}
+
+}  // namespace
+
+TEST(Navigation, MultiscaleReachesAGoalInSightTheSameForTheSameSeed) {
+    test::TempDir dir;
+    const World world = open_room(dir.path());
+    auto setup = room_setup();
+    setup.model = two_scales();
+    ASSERT_EQ(setup.model.place_scales(), (std::vector<std::string>{"place", "place-m"}));
+    const auto run = reaches_in_sight_twice_alike(world, setup);
     // The second scale takes part in the choice: the first alone (the 2-D model, the same learning walk and the
     // same first scale's reward cell) walks other paths.
     auto single = room_setup();
@@ -371,6 +516,17 @@ TEST(Navigation, MultiscaleReachesAGoalInSightTheSameForTheSameSeed) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("scale_lambdas"), std::string::npos) << e.what();
     }
+}
+
+// `adjacency: {prune: 0.01, rollout_weights: float16}`: the rollouts read the packed copy; navigation still reaches a
+// goal in sight, the same for a seed.
+TEST(Navigation, ReachesAGoalInSightWithSixteenBitRolloutWeights) {
+    test::TempDir dir;
+    const World world = open_room(dir.path());
+    auto setup = room_setup();
+    setup.adjacency.prune = 0.01;
+    setup.adjacency.rollout_weights = RolloutWeights::float16;
+    reaches_in_sight_twice_alike(world, setup);
 }
 
 TEST(Navigation, RefusesGoalsOutsideInWallsOrNone) {

@@ -381,6 +381,7 @@ private:
 // What one scale gives the choice: its frozen adjacency, its parameters and, per goal, its reward cell's weights.
 struct ScaleMemory {
     SparseAdjacency adjacency;
+    std::optional<PackedAdjacency> packed;  // what the rollouts read, if `adjacency.rollout_weights` is float16
     RewardParams reward;
     std::vector<std::vector<double>> rewards;  // per goal
 };
@@ -395,8 +396,10 @@ public:
     int choose(const Pose&, std::span<const char> allowed) override {
         std::vector<std::vector<double>> returns;
         for (std::size_t s = 0; s < scales_.size(); ++s)
-            returns.push_back(direction_returns(scales_[s].adjacency, scales_[s].rewards[goal_], senses_.rates()[s],
-                                                scales_[s].reward, allowed));
+            returns.push_back(scales_[s].packed ? direction_returns(*scales_[s].packed, scales_[s].rewards[goal_],
+                                                                    senses_.rates()[s], scales_[s].reward, allowed)
+                                                : direction_returns(scales_[s].adjacency, scales_[s].rewards[goal_],
+                                                                    senses_.rates()[s], scales_[s].reward, allowed));
         const auto prob = combine_scales(returns, {allowed.begin(), allowed.end()}, p_, scores_);
         const double u = rng_.uniform();
         double sum = 0;
@@ -503,7 +506,9 @@ NavigationRun navigate(const World& world, const NavigationSetup& s, std::uint64
     // Exploitation, per scale on the learned adjacency's sparse copy, after replay from each goal's reward cell.
     std::vector<ScaleMemory> memory;
     for (std::size_t k = 0; k < n_scales; ++k) {
-        memory.push_back({SparseAdjacency(adjacency[k]), s.reward.for_scale(k), {}});
+        memory.push_back({SparseAdjacency(adjacency[k]), std::nullopt, s.reward.for_scale(k), {}});
+        if (adjacency_params.rollout_weights == RolloutWeights::float16)
+            memory.back().packed.emplace(adjacency[k], adjacency_params.prune);
         adjacency[k] = HdAdjacency(1, adjacency_params);  // its dense matrices are not needed any more
         for (std::size_t g = 0; g < n_goals; ++g)
             memory[k].rewards.push_back(goal_cells[k][g] >= 0

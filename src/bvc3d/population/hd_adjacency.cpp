@@ -23,7 +23,12 @@ const params::Table<AdjacencyParams>& AdjacencyParams::table() {
          real("rate", &AdjacencyParams::rate, finite(), "a in ΔW_rec[k] = a·Υ_k·(v xᵀ − x vᵀ)"),
          real("decay", &AdjacencyParams::decay, closed_open(0, 1), "every weight × (1 − decay) per learning step"),
          real("prune", &AdjacencyParams::prune, closed_open(0, 1),
-              "navigation's products leave out |w| <= prune × the matrix's largest; 0: exact")});
+              "navigation's products leave out |w| <= prune × the matrix's largest; 0: exact"),
+         choice("rollout_weights", &AdjacencyParams::rollout_weights,
+                {{RolloutWeights::float32, "float32"}, {RolloutWeights::float16, "float16"}},
+                "navigation's rollouts read the kept weights as float32 matrices, or as 16-bit floats on one pattern "
+                "for all directions (faster, each weight within 2^-11 of itself)")
+             .quiet_at_default()});
     return t;
 }
 

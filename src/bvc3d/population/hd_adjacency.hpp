@@ -34,6 +34,9 @@
 
 namespace bvc3d {
 
+// The weights navigation's rollouts read: the float32 SparseAdjacency, or the PackedAdjacency (packed_adjacency.hpp).
+enum class RolloutWeights { float32, float16 };
+
 struct AdjacencyParams {
     int n_hd = 8;         // HD cells, one matrix each
     double eta = 0.096;   // η, as the place cells' Oja rule
@@ -42,6 +45,7 @@ struct AdjacencyParams {
     double rate = 0.3;    // a in ΔW_rec[k] = a·Υ_k·(v xᵀ − x vᵀ)
     double decay = 1e-4;  // δ: every weight × (1 − δ) per learning step
     double prune = 0.0;   // products leave out |w| ≤ prune · max|W_rec[k]| (SparseAdjacency); 0: none
+    RolloutWeights rollout_weights = RolloutWeights::float32;  // float16: the rollouts read a PackedAdjacency
     static const params::Table<AdjacencyParams>& table();
     void validate() const { table().check(*this); }
 };
@@ -83,6 +87,7 @@ private:
     std::vector<double> x_, u_;
     std::vector<int> active_;
     friend class SparseAdjacency;
+    friend class PackedAdjacency;
 };
 
 // A frozen copy of an adjacency for products (see above): per HD cell, the weights with |w| > prune·max|W_rec[k]|

@@ -101,6 +101,32 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
     return out;
 }
 
+std::vector<double> direction_returns(const PackedAdjacency& adj, std::span<const double> w, std::span<const double> v,
+                                      const RewardParams& p, std::span<const char> offered) {
+    const auto n = std::size_t(adj.n_place()), K = std::size_t(adj.n_hd());
+    if (!offered.empty() && offered.size() != K)
+        throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " + std::to_string(K) +
+                         " directions");
+    std::vector<double> out(K, 0.0), z(n * K), dot(K), l1(K);
+    std::vector<float> x(n * K), y(n * K);
+    for (std::size_t i = 0; i < n; ++i) std::fill_n(&x[i * K], K, static_cast<float>(v[i]));
+    double g = 1.0;
+    for (int t = 0; t < p.rollout_steps; ++t) {
+        adj.apply(x, y);
+        for (std::size_t e = 0; e < n * K; ++e) z[e] = std::max(double(y[e]) - double(x[e]), 0.0);
+        vector_tanh(z.data(), z.data(), n * K);
+        // r(x) per direction, as reward(): the cells in order.
+        std::fill(dot.begin(), dot.end(), 0.0), std::fill(l1.begin(), l1.end(), 0.0);
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t k = 0; k < K; ++k) dot[k] += w[i] * z[i * K + k], l1[k] += std::abs(z[i * K + k]);
+        for (std::size_t k = 0; k < K; ++k)
+            if (offered.empty() || offered[k]) out[k] += g * (dot[k] / std::max(l1[k], 1e-4));
+        for (std::size_t e = 0; e < n * K; ++e) x[e] = static_cast<float>(z[e]);
+        g *= p.discount;
+    }
+    return out;
+}
+
 std::vector<double> combine_scales(const std::vector<std::vector<double>>& returns, const std::vector<char>& allowed,
                                    const RewardParams& p, std::vector<double>& scores) {
     const std::size_t n_scales = returns.size();

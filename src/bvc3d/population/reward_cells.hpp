@@ -14,7 +14,9 @@
 // The rollouts' tanh is SLEEF's (core/vector_math.hpp: within 3.5 ulp, the same bits on every instruction set), many
 // cells at a time; replay (once per goal) keeps libm's: its ⌈8λ⌉ steps of a recurrent map amplify last-place
 // differences (to ~10⁻⁵ on a chain of cells), and its weights stay as they were.
-// Both read the adjacency's frozen sparse copy (hd_adjacency.hpp: weights below `prune` of the largest left out);
+// Both read the adjacency's frozen sparse copy (hd_adjacency.hpp: weights below `prune` of the largest left out), or
+// the rollouts its packed copy (packed_adjacency.hpp: 16-bit weights, every direction in one pass; `adjacency:
+// {rollout_weights: float16}`);
 // the forms taking an HdAdjacency make that copy first (O(n_hd·n²)): navigation makes it once per learning run.
 //
 // Several scales (a multiscale model: each its place cells, adjacency, reward cell and λ — 20 / 30 / 60, SPEC §17)
@@ -31,6 +33,7 @@
 
 #include "bvc3d/core/params.hpp"
 #include "bvc3d/population/hd_adjacency.hpp"
+#include "bvc3d/population/packed_adjacency.hpp"
 
 namespace bvc3d {
 
@@ -63,6 +66,10 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
                                       const RewardParams& params = {}, std::span<const char> offered = {});
 std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const double> w, std::span<const double> v,
                                       const RewardParams& params = {});
+// The same through the packed copy (packed_adjacency.hpp: 16-bit weights, all directions at once): the states are
+// stored in float32 between steps, the tanh and the read-out are computed in double as above.
+std::vector<double> direction_returns(const PackedAdjacency& adj, std::span<const double> w, std::span<const double> v,
+                                      const RewardParams& params = {}, std::span<const char> offered = {});
 // softmax(β·values) over the entries where `allowed` (others 0; all 0 if none is allowed).
 std::vector<double> softmax(std::span<const double> values, double beta, const std::vector<char>& allowed);
 
