@@ -2,7 +2,8 @@
 --learn-hours 15 --prune 0.01), the same learning walks, the rollouts reading the float32 sparse copy (full-starts.csv,
 ms2-starts.csv: the runs of "Every world at full size") or the float16 packed copy (make.py ... --rollout-weights
 float16 --prefix h16- and h16w-: h16-starts.csv, h16w-starts.csv). Prints per world the starts reached (per learning
-run), the path ratio of the reached and, over all worlds, the two proportions' z.
+run), the path ratio of the reached, the starts whose walk differs (another path length or time: the rounding changed
+a choice) and, over all worlds, the two proportions' z.
 Run from the repository root: /usr/bin/python3 docs/navigation/half.py
 """
 import csv
@@ -33,11 +34,26 @@ def summary(rows, world):
     return len(mine), len(ok), per_run, (np.median(ok) if ok else float("nan"))
 
 
+def differing(f32, f16, world):
+    """Starts (the same world, learning run, goal and start) whose walks differ, and which of them succeeded."""
+    key = ("seed", "goal_x", "goal_y", "start_x", "start_y")
+    walk = {tuple(r[k] for k in key): r for r in f32 if r["world"] == world}
+    diff = []
+    for r in f16:
+        if r["world"] == world:
+            a = walk[tuple(r[k] for k in key)]
+            if (a["path_m"], a["time_s"]) != (r["path_m"], r["time_s"]):
+                diff.append((a, r))
+    success = sum(a["success"] == "1" for a, _ in diff), sum(b["success"] == "1" for _, b in diff)
+    return f"{len(diff)} (reached: {success[0]} / {success[1]})"
+
+
 def main():
     f32, f16 = read(FLOAT32), read(FLOAT16)
     worlds = list(dict.fromkeys(r["world"] for r in f16))
-    print("| world | float32: reached, per run | float16: reached, per run | path ratio, reached (32 / 16) |")
-    print("|---|---|---|---|")
+    print("| world | float32: reached, per run | float16: reached, per run | path ratio, reached (32 / 16) "
+          "| walks that differ |")
+    print("|---|---|---|---|---|")
     totals = [[0, 0], [0, 0]]
     for world in worlds:
         a, b = summary(f32, world), summary(f16, world)
@@ -47,7 +63,8 @@ def main():
             t[0] += s[0]
             t[1] += s[1]
         print(f"| {world} | {100 * a[1] / a[0]:.1f} % ({a[1]} of {a[0]}): {', '.join(map(str, a[2]))} | "
-              f"{100 * b[1] / b[0]:.1f} % ({b[1]} of {b[0]}): {', '.join(map(str, b[2]))} | {a[3]:.2f} / {b[3]:.2f} |")
+              f"{100 * b[1] / b[0]:.1f} % ({b[1]} of {b[0]}): {', '.join(map(str, b[2]))} | {a[3]:.2f} / {b[3]:.2f} "
+              f"| {differing(f32, f16, world)} |")
     (n1, k1), (n2, k2) = totals
     p1, p2, p = k1 / n1, k2 / n2, (k1 + k2) / (n1 + n2)
     z = (p2 - p1) / math.sqrt(p * (1 - p) * (1 / n1 + 1 / n2))
