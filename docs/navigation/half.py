@@ -3,7 +3,7 @@
 ms2-starts.csv: the runs of "Every world at full size") or the float16 packed copy (make.py ... --rollout-weights
 float16 --prefix h16- and h16w-: h16-starts.csv, h16w-starts.csv). Prints per world the starts reached (per learning
 run), the path ratio of the reached, the starts whose walk differs (another path length or time: the rounding changed
-a choice) and, over all worlds, the two proportions' z.
+a choice) and the starts not in both and, over all worlds, the two proportions' z.
 Run from the repository root: /usr/bin/python3 docs/navigation/half.py
 """
 import csv
@@ -35,17 +35,22 @@ def summary(rows, world):
 
 
 def differing(f32, f16, world):
-    """Starts (the same world, learning run, goal and start) whose walks differ, and which of them succeeded."""
+    """Starts (the same world, learning run, goal and start position) whose walks differ, and which of them succeeded
+    with each; and the starts not in both runs (a walk of another length draws the next starts from the learning
+    run's generator at another point, so they differ from there on)."""
     key = ("seed", "goal_x", "goal_y", "start_x", "start_y")
     walk = {tuple(r[k] for k in key): r for r in f32 if r["world"] == world}
-    diff = []
-    for r in f16:
-        if r["world"] == world:
-            a = walk[tuple(r[k] for k in key)]
-            if (a["path_m"], a["time_s"]) != (r["path_m"], r["time_s"]):
-                diff.append((a, r))
+    mine = [r for r in f16 if r["world"] == world]
+    diff, unpaired = [], 0
+    for r in mine:
+        a = walk.get(tuple(r[k] for k in key))
+        if a is None:
+            unpaired += 1
+        elif (a["path_m"], a["time_s"]) != (r["path_m"], r["time_s"]):
+            diff.append((a, r))
     success = sum(a["success"] == "1" for a, _ in diff), sum(b["success"] == "1" for _, b in diff)
-    return f"{len(diff)} (reached: {success[0]} / {success[1]})"
+    text = f"{len(diff)} (reached: {success[0]} / {success[1]})"
+    return text + (f"; {unpaired} other starts" if unpaired else "")
 
 
 def main():
