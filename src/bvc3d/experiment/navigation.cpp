@@ -384,6 +384,11 @@ struct ScaleMemory {
     std::optional<PackedAdjacency> packed;  // what the rollouts read, if `adjacency.rollout_weights` is float16
     RewardParams reward;
     std::vector<std::vector<double>> rewards;  // per goal
+    // Each direction's return toward goal g from the scale's rates v, through the copy the rollouts read.
+    std::vector<double> returns(std::size_t g, std::span<const double> v, std::span<const char> offered) const {
+        return packed ? direction_returns(*packed, rewards[g], v, reward, offered)
+                      : direction_returns(adjacency, rewards[g], v, reward, offered);
+    }
 };
 
 // SPEC §17's choice: per scale softmax(β·R) over the offered directions, the scales combined (combine_scales),
@@ -396,10 +401,7 @@ public:
     int choose(const Pose&, std::span<const char> allowed) override {
         std::vector<std::vector<double>> returns;
         for (std::size_t s = 0; s < scales_.size(); ++s)
-            returns.push_back(scales_[s].packed ? direction_returns(*scales_[s].packed, scales_[s].rewards[goal_],
-                                                                    senses_.rates()[s], scales_[s].reward, allowed)
-                                                : direction_returns(scales_[s].adjacency, scales_[s].rewards[goal_],
-                                                                    senses_.rates()[s], scales_[s].reward, allowed));
+            returns.push_back(scales_[s].returns(goal_, senses_.rates()[s], allowed));
         const auto prob = combine_scales(returns, {allowed.begin(), allowed.end()}, p_, scores_);
         const double u = rng_.uniform();
         double sum = 0;

@@ -123,22 +123,32 @@ void HdAdjacency::apply(int k, std::span<const double> x, std::span<double> out)
     }
 }
 
+HdAdjacency::Kept HdAdjacency::kept(double prune, const char* copy) const {
+    if (!(prune >= 0 && prune < 1)) throw InputError("adjacency: prune must lie in [0, 1)");
+    if (std::size_t(n_) > std::size_t(UINT16_MAX) + 1 || std::size_t(n_) * std::size_t(n_) > UINT32_MAX)
+        throw InputError(std::string("adjacency: too many place cells for the ") + copy + " copy (" +
+                         std::to_string(n_) + "; at most 65 536)");
+    Kept out{std::vector<float>(std::size_t(p_.n_hd), 0.0f), {}};
+    for (int k = 0; k < p_.n_hd; ++k) {
+        const float* m = &m_[index(k, 0, 0)];
+        float& top = out.top[std::size_t(k)];
+        for (std::size_t e = 0; e < std::size_t(n_) * std::size_t(n_); ++e) top = std::max(top, std::abs(m[e]));
+        // |w| > cut: with prune = 0, every non-zero weight (symmetric in i, j: the copy stays antisymmetric).
+        out.cut.push_back(static_cast<float>(prune * double(top)));
+    }
+    return out;
+}
+
 SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
     : n_(adj.n_),
       scale_(adj.scale_),
       antisymmetric_(adj.antisymmetric_),
       pruned_(prune > 0),
       rows_(std::size_t(adj.p_.n_hd)) {
-    if (!(prune >= 0 && prune < 1)) throw InputError("adjacency: prune must lie in [0, 1)");
-    if (std::size_t(adj.n_) > std::size_t(UINT16_MAX) + 1 || std::size_t(adj.n_) * std::size_t(adj.n_) > UINT32_MAX)
-        throw InputError("adjacency: too many place cells for the sparse copy (" + std::to_string(adj.n_) +
-                         "; at most 65 536)");
+    const auto kept = adj.kept(prune, "sparse");
     for (int k = 0; k < adj.p_.n_hd; ++k) {
         const float* m = &adj.m_[adj.index(k, 0, 0)];
-        float top = 0.0f;
-        for (std::size_t e = 0; e < std::size_t(n_) * std::size_t(n_); ++e) top = std::max(top, std::abs(m[e]));
-        // |w| > cut: with prune = 0, every non-zero weight (symmetric in i, j: the copy stays antisymmetric).
-        const float cut = static_cast<float>(prune * double(top));
+        const float cut = kept.cut[std::size_t(k)];
         Rows& r = rows_[std::size_t(k)];
         r.start.assign(std::size_t(n_) + 1, 0);
         for (int i = 0; i < n_; ++i) {

@@ -18,7 +18,8 @@
 // is a common scale factor (W = scale·M, folded back into M when it falls below 10⁻⁶), and the update touches
 // only the rows and columns of the active cells: a step costs O(n_hd · active · n), not O(n_hd · n²).
 //
-// Products for navigation (replay, the rollouts) read a SparseAdjacency, a frozen copy in compressed rows. With
+// Products for navigation (replay, the rollouts) read a SparseAdjacency, a frozen copy in compressed rows (the
+// rollouts, with `rollout_weights: float16`, a PackedAdjacency keeping the same weights: packed_adjacency.hpp). With
 // `prune` = 0 (the default) it keeps every non-zero weight and gives exactly the dense products' bits. The trace x
 // of a cell never returns to exactly 0 once it fired, so W_rec[k][i][j] becomes non-zero for nearly every pair of
 // cells ever active within a few thousand steps of each other (the copy then holds ~all n² entries), but only the
@@ -79,6 +80,13 @@ public:
 
 private:
     std::size_t index(int k, int i, int j) const { return (std::size_t(k) * n_ + i) * n_ + j; }
+    // What a frozen copy keeps (SparseAdjacency, PackedAdjacency): per matrix k, the stored weights m with
+    // |m| > cut[k] = prune·top[k], top[k] = max|m| (the copy stays antisymmetric). Throws InputError naming the copy
+    // if prune is outside [0, 1) or a uint16 column index cannot reach every cell.
+    struct Kept {
+        std::vector<float> top, cut;
+    };
+    Kept kept(double prune, const char* copy) const;
     int n_;
     AdjacencyParams p_;
     std::vector<float> m_;  // W_rec = scale_ · m_

@@ -12,22 +12,14 @@ namespace bvc3d {
 
 PackedAdjacency::PackedAdjacency(const HdAdjacency& adj, double prune)
     : n_(adj.n_), n_hd_(adj.p_.n_hd), antisymmetric_(adj.antisymmetric_), start_(std::size_t(adj.n_) + 1, 0) {
-    if (!(prune >= 0 && prune < 1)) throw InputError("adjacency: prune must lie in [0, 1)");
-    if (std::size_t(n_) > std::size_t(UINT16_MAX) + 1 || std::size_t(n_) * std::size_t(n_) > UINT32_MAX)
-        throw InputError("adjacency: too many place cells for the packed copy (" + std::to_string(n_) +
-                         "; at most 65 536)");
+    const auto [top, cut] = adj.kept(prune, "packed");
     const auto n = std::size_t(n_), K = std::size_t(n_hd_);
-    std::vector<float> top(K, 0.0f), cut(K);
-    for (std::size_t k = 0; k < K; ++k) {
-        const float* m = &adj.m_[adj.index(int(k), 0, 0)];
-        for (std::size_t e = 0; e < n * n; ++e) top[k] = std::max(top[k], std::abs(m[e]));
-        cut[k] = static_cast<float>(prune * double(top[k]));  // as SparseAdjacency: |w| > cut is kept
-        factor_.push_back(static_cast<float>(adj.scale_ * double(top[k])));
-    }
+    for (std::size_t k = 0; k < K; ++k) factor_.push_back(static_cast<float>(adj.scale_ * double(top[k])));
     for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t j = 0; j < n; ++j) {
             bool kept = false;
-            for (std::size_t k = 0; k < K; ++k) kept = kept || std::abs(adj.m_[adj.index(int(k), int(i), int(j))]) > cut[k];
+            for (std::size_t k = 0; k < K; ++k)
+                kept = kept || std::abs(adj.m_[adj.index(int(k), int(i), int(j))]) > cut[k];
             if (!kept) continue;
             col_.push_back(std::uint16_t(j));
             for (std::size_t k = 0; k < K; ++k) {
@@ -51,8 +43,7 @@ void PackedAdjacency::apply(std::span<const float> x, std::span<float> y) const 
         if (std::any_of(&x[j * K], &x[j * K] + K, [](float v) { return v != 0.0f; })) work += start_[j + 1] - start_[j];
     if (antisymmetric_ && 3 * work < col_.size())
         kernels::half_columns(start_.data(), col_.data(), half_.data(), n_, n_hd_, x.data(), factor_.data(), y.data());
-    else
-        kernels::half_rows(start_.data(), col_.data(), half_.data(), n_, n_hd_, x.data(), factor_.data(), y.data());
+    else kernels::half_rows(start_.data(), col_.data(), half_.data(), n_, n_hd_, x.data(), factor_.data(), y.data());
 }
 
 double PackedAdjacency::bytes() const {
