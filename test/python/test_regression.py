@@ -6,7 +6,9 @@ test/data/paper-0.5h-digests.json, test/data/flight-0.25h-digests.json and their
 
 The digests of test/data/paper-0.5h-digests.json were taken again after issue 16's speed work, which
 moves the BVC sums by up to 4e-10 of a step's largest rate (docs/performance.md#results); before that,
-from the files of the code before the architecture refactor. A change that adds datasets or attributes without moving
+from the files of the code before the architecture refactor. The weights of the 30° arena's 3-D trials were
+retaken when Embree was held to its AVX2 kernels (its AVX-512 kernels, on the machine of the earlier digests, moved
+them). A change that adds datasets or attributes without moving
 any (a new metric, a new analysis parameter recorded with the metrics) records the new ones in a file of their own,
 test/data/<run>-digests.<what>.json, so that the earlier digests stay as they were and still
 must match:

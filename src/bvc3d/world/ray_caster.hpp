@@ -3,7 +3,8 @@
 // through Embree 3 (spheres as its point geometry, RTC_GEOMETRY_TYPE_SPHERE_POINT).
 // Embree finds the triangle or sphere a ray hits (in float); the distance is then recomputed in
 // double against that triangle's plane or that sphere, so ranges are exact to ~1e-12 m rather than
-// float's ~1e-6 m.
+// float's ~1e-6 m. Embree runs its AVX2 kernels at most, so that which triangle a grazing ray hits does
+// not change between machines.
 #include <limits>
 #include <memory>
 #include <span>
