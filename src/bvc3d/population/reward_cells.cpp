@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 
 #include "bvc3d/core/error.hpp"
@@ -69,20 +68,6 @@ std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const Rewa
     return w;
 }
 
-namespace {
-
-// z[i] = tanh(z[i]) for i < n, computed for the non-zero values only: a rollout's state is 0 in most cells after the
-// rectification, and tanh(±0) = ±0, so the bits are those of vector_tanh over all n.
-void tanh_in_place(double* z, std::size_t n, std::vector<std::uint32_t>& at, std::vector<double>& packed) {
-    at.clear(), packed.clear();
-    for (std::size_t i = 0; i < n; ++i)
-        if (z[i] != 0.0) at.push_back(std::uint32_t(i)), packed.push_back(z[i]);
-    vector_tanh(packed.data(), packed.data(), packed.size());
-    for (std::size_t o = 0; o < at.size(); ++o) z[at[o]] = packed[o];
-}
-
-}  // namespace
-
 double reward(std::span<const double> w, std::span<const double> v) {
     double dot = 0.0, l1 = 0.0;
     for (std::size_t i = 0; i < v.size(); ++i) dot += w[i] * v[i], l1 += std::abs(v[i]);
@@ -100,8 +85,7 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
     if (!offered.empty() && offered.size() != std::size_t(adj.n_hd()))
         throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " +
                          std::to_string(adj.n_hd()) + " directions");
-    std::vector<double> out(std::size_t(adj.n_hd()), 0.0), x(n), y(n), packed;
-    std::vector<std::uint32_t> at;
+    std::vector<double> out(std::size_t(adj.n_hd()), 0.0), x(n), y(n);
     for (int k = 0; k < adj.n_hd(); ++k) {
         if (!offered.empty() && !offered[std::size_t(k)]) continue;
         x.assign(v.begin(), v.end());
@@ -109,7 +93,7 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
         for (int t = 0; t < p.rollout_steps; ++t) {
             adj.apply(k, x, y);
             for (std::size_t i = 0; i < n; ++i) x[i] = std::max(y[i] - x[i], 0.0);
-            tanh_in_place(x.data(), n, at, packed);
+            vector_tanh(x.data(), x.data(), n);
             out[std::size_t(k)] += g * reward(w, x);
             g *= p.discount;
         }
@@ -123,15 +107,14 @@ std::vector<double> direction_returns(const PackedAdjacency& adj, std::span<cons
     if (!offered.empty() && offered.size() != K)
         throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " + std::to_string(K) +
                          " directions");
-    std::vector<double> out(K, 0.0), z(n * K), dot(K), l1(K), packed;
-    std::vector<std::uint32_t> at;
+    std::vector<double> out(K, 0.0), z(n * K), dot(K), l1(K);
     std::vector<float> x(n * K), y(n * K);
     for (std::size_t i = 0; i < n; ++i) std::fill_n(&x[i * K], K, static_cast<float>(v[i]));
     double g = 1.0;
     for (int t = 0; t < p.rollout_steps; ++t) {
         adj.apply(x, y);
         for (std::size_t e = 0; e < n * K; ++e) z[e] = std::max(double(y[e]) - double(x[e]), 0.0);
-        tanh_in_place(z.data(), n * K, at, packed);
+        vector_tanh(z.data(), z.data(), n * K);
         // r(x) per direction, as reward(): the cells in order.
         std::fill(dot.begin(), dot.end(), 0.0), std::fill(l1.begin(), l1.end(), 0.0);
         for (std::size_t i = 0; i < n; ++i)
