@@ -169,7 +169,7 @@ void SparseAdjacency::apply(int k, std::span<const double> x, std::span<double> 
     std::size_t active = 0, work = 0;
     for (std::size_t j = 0; j < x.size(); ++j)
         if (x[j] != 0.0) ++active, work += r.start[j + 1] - r.start[j];
-    if (pruned_ && !(antisymmetric_ && 3 * work < r.col.size())) {
+    if (pruned_ && !by_columns(antisymmetric_, work, r.col.size())) {
         kernels::row_sums16(r.start.data(), r.col.data(), r.w.data(), n_, x.data(), scale_, out.data());
         return;
     }

@@ -98,6 +98,12 @@ private:
     friend class PackedAdjacency;
 };
 
+// Whether a frozen copy's product is taken by columns (Wᵀ·x = −W·x, antisymmetric W only, over the rows of the
+// non-zero cells: `work` entries of `entries`) rather than by rows: where that reads under a third of the entries.
+inline bool by_columns(bool antisymmetric, std::size_t work, std::size_t entries) {
+    return antisymmetric && 3 * work < entries;
+}
+
 // A frozen copy of an adjacency for products (see above): per HD cell, the weights with |w| > prune·max|W_rec[k]|
 // in compressed rows (column index as uint16 and float32 value, 6 bytes an entry: at most 65 536 place cells; the
 // products stream the entries from memory, so their size is their speed). With prune 0, apply() gives the same bits

@@ -37,11 +37,10 @@ void PackedAdjacency::apply(std::span<const float> x, std::span<float> y) const 
     if (x.size() != std::size_t(n_) * K || y.size() != x.size())
         throw InputError("PackedAdjacency: states of " + std::to_string(x.size()) + " and " + std::to_string(y.size()) +
                          " values for " + std::to_string(n_) + " cells × " + std::to_string(K) + " directions");
-    // The column form where it reads under a third of the entries, as SparseAdjacency chooses.
     std::size_t work = 0;
     for (std::size_t j = 0; j < std::size_t(n_); ++j)
         if (std::any_of(&x[j * K], &x[j * K] + K, [](float v) { return v != 0.0f; })) work += start_[j + 1] - start_[j];
-    if (antisymmetric_ && 3 * work < col_.size())
+    if (by_columns(antisymmetric_, work, col_.size()))
         kernels::half_columns(start_.data(), col_.data(), half_.data(), n_, n_hd_, x.data(), factor_.data(), y.data());
     else kernels::half_rows(start_.data(), col_.data(), half_.data(), n_, n_hd_, x.data(), factor_.data(), y.data());
 }

@@ -68,6 +68,17 @@ std::vector<double> replay(const SparseAdjacency& adj, int goal_cell, const Rewa
     return w;
 }
 
+namespace {
+
+// `offered`: empty (every direction) or one flag per direction.
+void check_offered(std::span<const char> offered, std::size_t directions) {
+    if (!offered.empty() && offered.size() != directions)
+        throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " +
+                         std::to_string(directions) + " directions");
+}
+
+}  // namespace
+
 double reward(std::span<const double> w, std::span<const double> v) {
     double dot = 0.0, l1 = 0.0;
     for (std::size_t i = 0; i < v.size(); ++i) dot += w[i] * v[i], l1 += std::abs(v[i]);
@@ -82,9 +93,7 @@ std::vector<double> direction_returns(const HdAdjacency& adj, std::span<const do
 std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<const double> w, std::span<const double> v,
                                       const RewardParams& p, std::span<const char> offered) {
     const auto n = std::size_t(adj.n_place());
-    if (!offered.empty() && offered.size() != std::size_t(adj.n_hd()))
-        throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " +
-                         std::to_string(adj.n_hd()) + " directions");
+    check_offered(offered, std::size_t(adj.n_hd()));
     std::vector<double> out(std::size_t(adj.n_hd()), 0.0), x(n), y(n);
     for (int k = 0; k < adj.n_hd(); ++k) {
         if (!offered.empty() && !offered[std::size_t(k)]) continue;
@@ -104,9 +113,7 @@ std::vector<double> direction_returns(const SparseAdjacency& adj, std::span<cons
 std::vector<double> direction_returns(const PackedAdjacency& adj, std::span<const double> w, std::span<const double> v,
                                       const RewardParams& p, std::span<const char> offered) {
     const auto n = std::size_t(adj.n_place()), K = std::size_t(adj.n_hd());
-    if (!offered.empty() && offered.size() != K)
-        throw InputError("direction_returns: " + std::to_string(offered.size()) + " flags for " + std::to_string(K) +
-                         " directions");
+    check_offered(offered, K);
     std::vector<double> out(K, 0.0), z(n * K), dot(K), l1(K);
     std::vector<float> x(n * K), y(n * K);
     for (std::size_t i = 0; i < n; ++i) std::fill_n(&x[i * K], K, static_cast<float>(v[i]));
