@@ -106,6 +106,25 @@ def ros2_folder(name, storage_format="cdr", corrupt=False):
         (folder / "bag_0.db3").write_bytes(b"SQLite format 3\0" + bytes(range(256)) * 8)
 
 
+def ros1_records(data, start=13):
+    """(start, header fields, data start, data length) of each record from `start`: the ROS 1 bag format
+    2.0 (after its 13-byte "#ROSBAG V2.0" line, records of a uint32 header length, the header's
+    length-prefixed name=value fields, a uint32 data length and the data)."""
+    records, pos = [], start
+    while pos < len(data):
+        header_length = struct.unpack_from("<I", data, pos)[0]
+        header, fields, f = data[pos + 4:pos + 4 + header_length], {}, 0
+        while f < header_length:
+            n = struct.unpack_from("<I", header, f)[0]
+            name, _, value = bytes(header[f + 4:f + 4 + n]).partition(b"=")
+            fields[name] = value
+            f += 4 + n
+        data_length = struct.unpack_from("<I", data, pos + 4 + header_length)[0]
+        records.append((pos, fields, pos + 8 + header_length, data_length))
+        pos += 8 + header_length + data_length
+    return records
+
+
 def ros1_bags():
     try:
         import rosbag
@@ -115,27 +134,52 @@ def ros1_bags():
     except ImportError:
         print("make_bag_cases: no python3-rosbag/python3-sensor-msgs: the ROS 1 cases are left as they are")
         return {}
-    path = pathlib.Path(tempfile.mkdtemp()) / "case.bag"
-    with rosbag.Bag(str(path), "w") as bag:
-        for i in range(3):
-            t = rospy.Time.from_sec(1.0 + 0.1 * i)
-            c = PointCloud2()
-            c.header.stamp, c.header.frame_id = t, "lidar"
-            c.height, c.width, c.point_step, c.row_step = 1, 40, 12, 480
-            c.fields = [PointField(name=n, offset=o, datatype=d, count=k) for n, o, d, k in XYZ]
-            c.data = b"".join(struct.pack("<fff", 3.0 + k * 0.1, 1.0, 0.0) for k in range(40))
-            o = Odometry()
-            o.header.stamp, o.header.frame_id, o.child_frame_id = t, "map", "lidar"
-            o.pose.pose.orientation.w = 1.0
-            bag.write("/odom", o, t)
-            bag.write("/points", c, t)
-    data = path.read_bytes()
-    shutil.rmtree(path.parent)
+
+    def written(compression):
+        path = pathlib.Path(tempfile.mkdtemp()) / "case.bag"
+        with rosbag.Bag(str(path), "w", compression=compression) as bag:
+            for i in range(3):
+                t = rospy.Time.from_sec(1.0 + 0.1 * i)
+                c = PointCloud2()
+                c.header.stamp, c.header.frame_id = t, "lidar"
+                c.height, c.width, c.point_step, c.row_step = 1, 40, 12, 480
+                c.fields = [PointField(name=n, offset=o, datatype=d, count=k) for n, o, d, k in XYZ]
+                c.data = b"".join(struct.pack("<fff", 3.0 + k * 0.1, 1.0, 0.0) for k in range(40))
+                o = Odometry()
+                o.header.stamp, o.header.frame_id, o.child_frame_id = t, "map", "lidar"
+                o.pose.pose.orientation.w = 1.0
+                bag.write("/odom", o, t)
+                bag.write("/points", c, t)
+        data = path.read_bytes()
+        shutil.rmtree(path.parent)
+        return data
+
+    data = written("none")
     # A cloud whose data array claims 2 GB (the message itself is whole): refused before any allocation.
     first = struct.pack("<I", 480) + struct.pack("<fff", 3.0, 1.0, 0.0)
     at = data.index(first)
     lying = data[:at] + struct.pack("<I", 0x7FFFFFFF) + data[at + 4:]
+    # Inside the first chunk: a message record whose data runs 100 kB past the chunk's end (rosbag storage
+    # would copy that far); an index entry pointing at the chunk's first record, a connection.
+    chunk = next(r for r in ros1_records(data) if r[1][b"op"] == b"\x05")
+    inner = next(r for r in ros1_records(data[chunk[2]:chunk[2] + chunk[3]], 0) if r[1][b"op"] == b"\x02")
+    length_at = chunk[2] + inner[2] - 4
+    message_lies = bytearray(data)
+    struct.pack_into("<I", message_lies, length_at, inner[3] + 100000)
+    index = next(r for r in ros1_records(data) if r[1][b"op"] == b"\x04")
+    index_lies = bytearray(data)
+    struct.pack_into("<I", index_lies, index[2] + 8, 0)
+    # An lz4 chunk whose frame does not start with lz4's magic number.
+    lz4 = bytearray(written("lz4"))
+    lz4_chunk = next(r for r in ros1_records(lz4) if r[1][b"op"] == b"\x05")
+    lz4[lz4_chunk[2]:lz4_chunk[2] + 4] = b"\0\0\0\0"
     return {
+        "ros1-message-length-lies.bag": (bytes(message_lies), REPLAY,
+                                         f"chunk at byte {chunk[0]}, byte {inner[2] - 4} of its uncompressed "
+                                         "data; a record's data claims"),
+        "ros1-index-offset-lies.bag": (bytes(index_lies), REPLAY,
+                                       "the index points at byte 0 of the chunk before it; no message record starts"),
+        "ros1-lz4-not-lz4.bag": (bytes(lz4), REPLAY, "chunk's lz4 data cannot be decompressed"),
         "ros1-cloud-length-lies.bag": (lying, REPLAY, "/points; message 0; truncated or corrupt"),
         "ros1-truncated.bag": (data[: len(data) * 2 // 3], REPLAY, "ros1-truncated.bag"),
         "ros1-not-a-bag.bag": (b"#ROSBAG V2.0\n" + bytes(range(256)) * 4, REPLAY, "not a readable ROS 1 bag"),

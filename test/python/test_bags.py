@@ -140,7 +140,8 @@ def test_tf_gap_is_an_error(tmp_path):
 rosbag = pytest.importorskip("rosbag") if shutil.which("rosbag") else None
 
 
-def test_ros1_bag_written_by_python_rosbag(tmp_path):
+@pytest.mark.parametrize("compression", ["none", "bz2", "lz4"])
+def test_ros1_bag_written_by_python_rosbag(tmp_path, compression):
     if rosbag is None:
         pytest.skip("Debian's python3-rosbag is not installed")
     msg = pytest.importorskip("sensor_msgs.msg")
@@ -149,7 +150,7 @@ def test_ros1_bag_written_by_python_rosbag(tmp_path):
     rng = np.random.default_rng(3)
     path = tmp_path / "x.bag"
     expected, poses = [], []
-    with rosbag.Bag(str(path), "w") as bag:
+    with rosbag.Bag(str(path), "w", compression=compression) as bag:
         for i in range(3):
             stamp = rospy.Time.from_sec(100.0 + 0.1 * i)
             pts = scan_points(rng, 8)

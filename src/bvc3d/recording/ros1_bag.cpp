@@ -10,14 +10,12 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include <algorithm>
-#include <cstring>
-#include <fstream>
 #include <map>
 #include <mutex>
 
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recording/bag.hpp"
+#include "bvc3d/recording/ros1_framing.hpp"
 
 namespace bvc3d::recording {
 
@@ -236,82 +234,12 @@ std::string expected_md5(MessageKind kind) {
     return "";
 }
 
-// The record framing of a ROS 1 bag (format 2.0: "#ROSBAG V2.0\n", then records of a uint32 header
-// length, the header's fields, a uint32 data length and the data), checked before rosbag storage
-// reads it: the library sizes its buffers from these lengths before it reads (a corrupt length of
-// 2 GB is 2 GB allocated). The offsets the index gives must be where records start, and chunks'
-// uncompressed sizes are bounded.
-void check_framing(const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    in.seekg(0, std::ios::end);
-    const auto size = static_cast<std::uint64_t>(in.tellg());
-    in.seekg(0);
-    char magic[13] = {};
-    in.read(magic, 13);
-    if (!in || std::memcmp(magic, "#ROSBAG V2.0\n", 13) != 0)
-        throw InputError(quoted_path(file) + ": not a ROS 1 bag (no '#ROSBAG V2.0' at its start)");
-    const auto fail = [&](std::uint64_t at, const std::string& why) {
-        throw InputError(quoted_path(file) + ", byte " + std::to_string(at) + ": " + why +
-                         " (not a readable ROS 1 bag: truncated or corrupt)");
-    };
-    const auto u32 = [&](std::uint64_t at) {
-        if (at > size || size - at < 4) fail(at, "a record is cut off");
-        std::uint8_t b[4] = {};
-        in.clear();
-        in.seekg(static_cast<std::streamoff>(at));
-        in.read(reinterpret_cast<char*>(b), 4);
-        return static_cast<std::uint32_t>(b[0] | b[1] << 8 | b[2] << 16 | static_cast<std::uint32_t>(b[3]) << 24);
-    };
-    std::vector<std::uint64_t> starts, offsets;  // where records start; where the index says they do
-    for (std::uint64_t pos = 13; pos < size;) {
-        starts.push_back(pos);
-        const std::uint32_t header_length = u32(pos);
-        if (header_length > size - pos - 4)
-            fail(pos, "a record header claims " + std::to_string(header_length) + " bytes");
-        std::string header(header_length, '\0');
-        in.read(header.data(), header_length);
-        std::string op, compression;
-        std::uint64_t chunk_size = 0;
-        for (std::size_t f = 0; f + 4 <= header.size();) {
-            std::uint32_t n = 0;
-            std::memcpy(&n, header.data() + f, 4);
-            if (n > header.size() - f - 4) fail(pos, "a header field claims " + std::to_string(n) + " bytes");
-            const std::string field = header.substr(f + 4, n);
-            const auto eq = field.find('=');
-            const std::string name = field.substr(0, eq), value = eq == std::string::npos ? "" : field.substr(eq + 1);
-            if (name == "op") op = value;
-            if (name == "compression") compression = value;
-            if (name == "size" && value.size() == 4) {
-                std::uint32_t v = 0;
-                std::memcpy(&v, value.data(), 4);
-                chunk_size = v;
-            }
-            if ((name == "index_pos" || name == "chunk_pos") && value.size() == 8) {
-                std::uint64_t v = 0;
-                std::memcpy(&v, value.data(), 8);
-                offsets.push_back(v);
-            }
-            f += 4 + n;
-        }
-        pos += 4 + header_length;
-        const std::uint32_t data_length = u32(pos);
-        if (data_length > size - pos - 4) fail(pos, "a record's data claims " + std::to_string(data_length) + " bytes");
-        if (op == std::string(1, '\x05') && compression != "none" &&
-            (chunk_size > (std::uint64_t{1} << 30) || chunk_size > 1024 * std::uint64_t{data_length} + (1u << 20)))
-            fail(pos, "a chunk claims " + std::to_string(chunk_size) + " bytes uncompressed");
-        pos += 4 + data_length;
-    }
-    for (const std::uint64_t at : offsets)
-        if (at != size && !std::binary_search(starts.begin(), starts.end(), at))
-            fail(at, "the bag's index points at byte " + std::to_string(at) + ", where no record starts");
-}
-
 class Ros1Bag : public BagReader {
 public:
     explicit Ros1Bag(const std::filesystem::path& file) : BagReader(file) {
         std::error_code ec;
         if (!std::filesystem::is_regular_file(file, ec)) throw InputError(quoted_path(file) + " is not a file");
-        check_framing(file);
+        ros1::check_framing(file);
         try {
             bag_.open(file.string(), rosbag::bagmode::Read);
             rosbag::View all(bag_);
