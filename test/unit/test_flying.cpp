@@ -288,18 +288,26 @@ TEST(FlyingWalk, LevelHeadByDefaultAndStartsAnywhereInTheVolume) {
     const World world(config::resolve_world("atrium"));
     const auto steps = flying_walk(world, 0.5, 8);
     for (const auto& s : steps) ASSERT_TRUE(s.pose.level());
-    // Starts: uniform in the volume, never inside a pillar.
+    // Starts: uniform in the volume, never inside a pillar. Drawn as a walk of each seed draws its start, on one
+    // body (building the body's free space once per walk made this test minutes long under the sanitizers).
+    const SphereCollider body(world.description(), R);
     double lo = INFINITY, hi = -INFINITY;
     for (std::uint64_t seed = 0; seed < 60; ++seed) {
-        const auto s = flying_walk(world, 0.0005, seed);
-        ASSERT_FALSE(s.empty());
-        lo = std::min(lo, s[0].pose.z), hi = std::max(hi, s[0].pose.z);
+        Rng rng(seed, Stream::walk);
+        const Vec3 p = FlyingWalk::draw_start(body, FlightParams{}, rng, "atrium").position;
+        lo = std::min(lo, p.z()), hi = std::max(hi, p.z());
         for (const auto& c : {Vec2(-1.5, 1.0), Vec2(2.0, -1.5)})
-            EXPECT_GT(std::max(std::abs(s[0].pose.x - c.x()), std::abs(s[0].pose.y - c.y())), 0.3 + R - 0.3) << seed;
+            EXPECT_GT(std::max(std::abs(p.x() - c.x()), std::abs(p.y() - c.y())), 0.3 + R - 0.3) << seed;
     }
     EXPECT_LT(lo, 2.0);
     EXPECT_GT(hi, 3.5);
-    const SphereCollider body(world.description(), R);
+    // A walk of that seed starts there: its first step lies within one step's flight (0.288 m) of the drawn start.
+    ASSERT_EQ(FlightParams{}.radius, R);
+    const auto first = flying_walk(world, 0.0005, 7);
+    Rng rng7(7, Stream::walk);
+    ASSERT_FALSE(first.empty());
+    const Vec3 start = FlyingWalk::draw_start(body, FlightParams{}, rng7, "atrium").position;
+    EXPECT_LE((first[0].pose.position() - start).norm(), FlightParams{}.speed * FlightParams{}.model_dt + 1e-9);
     EXPECT_TRUE(body.is_free(Vec3(-1.5, 1.0, 1.0)));        // inside the pillar, far from its faces ...
     EXPECT_FALSE(body.can_start_at(Vec3(-1.5, 1.0, 1.0)));  // ... but closed off
     EXPECT_TRUE(body.can_start_at(Vec3(0, 0, 1.0)));

@@ -164,15 +164,14 @@ std::string uncompressed(FileBytes& file, const Record& chunk, const Faults& fau
     if (*size > max_chunk_bytes || *size > 1024 * std::uint64_t{chunk.data_length} + (1u << 20))
         fault.at(chunk.start, "a chunk claims " + std::to_string(*size) + " bytes uncompressed from " +
                                   std::to_string(chunk.data_length));
+    if (compression != "lz4" && compression != "bz2")
+        fault.at(chunk.start, "a chunk's compression '" + compression + "' is none of none, lz4, bz2");
     std::string out(*size, '\0');
     unsigned int out_length = *size;
-    bool decoded = false;
-    if (compression == "lz4")
-        decoded = roslz4_buffToBuffDecompress(raw.data(), chunk.data_length, out.data(), &out_length) == ROSLZ4_OK;
-    else if (compression == "bz2")
-        decoded = BZ2_bzBuffToBuffDecompress(out.data(), &out_length, raw.data(), chunk.data_length, 0, 0) == BZ_OK;
-    else
-        fault.at(chunk.start, "a chunk's compression '" + compression + "' is none of none, lz4, bz2");
+    const bool decoded =
+        compression == "lz4"
+            ? roslz4_buffToBuffDecompress(raw.data(), chunk.data_length, out.data(), &out_length) == ROSLZ4_OK
+            : BZ2_bzBuffToBuffDecompress(out.data(), &out_length, raw.data(), chunk.data_length, 0, 0) == BZ_OK;
     if (!decoded) fault.at(chunk.data_at, "a chunk's " + compression + " data cannot be decompressed");
     if (out_length != *size)
         fault.at(chunk.data_at, "a chunk decompresses to " + std::to_string(out_length) + " bytes, not the " +
@@ -216,9 +215,9 @@ void check_framing(const std::filesystem::path& file) {
     if (bytes.size() < 13 || bytes.read(0, 13) != "#ROSBAG V2.0\n")
         throw InputError(quoted_path(file) + ": not a ROS 1 bag (no '#ROSBAG V2.0' at its start)");
     const Faults fault(quoted_path(file) + ", ", "");
-    std::vector<std::uint64_t> starts, chunks;  // where records start; where chunk records do
+    std::vector<std::uint64_t> starts, chunks;       // where records start; where chunk records do
     std::vector<std::uint64_t> index_at, chunks_at;  // where the header and the chunk infos say they are
-    std::vector<std::uint64_t> messages;  // where messages start in the last chunk's uncompressed data
+    std::vector<std::uint64_t> messages;             // where messages start in the last chunk's uncompressed data
     walk(bytes, 13, fault, [&](const Record& r) {
         starts.push_back(r.start);
         switch (r.op()) {
@@ -228,13 +227,13 @@ void check_framing(const std::filesystem::path& file) {
             case op_chunk_info:
                 if (const auto at = r.number<std::uint64_t>("chunk_pos")) chunks_at.push_back(*at);
                 break;
-            case op_chunk:
+            case op_chunk: {
                 chunks.push_back(r.start);
-                messages = message_starts(uncompressed(bytes, r, fault),
-                                          Faults(quoted_path(file) + ", chunk at byte " + std::to_string(r.start) +
-                                                     ", ",
-                                                 " of its uncompressed data"));
+                const Faults in_chunk(quoted_path(file) + ", chunk at byte " + std::to_string(r.start) + ", ",
+                                      " of its uncompressed data");
+                messages = message_starts(uncompressed(bytes, r, fault), in_chunk);
                 break;
+            }
             case op_index:
                 check_index(bytes, r, messages, fault);
                 break;
@@ -244,7 +243,7 @@ void check_framing(const std::filesystem::path& file) {
     });
     for (const std::uint64_t at : index_at)
         if (at != bytes.size() && !std::binary_search(starts.begin(), starts.end(), at))
-            fault.at(at, "the bag's header points its index at byte " + std::to_string(at) + ", where no record starts");
+            fault.at(at, "the bag's header points its index at byte " + std::to_string(at) + ", where no record is");
     for (const std::uint64_t at : chunks_at)
         if (!std::binary_search(chunks.begin(), chunks.end(), at))
             fault.at(at, "the bag's index points at byte " + std::to_string(at) + ", where no chunk starts");
