@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -19,6 +18,7 @@
 
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/recording/bag.hpp"
+#include "bvc3d/recording/parsing.hpp"
 
 namespace bvc3d::recording::ros1 {
 
@@ -30,11 +30,10 @@ constexpr char op_message = 0x02, op_bag_header = 0x03, op_index = 0x04, op_chun
 // bytes + 1 MiB (lz4 and bzip2 do not expand further on real data).
 constexpr std::uint64_t max_chunk_bytes = std::uint64_t{1} << 30;
 
+// A little-endian number at byte `at` of `bytes` (the readers' shared binary load).
 template <class T>
 T little_endian(const std::string& bytes, std::size_t at) {
-    T v = 0;
-    for (std::size_t i = sizeof(T); i-- > 0;) v = static_cast<T>(v << 8 | static_cast<unsigned char>(bytes[at + i]));
-    return v;
+    return detail::load<T>(bytes.data() + at, detail::ByteOrder::little);
 }
 
 // Where a fault is: "'<file>', byte N: why" or "'<file>', chunk at byte C, byte N of its uncompressed data: why".
