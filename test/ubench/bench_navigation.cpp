@@ -130,6 +130,32 @@ BENCHMARK(BM_DirectionChoiceMultiscale<PackedAdjacency>)
     ->ArgsProduct({{3500}, {3, 4}, {3}})
     ->Unit(benchmark::kMicrosecond);
 
+// The packed copy's tiles (kernels::HalfTiles): the decision above at prune 10⁻² with panels of `panel` cells (the
+// default 512) against whole rows (panel 65 536: one tile a block of rows, the layout before the tiles). The same
+// bits either way; run with --benchmark_enable_random_interleaving for a paired comparison.
+void BM_DirectionChoiceTiles(benchmark::State& state) {
+    const int panel = static_cast<int>(state.range(0));
+    std::vector<const Learned*> scales;
+    std::vector<PackedAdjacency> copies;
+    for (int n : {2000, 1000, 500}) {
+        scales.push_back(&learned(n));
+        copies.emplace_back(scales.back()->adj, 0.01, panel);
+    }
+    std::vector<std::vector<double>> v;
+    for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
+    const RewardParams p;
+    const std::vector<char> allowed(8, 1);
+    std::vector<std::vector<double>> returns(scales.size());
+    std::vector<double> scores;
+    for (auto _ : state) {
+        for (std::size_t s = 0; s < scales.size(); ++s)
+            returns[s] = direction_returns(copies[s], scales[s]->w, v[s], p);
+        benchmark::DoNotOptimize(combine_scales(returns, allowed, p, scores));
+    }
+    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DirectionChoiceTiles)->Arg(512)->Arg(65536)->Unit(benchmark::kMicrosecond);
+
 // One learning step of the adjacency (traces, the active rows and columns of 8 matrices, the decay) on the synthetic
 // walk's place rates, for the multiscale sizes: what learning adds to each model step of navigation.
 void BM_AdjacencyLearn(benchmark::State& state) {

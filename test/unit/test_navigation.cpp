@@ -218,7 +218,9 @@ std::pair<std::uint16_t, double> random_half(std::mt19937& gen) {
 // The packed copy's products (kernels::half_rows, half_columns), restated: rows — entry o of a row into accumulator
 // o mod 4 (float32), (a0 + a1) + (a2 + a3), × f_k; columns — 0 minus each entry's product, rows j in order, skipping
 // rows whose state is 0 in every direction, × f_k. Bits must match on whatever instruction set runs the test (8
-// directions: AVX2 where the CPU has it; 3: one at a time), and the sums lie within float32's rounding of the exact.
+// directions: AVX2 where the CPU has it; 3: one at a time), whatever the tiles (blocks of rows, panels of columns:
+// one tile, rows cut mid-way by panels with every phase mod 4, a short last block, single rows and columns), and the
+// sums lie within float32's rounding of the exact.
 TEST(PackedAdjacency, KernelsAddInAFixedOrder) {
     std::mt19937 gen(5);
     std::uniform_real_distribution<float> u(-1, 1);
@@ -241,35 +243,46 @@ TEST(PackedAdjacency, KernelsAddInAFixedOrder) {
         for (float& v : x) v = u(gen);
         for (int j = 0; j < n; j += 3) std::fill_n(&x[std::size_t(j * K)], K, 0.0f);  // rows the columns form skips
         for (float& v : f) v = u(gen);
-        kernels::half_rows(start.data(), col.data(), h.data(), n, K, x.data(), f.data(), y.data());
-        kernels::half_columns(start.data(), col.data(), h.data(), n, K, x.data(), f.data(), yc.data());
-        std::vector<float> columns(x.size(), 0.0f);
-        for (int j = 0; j < n; ++j) {
-            bool zero = true;
-            for (int k = 0; k < K; ++k) zero = zero && x[std::size_t(j * K + k)] == 0.0f;
-            if (zero) continue;
-            for (std::uint32_t e = start[std::size_t(j)]; e < start[std::size_t(j) + 1]; ++e)
-                for (int k = 0; k < K; ++k)
-                    columns[std::size_t(col[e] * K + k)] -=
-                        float(value[e * std::size_t(K) + std::size_t(k)]) * x[std::size_t(j * K + k)];
-        }
-        for (int i = 0; i < n; ++i)
-            for (int k = 0; k < K; ++k) {
-                float a[4] = {};
-                long double exact = 0, size = 0;
-                for (std::uint32_t e = start[std::size_t(i)]; e < start[std::size_t(i) + 1]; ++e) {
-                    const double w = value[e * std::size_t(K) + std::size_t(k)];
-                    const float xv = x[std::size_t(col[e] * K + k)];
-                    a[(e - start[std::size_t(i)]) % 4] += float(w) * xv;
-                    exact += static_cast<long double>(w) * xv, size += std::abs(static_cast<long double>(w) * xv);
-                }
-                const auto at = std::size_t(i * K + k);
-                EXPECT_EQ(y[at], f[std::size_t(k)] * ((a[0] + a[1]) + (a[2] + a[3]))) << "K " << K << " row " << i;
-                EXPECT_NEAR(y[at], double(f[std::size_t(k)] * exact), double(1e-6L * size))
-                    << "K " << K << " row " << i;
-                EXPECT_EQ(yc[at], f[std::size_t(k)] * columns[at]) << "K " << K << " column " << i;
+        struct Tiling {
+            int block, panel;
+        };
+        for (const Tiling tiling : {Tiling{64, 512}, Tiling{7, 16}, Tiling{13, 29}, Tiling{1, 1}, Tiling{64, 89}}) {
+            const kernels::HalfTiles tiles(start.data(), col.data(), h.data(), n, K, tiling.block, tiling.panel);
+            ASSERT_EQ(tiles.col.size(), col.size());
+            kernels::half_rows(tiles, x.data(), f.data(), y.data());
+            kernels::half_columns(tiles, x.data(), f.data(), yc.data());
+            std::vector<float> columns(x.size(), 0.0f);
+            for (int j = 0; j < n; ++j) {
+                bool zero = true;
+                for (int k = 0; k < K; ++k) zero = zero && x[std::size_t(j * K + k)] == 0.0f;
+                if (zero) continue;
+                for (std::uint32_t e = start[std::size_t(j)]; e < start[std::size_t(j) + 1]; ++e)
+                    for (int k = 0; k < K; ++k)
+                        columns[std::size_t(col[e] * K + k)] -=
+                            float(value[e * std::size_t(K) + std::size_t(k)]) * x[std::size_t(j * K + k)];
             }
+            for (int i = 0; i < n; ++i)
+                for (int k = 0; k < K; ++k) {
+                    float a[4] = {};
+                    long double exact = 0, size = 0;
+                    for (std::uint32_t e = start[std::size_t(i)]; e < start[std::size_t(i) + 1]; ++e) {
+                        const double w = value[e * std::size_t(K) + std::size_t(k)];
+                        const float xv = x[std::size_t(col[e] * K + k)];
+                        a[(e - start[std::size_t(i)]) % 4] += float(w) * xv;
+                        exact += static_cast<long double>(w) * xv, size += std::abs(static_cast<long double>(w) * xv);
+                    }
+                    const auto at = std::size_t(i * K + k);
+                    EXPECT_EQ(y[at], f[std::size_t(k)] * ((a[0] + a[1]) + (a[2] + a[3]))) << "K " << K << " row " << i;
+                    EXPECT_NEAR(y[at], double(f[std::size_t(k)] * exact), double(1e-6L * size))
+                        << "K " << K << " row " << i;
+                    EXPECT_EQ(yc[at], f[std::size_t(k)] * columns[at]) << "K " << K << " column " << i;
+                }
+        }
     }
+    const std::uint32_t start[] = {0, 1};
+    const std::uint16_t col[] = {1}, h[] = {0};
+    EXPECT_THROW(kernels::HalfTiles(start, col, h, 1, 1), std::invalid_argument);  // column 1 of 1 row
+    EXPECT_THROW(kernels::HalfTiles(start, col, h, 2, 1, 65, 512), std::invalid_argument);
 }
 
 // The packed copy keeps an entry where any direction keeps it (|w| > prune·max|W_rec[k]|, counted here), holds each

@@ -2,6 +2,8 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "bvc3d/core/simd.hpp"
 
@@ -30,38 +32,48 @@ inline double row_sum(const std::uint16_t* col, const float* w, std::uint32_t co
 // A binary16's value: exact (every half is a float), so any conversion gives these bits.
 inline float half_value(std::uint16_t bits) { return static_cast<float>(Eigen::numext::bit_cast<Eigen::half>(bits)); }
 
-constexpr int max_directions = 64;  // AdjacencyParams::n_hd's limit
+constexpr int max_block = 64;  // rows of a tile: the vectorised form keeps their accumulators on the stack
 
 // The packed products, one (row, direction) at a time: what every instruction set computes.
-void half_rows_each(const std::uint32_t* start, const std::uint16_t* col, const std::uint16_t* h, int rows, int K,
-                    const float* x, const float* f, float* y) {
-    float acc[4][max_directions];
-    for (int i = 0; i < rows; ++i) {
-        for (auto& a : acc) std::fill(a, a + K, 0.0f);
-        for (std::uint32_t e = start[i]; e < start[i + 1]; ++e) {
-            float* a = acc[(e - start[i]) % 4];
-            const float* xr = x + std::size_t(col[e]) * std::size_t(K);
-            for (int k = 0; k < K; ++k) a[k] += half_value(h[std::size_t(e) * std::size_t(K) + std::size_t(k)]) * xr[k];
+void half_rows_each(const HalfTiles& t, const float* x, const float* f, float* y) {
+    const auto K = std::size_t(t.K);
+    std::vector<float> acc(std::size_t(t.block) * 4 * K);  // row r of the block, accumulator q: acc[(4r + q)·K + k]
+    std::size_t s = 0;
+    for (int b0 = 0; b0 < t.rows; b0 += t.block) {
+        const int rb = std::min(t.block, t.rows - b0);
+        std::fill(acc.begin(), acc.end(), 0.0f);
+        for (int p = 0; p < t.panels; ++p)
+            for (int r = 0; r < rb; ++r, ++s)
+                for (std::uint32_t e = t.start[s]; e < t.start[s + 1]; ++e) {
+                    float* a = &acc[(4 * std::size_t(r) + (t.phase[s] + e - t.start[s]) % 4) * K];
+                    const float* xr = x + std::size_t(t.col[e]) * K;
+                    for (std::size_t k = 0; k < K; ++k) a[k] += half_value(t.h[std::size_t(e) * K + k]) * xr[k];
+                }
+        for (int r = 0; r < rb; ++r) {
+            const float* a = &acc[4 * std::size_t(r) * K];
+            for (std::size_t k = 0; k < K; ++k)
+                y[std::size_t(b0 + r) * K + k] = f[k] * ((a[k] + a[K + k]) + (a[2 * K + k] + a[3 * K + k]));
         }
-        for (int k = 0; k < K; ++k)
-            y[std::size_t(i) * std::size_t(K) + std::size_t(k)] =
-                f[k] * ((acc[0][k] + acc[1][k]) + (acc[2][k] + acc[3][k]));
     }
 }
 
-void half_columns_each(const std::uint32_t* start, const std::uint16_t* col, const std::uint16_t* h, int rows, int K,
-                       const float* x, const float* f, float* y) {
-    std::fill(y, y + std::size_t(rows) * std::size_t(K), 0.0f);
-    for (int j = 0; j < rows; ++j) {
-        const float* xr = x + std::size_t(j) * std::size_t(K);
-        if (std::all_of(xr, xr + K, [](float v) { return v == 0.0f; })) continue;
-        for (std::uint32_t e = start[j]; e < start[j + 1]; ++e) {
-            float* yr = y + std::size_t(col[e]) * std::size_t(K);
-            for (int k = 0; k < K; ++k)
-                yr[k] -= half_value(h[std::size_t(e) * std::size_t(K) + std::size_t(k)]) * xr[k];
-        }
+void half_columns_each(const HalfTiles& t, const float* x, const float* f, float* y) {
+    const auto K = std::size_t(t.K);
+    std::fill(y, y + std::size_t(t.rows) * K, 0.0f);
+    std::size_t s = 0;
+    for (int b0 = 0; b0 < t.rows; b0 += t.block) {
+        const int rb = std::min(t.block, t.rows - b0);
+        for (int p = 0; p < t.panels; ++p)
+            for (int r = 0; r < rb; ++r, ++s) {
+                const float* xr = x + std::size_t(b0 + r) * K;
+                if (std::all_of(xr, xr + K, [](float v) { return v == 0.0f; })) continue;
+                for (std::uint32_t e = t.start[s]; e < t.start[s + 1]; ++e) {
+                    float* yr = y + std::size_t(t.col[e]) * K;
+                    for (std::size_t k = 0; k < K; ++k) yr[k] -= half_value(t.h[std::size_t(e) * K + k]) * xr[k];
+                }
+            }
     }
-    for (std::size_t o = 0; o < std::size_t(rows) * std::size_t(K); ++o) y[o] = f[o % std::size_t(K)] * y[o];
+    for (std::size_t o = 0; o < std::size_t(t.rows) * K; ++o) y[o] = f[o % K] * y[o];
 }
 
 #if BVC3D_HAVE_DISPATCH
@@ -70,44 +82,62 @@ BVC3D_TARGET_V3 inline __m256 half_times(const std::uint16_t* h, const float* x)
     return _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(h))), _mm256_loadu_ps(x));
 }
 
-BVC3D_TARGET_V3 void half_rows_v3(const std::uint32_t* start, const std::uint16_t* col, const std::uint16_t* h,
-                                  int rows, const float* x, const float* f, float* y) {
+// One segment of a row into its four accumulators, entry o of the segment into a[o mod 4].
+BVC3D_TARGET_V3 inline void half_segment_v3(const HalfTiles& t, std::size_t s, const float* x, __m256 a[4]) {
+    const std::uint16_t* col = t.col.data();
+    const std::uint16_t* h = t.h.data();
+    std::uint32_t e = t.start[s];
+    const std::uint32_t end = t.start[s + 1];
+    for (; e + 4 <= end; e += 4)
+        for (std::uint32_t q = 0; q < 4; ++q)
+            a[q] = _mm256_add_ps(a[q], half_times(h + 8 * std::size_t(e + q), x + 8 * std::size_t(col[e + q])));
+    for (std::uint32_t q = 0; e + q < end; ++q)
+        a[q] = _mm256_add_ps(a[q], half_times(h + 8 * std::size_t(e + q), x + 8 * std::size_t(col[e + q])));
+}
+
+BVC3D_TARGET_V3 void half_rows_v3(const HalfTiles& t, const float* x, const float* f, float* y) {
     const __m256 fv = _mm256_loadu_ps(f);
-    for (int i = 0; i < rows; ++i) {
-        __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
-        std::uint32_t e = start[i];
-        const std::uint32_t end = start[i + 1];
-        for (; e + 4 <= end; e += 4) {
-            a0 = _mm256_add_ps(a0, half_times(h + 8 * std::size_t(e), x + 8 * std::size_t(col[e])));
-            a1 = _mm256_add_ps(a1, half_times(h + 8 * std::size_t(e + 1), x + 8 * std::size_t(col[e + 1])));
-            a2 = _mm256_add_ps(a2, half_times(h + 8 * std::size_t(e + 2), x + 8 * std::size_t(col[e + 2])));
-            a3 = _mm256_add_ps(a3, half_times(h + 8 * std::size_t(e + 3), x + 8 * std::size_t(col[e + 3])));
+    alignas(32) float acc[max_block][4][8];  // row r of the block, accumulator q (o mod 4)
+    std::size_t s = 0;
+    for (int b0 = 0; b0 < t.rows; b0 += t.block) {
+        const int rb = std::min(t.block, t.rows - b0);
+        std::fill(&acc[0][0][0], &acc[0][0][0] + 32 * rb, 0.0f);
+        for (int p = 0; p < t.panels; ++p)
+            for (int r = 0; r < rb; ++r, ++s) {
+                if (t.start[s] == t.start[s + 1]) continue;
+                const unsigned ph = t.phase[s];
+                __m256 a[4];
+                for (unsigned q = 0; q < 4; ++q) a[q] = _mm256_load_ps(acc[r][(ph + q) % 4]);
+                half_segment_v3(t, s, x, a);
+                for (unsigned q = 0; q < 4; ++q) _mm256_store_ps(acc[r][(ph + q) % 4], a[q]);
+            }
+        for (int r = 0; r < rb; ++r) {
+            const __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_load_ps(acc[r][0]), _mm256_load_ps(acc[r][1])),
+                                             _mm256_add_ps(_mm256_load_ps(acc[r][2]), _mm256_load_ps(acc[r][3])));
+            _mm256_storeu_ps(y + 8 * std::size_t(b0 + r), _mm256_mul_ps(fv, sum));
         }
-        if (e < end) a0 = _mm256_add_ps(a0, half_times(h + 8 * std::size_t(e), x + 8 * std::size_t(col[e])));
-        if (e + 1 < end)
-            a1 = _mm256_add_ps(a1, half_times(h + 8 * std::size_t(e + 1), x + 8 * std::size_t(col[e + 1])));
-        if (e + 2 < end)
-            a2 = _mm256_add_ps(a2, half_times(h + 8 * std::size_t(e + 2), x + 8 * std::size_t(col[e + 2])));
-        _mm256_storeu_ps(y + 8 * std::size_t(i),
-                         _mm256_mul_ps(fv, _mm256_add_ps(_mm256_add_ps(a0, a1), _mm256_add_ps(a2, a3))));
     }
 }
 
-BVC3D_TARGET_V3 void half_columns_v3(const std::uint32_t* start, const std::uint16_t* col, const std::uint16_t* h,
-                                     int rows, const float* x, const float* f, float* y) {
-    std::fill(y, y + 8 * std::size_t(rows), 0.0f);
-    for (int j = 0; j < rows; ++j) {
-        const __m256 xr = _mm256_loadu_ps(x + 8 * std::size_t(j));
-        if (!_mm256_movemask_ps(_mm256_cmp_ps(xr, _mm256_setzero_ps(), _CMP_NEQ_UQ))) continue;
-        for (std::uint32_t e = start[j]; e < start[j + 1]; ++e) {
-            float* yr = y + 8 * std::size_t(col[e]);
-            const __m256 p = _mm256_mul_ps(
-                _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(h + 8 * std::size_t(e)))), xr);
-            _mm256_storeu_ps(yr, _mm256_sub_ps(_mm256_loadu_ps(yr), p));
-        }
+BVC3D_TARGET_V3 void half_columns_v3(const HalfTiles& t, const float* x, const float* f, float* y) {
+    std::fill(y, y + 8 * std::size_t(t.rows), 0.0f);
+    std::size_t s = 0;
+    for (int b0 = 0; b0 < t.rows; b0 += t.block) {
+        const int rb = std::min(t.block, t.rows - b0);
+        for (int p = 0; p < t.panels; ++p)
+            for (int r = 0; r < rb; ++r, ++s) {
+                const __m256 xr = _mm256_loadu_ps(x + 8 * std::size_t(b0 + r));
+                if (!_mm256_movemask_ps(_mm256_cmp_ps(xr, _mm256_setzero_ps(), _CMP_NEQ_UQ))) continue;
+                for (std::uint32_t e = t.start[s]; e < t.start[s + 1]; ++e) {
+                    float* yr = y + 8 * std::size_t(t.col[e]);
+                    const __m256 w =
+                        _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(&t.h[8 * std::size_t(e)])));
+                    _mm256_storeu_ps(yr, _mm256_sub_ps(_mm256_loadu_ps(yr), _mm256_mul_ps(w, xr)));
+                }
+            }
     }
     const __m256 fv = _mm256_loadu_ps(f);
-    for (int i = 0; i < rows; ++i)
+    for (int i = 0; i < t.rows; ++i)
         _mm256_storeu_ps(y + 8 * std::size_t(i), _mm256_mul_ps(fv, _mm256_loadu_ps(y + 8 * std::size_t(i))));
 }
 
@@ -188,20 +218,47 @@ void row_sums16(const std::uint32_t* start, const std::uint16_t* col, const floa
     for (int i = 0; i < rows; ++i) out[i] = scale * row_sum(col + start[i], w + start[i], start[i + 1] - start[i], x);
 }
 
-void half_rows(const std::uint32_t* start, const std::uint16_t* col, const std::uint16_t* h, int rows, int K,
-               const float* x, const float* f, float* y) {
-#if BVC3D_HAVE_DISPATCH
-    if (K == 8 && simd::isa() != simd::Isa::baseline) return half_rows_v3(start, col, h, rows, x, f, y);
-#endif
-    half_rows_each(start, col, h, rows, K, x, f, y);
+HalfTiles::HalfTiles(const std::uint32_t* row_start, const std::uint16_t* row_col, const std::uint16_t* row_h,
+                     int rows_, int K_, int block_, int panel)
+    : rows(rows_), K(K_), block(block_), panels(std::max(1, (rows_ + panel - 1) / std::max(panel, 1))) {
+    if (rows < 0 || K < 1 || block < 1 || block > max_block || panel < 1)
+        throw std::invalid_argument("HalfTiles: " + std::to_string(rows) + " rows, " + std::to_string(K) +
+                                    " weights an entry, blocks of " + std::to_string(block) + " rows (1 to " +
+                                    std::to_string(max_block) + "), panels of " + std::to_string(panel) + " cells");
+    const auto k = std::size_t(K);
+    start.push_back(0);
+    std::vector<std::uint32_t> next(static_cast<std::size_t>(block));  // each row's first entry not yet laid out
+    for (int b0 = 0; b0 < rows; b0 += block) {
+        const int rb = std::min(block, rows - b0);
+        std::copy_n(row_start + b0, rb, next.begin());
+        for (int p = 0; p < panels; ++p)
+            for (int r = 0; r < rb; ++r) {
+                const std::uint32_t end = row_start[b0 + r + 1];
+                phase.push_back(std::uint8_t((next[std::size_t(r)] - row_start[b0 + r]) % 4));
+                for (auto& e = next[std::size_t(r)]; e < end && row_col[e] < (p + 1) * panel; ++e) {
+                    col.push_back(row_col[e]);
+                    h.insert(h.end(), row_h + std::size_t(e) * k, row_h + (std::size_t(e) + 1) * k);
+                }
+                start.push_back(std::uint32_t(col.size()));
+            }
+    }
+    if (col.size() != (rows ? row_start[rows] - row_start[0] : 0) ||
+        std::any_of(col.begin(), col.end(), [&](std::uint16_t c) { return c >= rows; }))
+        throw std::invalid_argument("HalfTiles: a column index not below the " + std::to_string(rows) + " rows");
 }
 
-void half_columns(const std::uint32_t* start, const std::uint16_t* col, const std::uint16_t* h, int rows, int K,
-                  const float* x, const float* f, float* y) {
+void half_rows(const HalfTiles& t, const float* x, const float* f, float* y) {
 #if BVC3D_HAVE_DISPATCH
-    if (K == 8 && simd::isa() != simd::Isa::baseline) return half_columns_v3(start, col, h, rows, x, f, y);
+    if (t.K == 8 && simd::isa() != simd::Isa::baseline) return half_rows_v3(t, x, f, y);
 #endif
-    half_columns_each(start, col, h, rows, K, x, f, y);
+    half_rows_each(t, x, f, y);
+}
+
+void half_columns(const HalfTiles& t, const float* x, const float* f, float* y) {
+#if BVC3D_HAVE_DISPATCH
+    if (t.K == 8 && simd::isa() != simd::Isa::baseline) return half_columns_v3(t, x, f, y);
+#endif
+    half_columns_each(t, x, f, y);
 }
 
 }  // namespace bvc3d::kernels
