@@ -94,6 +94,24 @@ BENCHMARK(BM_DirectionChoice)->ArgsProduct({{250, 1000, 2000}, {0, 4}, {3, 1}})-
 // scales' combination (combine_scales: softmaxes over 8 and 3 numbers), as navigation decides; through the float32
 // sparse copies (Copy = SparseAdjacency) or the packed ones (PackedAdjacency: `adjacency: {rollout_weights:
 // float16}`, one pattern for the 8 directions, 16-bit weights, every direction in one pass).
+// The benchmark's loop: one decision at (-3, -2) a lap, every scale's rollouts through its copy and the scales'
+// combination, as navigation decides.
+template <class Copy>
+void decide(benchmark::State& state, const std::vector<const Learned*>& scales, const std::vector<Copy>& copies,
+            const RewardParams& p) {
+    std::vector<std::vector<double>> v;
+    for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
+    const std::vector<char> allowed(8, 1);
+    std::vector<std::vector<double>> returns(scales.size());
+    std::vector<double> scores;
+    for (auto _ : state) {
+        for (std::size_t s = 0; s < scales.size(); ++s)
+            returns[s] = direction_returns(copies[s], scales[s]->w, v[s], p);
+        benchmark::DoNotOptimize(combine_scales(returns, allowed, p, scores));
+    }
+    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 template <class Copy>
 void BM_DirectionChoiceMultiscale(benchmark::State& state) {
     std::vector<const Learned*> scales;
@@ -105,18 +123,7 @@ void BM_DirectionChoiceMultiscale(benchmark::State& state) {
         bytes += copies.back().bytes(), entries += double(copies.back().entries());
         dense += HdAdjacency::bytes(n, 8);
     }
-    std::vector<std::vector<double>> v;
-    for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
-    const RewardParams p = rollout_of(state);
-    const std::vector<char> allowed(8, 1);
-    std::vector<std::vector<double>> returns(scales.size());
-    std::vector<double> scores;
-    for (auto _ : state) {
-        for (std::size_t s = 0; s < scales.size(); ++s)
-            returns[s] = direction_returns(copies[s], scales[s]->w, v[s], p);
-        benchmark::DoNotOptimize(combine_scales(returns, allowed, p, scores));
-    }
-    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+    decide(state, scales, copies, rollout_of(state));
     state.counters["MB"] = bytes / 1e6;
     state.counters["entries"] = entries;
     state.counters["dense_MB"] = dense / 1e6;
@@ -141,18 +148,7 @@ void BM_DirectionChoiceTiles(benchmark::State& state) {
         scales.push_back(&learned(n));
         copies.emplace_back(scales.back()->adj, 0.01, panel);
     }
-    std::vector<std::vector<double>> v;
-    for (const Learned* l : scales) v.push_back(l->fields.rates(-3, -2, l->width));
-    const RewardParams p;
-    const std::vector<char> allowed(8, 1);
-    std::vector<std::vector<double>> returns(scales.size());
-    std::vector<double> scores;
-    for (auto _ : state) {
-        for (std::size_t s = 0; s < scales.size(); ++s)
-            returns[s] = direction_returns(copies[s], scales[s]->w, v[s], p);
-        benchmark::DoNotOptimize(combine_scales(returns, allowed, p, scores));
-    }
-    state.counters["decisions/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+    decide(state, scales, copies, RewardParams{});
 }
 BENCHMARK(BM_DirectionChoiceTiles)->Arg(512)->Arg(65536)->Unit(benchmark::kMicrosecond);
 

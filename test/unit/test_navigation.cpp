@@ -283,6 +283,9 @@ TEST(PackedAdjacency, KernelsAddInAFixedOrder) {
     const std::uint16_t col[] = {1}, h[] = {0};
     EXPECT_THROW(kernels::HalfTiles(start, col, h, 1, 1), std::invalid_argument);  // column 1 of 1 row
     EXPECT_THROW(kernels::HalfTiles(start, col, h, 2, 1, 65, 512), std::invalid_argument);
+    const std::uint32_t pair_start[] = {0, 2, 2};
+    const std::uint16_t twice[] = {1, 1}, pair_h[] = {0, 0};
+    EXPECT_THROW(kernels::HalfTiles(pair_start, twice, pair_h, 2, 1), std::invalid_argument);  // not ascending
 }
 
 // The packed copy keeps an entry where any direction keeps it (|w| > prune·max|W_rec[k]|, counted here), holds each

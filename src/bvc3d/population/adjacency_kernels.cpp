@@ -225,6 +225,12 @@ HalfTiles::HalfTiles(const std::uint32_t* row_start, const std::uint16_t* row_co
         throw std::invalid_argument("HalfTiles: " + std::to_string(rows) + " rows, " + std::to_string(K) +
                                     " weights an entry, blocks of " + std::to_string(block) + " rows (1 to " +
                                     std::to_string(max_block) + "), panels of " + std::to_string(panel) + " cells");
+    for (int i = 0; i < rows; ++i)
+        for (std::uint32_t e = row_start[i]; e < row_start[i + 1]; ++e)
+            if (row_col[e] >= rows || (e > row_start[i] && row_col[e] <= row_col[e - 1]))
+                throw std::invalid_argument("HalfTiles: row " + std::to_string(i) + "'s column " +
+                                            std::to_string(row_col[e]) + " not ascending below the " +
+                                            std::to_string(rows) + " rows");
     const auto k = std::size_t(K);
     start.push_back(0);
     std::vector<std::uint32_t> next(static_cast<std::size_t>(block));  // each row's first entry not yet laid out
@@ -242,9 +248,6 @@ HalfTiles::HalfTiles(const std::uint32_t* row_start, const std::uint16_t* row_co
                 start.push_back(std::uint32_t(col.size()));
             }
     }
-    if (col.size() != (rows ? row_start[rows] - row_start[0] : 0) ||
-        std::any_of(col.begin(), col.end(), [&](std::uint16_t c) { return c >= rows; }))
-        throw std::invalid_argument("HalfTiles: a column index not below the " + std::to_string(rows) + " rows");
 }
 
 void half_rows(const HalfTiles& t, const float* x, const float* f, float* y) {
