@@ -84,7 +84,7 @@ BVC3D_TARGET_V3 inline __m256 half_times(const std::uint16_t* h, const float* x)
 }
 
 // The weights are fetched this many entries (4 KB) ahead of their use: measured on Zen 4, the row products took
-// 0.72–0.80 × the time with it (16–64 entries ahead gave 0.9–1.0 ×, 1 024 and more a little less than 256;
+// 0.69–0.80 × the time with it (16–64 entries ahead: 0.88–0.98 ×; 512 and more: a little slower than 256;
 // docs/performance.md). A prefetch never faults: past the end it fetches a line for nothing (the address is formed
 // as an integer, not as a pointer past the array).
 constexpr std::size_t prefetch_entries = 256;
