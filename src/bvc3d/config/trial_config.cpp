@@ -83,7 +83,8 @@ const params::Table<Protocol>& Protocol::table() {
 
 void Protocol::validate() const {
     table().check(*this);
-    if (records() && !(sample_hours > 0)) table().fail("sample_hours", "must be more than 0 (a phase that records)");
+    if (records() && !(sample_hours > 0))
+        table().fail("sample_hours", "must be in (0, " + format_number(max_agent_hours) + "] (0 only for kind learn)");
 }
 
 double Protocol::seconds() const {
