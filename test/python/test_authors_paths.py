@@ -134,3 +134,18 @@ def test_oriented_rectangles_block_the_cells_inside_them_grown():
     on_line = np.abs(xs - ys) / math.sqrt(2)
     along = np.abs(xs + ys) / math.sqrt(2)
     assert np.array_equal(blocked, (on_line <= 0.7) & (along <= 4.0))
+
+
+@pytest.mark.parametrize("name, rects", [("authors-cross", CROSS), ("authors-maze", MAZE), ("authors-open", [])])
+def test_the_world_files_hold_the_planners_rectangles_inside_their_outer_walls(source_dir, name, rects):
+    import yaml
+
+    world = yaml.safe_load((source_dir / "configs" / "worlds" / f"{name}.yaml").read_text())
+    boxes = [o["box"] for o in world["objects"] if "box" in o]
+    outer, inner = boxes[:4], boxes[4:]
+    # The outer walls: 0.3 m thick, centred on ±10 m, so the walkable square ends at their inner faces, ±9.85 m.
+    assert sorted((abs(b["center"][0]) + abs(b["center"][1]), min(b["size"][:2])) for b in outer) == [(10, 0.3)] * 4
+    assert world["walkable"]["rect"] == [-9.85, -9.85, 9.85, 9.85]
+    footprints = [((b["center"][0] - b["size"][0] / 2, b["center"][1] - b["size"][1] / 2),
+                   (b["center"][0] + b["size"][0] / 2, b["center"][1] + b["size"][1] / 2)) for b in inner]
+    assert np.allclose(np.array(footprints, dtype=float).reshape(-1, 4), np.array(rects, dtype=float).reshape(-1, 4))
