@@ -280,3 +280,77 @@ def test_bag_info_reads_the_index_not_the_chunks(tmp_path, cli):
     bad = cli("replay", "--bag", tmp_path / "spoiled.mcap", "--cloud-topic", "/points", "--pose-topic", "/odom",
               "--model", "2d", "--out", tmp_path / "r.h5")
     assert bad.returncode == 2 and f"chunk {len(chunk_starts) - 1}" in bad.stderr
+
+
+def sqlite_folder(tmp_path, name="bag", storage_format="cdr"):
+    msgs, expected, poses = messages()
+    topics = [(1, "/points", "sensor_msgs/msg/PointCloud2"), (2, "/odom", "nav_msgs/msg/Odometry")]
+    bw.ros2_sqlite(tmp_path / name, topics, [(c + 1, t, d) for c, t, d in msgs], storage_format)
+    return tmp_path / name, expected, poses
+
+
+def test_rosbag2_zstd_file_and_message_compression(tmp_path, cli):
+    folder, expected, poses = sqlite_folder(tmp_path, "file")
+    db = folder / "bag_0.db3"
+    subprocess.run(["zstd", "-q", "--rm", "-o", f"{db}.zstd", str(db)], check=True)  # rosbag2's name
+    meta = (folder / "metadata.yaml").read_text().replace("- bag_0.db3", "- bag_0.db3.zstd")
+    (folder / "metadata.yaml").write_text(meta + "  compression_format: zstd\n  compression_mode: FILE\n")
+    check_recording(bvc3d.Recording.open_bag(folder, "/points", pose_topic="/odom"), expected, poses)
+    assert "files compressed with zstd" in cli("bag-info", folder, check=True).stdout
+
+    folder, expected, poses = sqlite_folder(tmp_path, "message")
+    con = sqlite3.connect(folder / "bag_0.db3")
+    for row, data in con.execute("SELECT id, data FROM messages").fetchall():
+        packed = subprocess.run(["zstd", "-q", "-c"], input=bytes(data), capture_output=True, check=True).stdout
+        con.execute("UPDATE messages SET data = ? WHERE id = ?", (packed, row))
+    con.commit()
+    con.close()
+    meta = (folder / "metadata.yaml").read_text()
+    (folder / "metadata.yaml").write_text(meta + "  compression_format: zstd\n  compression_mode: MESSAGE\n")
+    check_recording(bvc3d.Recording.open_bag(folder, "/points", pose_topic="/odom"), expected, poses)
+
+    (folder / "metadata.yaml").write_text(meta + "  compression_format: lz4\n  compression_mode: MESSAGE\n")
+    bad = cli("bag-info", folder)
+    assert bad.returncode == 2 and "lz4" in bad.stderr and "metadata.yaml" in bad.stderr
+
+
+def test_unknown_serialization_is_one_rule_for_sqlite_and_mcap(tmp_path, cli):
+    """rosbag2's wrong_rmw_test: metadata.yaml and the storage name another serialization than cdr. The
+    bag is listed (with that format), and a topic of it is refused when read, whatever the storage."""
+    sq, _, _ = sqlite_folder(tmp_path, "sqlite", storage_format="wrong_format")
+    mc = tmp_path / "mcap"
+    mc.mkdir()
+    msgs, _, _ = messages()
+    bw.mcap(mc / "bag_0.mcap", CHANNELS, msgs)
+    (mc / "metadata.yaml").write_text((sq / "metadata.yaml").read_text().replace("sqlite3", "mcap")
+                                      .replace("bag_0.db3", "bag_0.mcap"))
+    for folder in (sq, mc):
+        info = cli("bag-info", folder)
+        assert info.returncode == 0, info.stderr
+        assert "wrong_format" in info.stdout
+        bad = cli("replay", "--bag", folder, "--cloud-topic", "/points", "--pose-topic", "/odom", "--model", "2d",
+                  "--out", tmp_path / "r.h5")
+        assert bad.returncode == 2 and "unknown message encoding 'wrong_format'" in bad.stderr, bad.stderr
+
+
+def test_storage_without_metadata(tmp_path, cli):
+    folder, expected, poses = sqlite_folder(tmp_path)
+    # A bare .db3: read from itself.
+    check_recording(bvc3d.Recording.open_bag(folder / "bag_0.db3", "/points", pose_topic="/odom"), expected, poses)
+    # A folder that lost its metadata.yaml: read from its storage files, as `ros2 bag reindex` would.
+    (folder / "metadata.yaml").unlink()
+    check_recording(bvc3d.Recording.open_bag(folder, "/points", pose_topic="/odom"), expected, poses)
+    # A folder with neither: what is missing, said.
+    (tmp_path / "empty").mkdir()
+    bad = cli("bag-info", tmp_path / "empty")
+    assert bad.returncode == 2 and "without metadata.yaml and without .db3 or .mcap files" in bad.stderr
+    subprocess.run(["zstd", "-q", "--rm", "-o", str(folder / "bag_0.db3.zstd"), str(folder / "bag_0.db3")],
+                   check=True)
+    bad = cli("bag-info", folder)
+    assert bad.returncode == 2 and "bag_0.db3.zstd" in bad.stderr and "compressed" in bad.stderr
+
+
+def test_ros1_bag_format_1_2_is_named(tmp_path, cli):
+    (tmp_path / "old.bag").write_bytes(b"#ROSRECORD V1.2\n" + bytes(100))
+    bad = cli("bag-info", tmp_path / "old.bag")
+    assert bad.returncode == 2 and "ROS 1 bag format 1.2 is not supported" in bad.stderr
