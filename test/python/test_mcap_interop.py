@@ -250,6 +250,15 @@ def test_zstd_chunk_of_zeros_is_read(tmp_path, cli):
     crafted(tmp_path / "lying.mcap", [lying])
     bad = cli("bag-info", tmp_path / "lying.mcap")
     assert bad.returncode == 2 and "chunk 0" in bad.stderr and "declared" in bad.stderr
+    # A frame that does not say its size, in a chunk that claims 8 GB: refused as the data runs out, with no
+    # 8 GB buffer allocated first (the buffer grows with what the data holds).
+    bare = subprocess.run(["zstd", "-q", "-c", "--no-content-size"], input=inner, capture_output=True,
+                          check=True).stdout
+    huge = bw.record(0x06, struct.pack("<QQQI", 10, 10, 8 << 30, zlib.crc32(inner)) + bw._s("zstd") +
+                     struct.pack("<Q", len(bare)) + bare)
+    crafted(tmp_path / "huge.mcap", [huge])
+    bad = cli("bag-info", tmp_path / "huge.mcap", timeout=60)
+    assert bad.returncode == 2 and "chunk 0" in bad.stderr and "declared" in bad.stderr
 
 
 def test_bag_info_reads_the_index_not_the_chunks(tmp_path, cli):

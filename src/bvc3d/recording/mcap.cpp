@@ -177,6 +177,14 @@ struct ChunkIndex {
     std::vector<std::pair<std::uint16_t, std::uint64_t>> message_indexes;  // channel, Message Index offset
 };
 
+// Room for more decompressed bytes, up to the declared size: the buffer grows with what the data
+// really holds (doubling from 1 MB), so a corrupt declared size costs nothing until data fills it.
+void grow(std::vector<std::uint8_t>& out, std::size_t produced, std::uint64_t declared) {
+    if (produced < out.size() || out.size() >= declared) return;
+    out.resize(
+        static_cast<std::size_t>(std::min<std::uint64_t>(declared, std::max<std::size_t>(out.size() * 2, 1u << 20))));
+}
+
 class McapBag : public BagReader {
 public:
     explicit McapBag(const fs::path& file) : BagReader(file), file_(file) {
@@ -226,9 +234,9 @@ private:
 
     std::vector<std::uint8_t> decompress(const Chunk& c, std::size_t index) const {
         const std::string what = quoted_path(path()) + ", chunk " + std::to_string(index);
-        // The chunk declares its uncompressed size: the buffer is that size (if the machine has the
-        // memory), and data that decompresses to more or less is refused. No ratio is assumed: zstd
-        // packs 4 MB of zeros into ~150 bytes.
+        // The chunk declares its uncompressed size: the buffer grows up to that size (if the machine has
+        // the memory) as the data fills it, and data that decompresses to more or less is refused. No
+        // ratio is assumed: zstd packs 4 MB of zeros into ~150 bytes.
         if (c.uncompressed_size > std::numeric_limits<std::size_t>::max() / 2)
             throw InputError(what + ": an uncompressed size of " + std::to_string(c.uncompressed_size) +
                              " bytes is not believable (corrupt)");
@@ -251,24 +259,34 @@ private:
                     framed != c.uncompressed_size)
                     throw InputError(what + ": its zstd frame holds " + std::to_string(framed) + " bytes where " +
                                      std::to_string(c.uncompressed_size) + " are declared");
-                out.resize(c.uncompressed_size);
-                const std::size_t n = ZSTD_decompress(out.data(), out.size(), src, c.size);
-                if (ZSTD_isError(n))
-                    throw InputError(what + ": zstd cannot decompress it into the " +
-                                     std::to_string(c.uncompressed_size) + " bytes declared (" + ZSTD_getErrorName(n) +
-                                     ")");
-                if (n != c.uncompressed_size)
-                    throw InputError(what + ": decompresses to " + std::to_string(n) + " bytes where " +
+                std::unique_ptr<ZSTD_DStream, std::size_t (*)(ZSTD_DStream*)> z(ZSTD_createDStream(), ZSTD_freeDStream);
+                ZSTD_initDStream(z.get());
+                ZSTD_inBuffer in{src, c.size, 0};
+                std::size_t produced = 0, left = 1;
+                for (;;) {
+                    grow(out, produced, c.uncompressed_size);
+                    ZSTD_outBuffer o{out.data(), out.size(), produced};
+                    const std::size_t before = in.pos;
+                    left = ZSTD_decompressStream(z.get(), &o, &in);
+                    if (ZSTD_isError(left))
+                        throw InputError(what + ": zstd cannot decompress it (" + ZSTD_getErrorName(left) + ")");
+                    const bool progress = o.pos > produced || in.pos > before;
+                    produced = o.pos;
+                    if ((left == 0 && in.pos == in.size) || !progress) break;
+                }
+                if (left != 0 || in.pos != in.size || produced != c.uncompressed_size)
+                    throw InputError(what + ": decompresses to " + std::to_string(produced) +
+                                     (in.pos != in.size ? "+" : "") + " bytes where " +
                                      std::to_string(c.uncompressed_size) + " are declared");
                 break;
             }
             case McapCompression::lz4: {
-                out.resize(c.uncompressed_size);
                 LZ4F_dctx* ctx = nullptr;
                 if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION)))
                     throw std::runtime_error("lz4: no decompression context");
                 std::size_t produced = 0, consumed = 0, hint = 1;
                 while (hint != 0 && consumed < c.size) {
+                    grow(out, produced, c.uncompressed_size);
                     std::size_t dst = out.size() - produced, src_n = c.size - consumed;
                     hint = LZ4F_decompress(ctx, out.data() + produced, &dst, src + consumed, &src_n, nullptr);
                     if (LZ4F_isError(hint)) {
@@ -281,6 +299,7 @@ private:
                     if (dst == 0 && src_n == 0) break;  // no progress: the output is full
                 }
                 LZ4F_freeDecompressionContext(ctx);
+                out.resize(produced);
                 if (hint != 0 || produced != c.uncompressed_size)
                     throw InputError(what + ": decompresses to " + std::to_string(produced) + (hint != 0 ? "+" : "") +
                                      " bytes where " + std::to_string(c.uncompressed_size) + " are declared");
