@@ -18,6 +18,7 @@
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/parallel.hpp"
 #include "bvc3d/experiment/navigation.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -287,7 +288,7 @@ void navigate_command(const NavigateOptions& o) {
     for (std::size_t m = 0; m < models.size(); ++m)
         for (int k = 0; k < plan.seeds; ++k) results.push_back({m, plan.first_seed + std::uint64_t(k), {}});
     // Each learning run depends on its model and seed alone: --jobs of them at once write the same files as one.
-    run_in_parallel(results.size(), o.run.jobs, [&](std::size_t t) {
+    parallel_for(results.size(), o.run.jobs, [&](std::size_t t) {
         Done& d = results[t];
         const std::string prefix = models.size() > 1 ? label_of(plan.models[d.model]) : "";
         const std::string name = (prefix.empty() ? "" : prefix + " ") + "seed " + std::to_string(d.seed);
