@@ -30,7 +30,7 @@ std::uint64_t text_hash(const std::string& s) {
 
 WorldDescription WorldSpec::resolve() const {
     if (is_none()) throw InputError("this trial has no world (its returns are recorded data)");
-    return config::resolve_world(source, tilt_deg, lean);
+    return config::resolve_world(source, tilt_deg, lean, missing_models);
 }
 
 std::string WorldSpec::label() const {
@@ -58,6 +58,7 @@ std::string WorldSpec::fingerprint() const {
     };
     std::string fp = "file " + std::filesystem::path(source).filename().string() + " " + file_hash(source);
     for (const auto& mesh : config::world_file_meshes(source)) fp += " mesh " + file_hash(mesh);
+    if (missing_models == config::MissingModels::skip) fp += " missing-models skip";  // absent at the default
     return fp;
 }
 

@@ -399,7 +399,7 @@ void Loader::check_errors(const sdf::Errors& errors, const std::vector<std::stri
             }
             fail(at, "model '" + uri + "' was not found on the model path (" + join(model_path_, ", ") +
                          "): add its folder to model_path or GAZEBO_MODEL_PATH, or leave missing models out "
-                         "(missing_models: skip)");
+                         "(missing_models: skip; on the command line --missing-models skip)");
         }
         fatal.push_back(&e);
     }
