@@ -21,14 +21,12 @@ double quantile(std::vector<double> v, double q) {
 
 namespace {
 
-std::string num(double v) { return format_number(v); }
-
 // "x,y" or "x,y,z" of point i of `v` (points of `dims` numbers).
 std::string point(const std::vector<double>& v, std::size_t i, int dims) {
     std::string s;
     for (int d = 0; d < dims; ++d) {
         if (d) s += ',';
-        s += num(v[i * std::size_t(dims) + std::size_t(d)]);
+        s += format_number(v[i * std::size_t(dims) + std::size_t(d)]);
     }
     return s;
 }
@@ -84,25 +82,26 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
         const NavigationRecord& r = t.record;
         const std::string who = t.model + ',' + std::to_string(t.seed);
         for (std::size_t g = 0; g < r.n_goals(); ++g) {
-            learning.stream() << who << ',' << num(r.learn_s) << ',' << num(r.coverage) << ',' << g << ','
-                              << r.visits[g] << ',' << r.goal_cells[g] << '\n';
+            learning.stream() << who << ',' << format_number(r.learn_s) << ',' << format_number(r.coverage) << ',' << g
+                              << ',' << r.visits[g] << ',' << r.goal_cells[g] << '\n';
             Cell& c = cell_of(t, g);
             c.learn_s.push_back(r.learn_s);
             ++c.seeds;
             const std::size_t n_points = r.map_points.size() / 2;
             for (std::size_t k = 0; k < n_points; ++k)
                 maps.stream() << who << ',' << g << ',' << point(r.map_points, k, 2) << ','
-                              << num(r.map_reward[g * n_points + k]) << '\n';
+                              << format_number(r.map_reward[g * n_points + k]) << '\n';
         }
         for (std::size_t i = 0; i < r.n_starts(); ++i) {
             const auto g = std::size_t(r.start_goal[i]);
             const auto goal = goal_of(r, g);
             const double ratio = r.path_m[i] / r.shortest_m[i];
-            starts.stream() << t.world << ',' << who << ',' << num(goal[0]) << ',' << num(goal[1]) << ','
-                            << num(r.start[i * std::size_t(dims)]) << ',' << num(r.start[i * std::size_t(dims) + 1])
-                            << ',' << r.success[i] << ',' << num(r.path_m[i]) << ',' << num(r.shortest_m[i]) << ','
-                            << num(ratio) << ',' << num(r.time_s[i]);
-            if (flying) starts.stream() << ',' << num(goal[2]) << ',' << num(r.start[i * 3 + 2]);
+            starts.stream() << t.world << ',' << who << ',' << format_number(goal[0]) << ',' << format_number(goal[1])
+                            << ',' << format_number(r.start[i * std::size_t(dims)]) << ','
+                            << format_number(r.start[i * std::size_t(dims) + 1]) << ',' << r.success[i] << ','
+                            << format_number(r.path_m[i]) << ',' << format_number(r.shortest_m[i]) << ','
+                            << format_number(ratio) << ',' << format_number(r.time_s[i]);
+            if (flying) starts.stream() << ',' << format_number(goal[2]) << ',' << format_number(r.start[i * 3 + 2]);
             starts.stream() << '\n';
             for (std::uint64_t k = r.path_start[i]; k < r.path_start[i + 1]; ++k)
                 paths.stream() << who << ',' << i << ',' << point(r.path, k, dims) << '\n';
@@ -127,10 +126,10 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
         for (double s : c.learn_s) mean_learn += s / 3600 / double(c.learn_s.size());
         const double rate = c.tried ? double(c.reached) / c.tried : 0.0;
         const double med = quantile(c.ratios, 0.5), q25 = quantile(c.ratios, 0.25), q75 = quantile(c.ratios, 0.75);
-        csv.stream() << c.world << ',' << c.model << ',' << num(c.goal[0]) << ',' << num(c.goal[1]) << ',' << c.seeds
-                     << ',' << c.tried << ',' << num(rate) << ',' << num(med) << ',' << num(q25) << ',' << num(q75)
-                     << ',' << num(mean_learn);
-        if (flying) csv.stream() << ',' << num(c.goal[2]);
+        csv.stream() << c.world << ',' << c.model << ',' << format_number(c.goal[0]) << ',' << format_number(c.goal[1])
+                     << ',' << c.seeds << ',' << c.tried << ',' << format_number(rate) << ',' << format_number(med)
+                     << ',' << format_number(q25) << ',' << format_number(q75) << ',' << format_number(mean_learn);
+        if (flying) csv.stream() << ',' << format_number(c.goal[2]);
         csv.stream() << '\n';
         char where[96], line[256];
         if (flying) std::snprintf(where, sizeof where, "(%g, %g, %g)", c.goal[0], c.goal[1], c.goal[2]);
