@@ -181,6 +181,7 @@ void navigate_command(const NavigateOptions& o) {
         if (o.config.empty()) throw;
         throw InputError(o.config + ": " + e.what());
     }
+    check_folder_holds_one_kind(o.run.out, trials);
     if (o.dry_run) {
         std::printf("%s: %zu goal(s), %zu model(s) × %d seed(s) = %zu learning runs, %d starts per goal each\n",
                     world_name.c_str(), plan.goals.size(), plan.models.size(), plan.seeds, trials.size(),

@@ -1,11 +1,13 @@
 #include "run_options.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/memory.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
 #include "cli_common.hpp"
 #include "summary_report.hpp"
 
@@ -97,9 +99,30 @@ void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const
     std::printf("\n");
 }
 
+void check_folder_holds_one_kind(const std::filesystem::path& out, const std::vector<TrialConfig>& trials) {
+    std::error_code ec;
+    if (trials.empty() || !std::filesystem::is_directory(out, ec)) return;
+    const bool navigating = trials.front().navigation != nullptr;
+    const auto kind = [](bool navigation) {
+        return navigation ? std::string("navigation trials") : std::string("trials that record place cells");
+    };
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(out))
+        if (e.path().extension() == ".h5") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+        const auto stamp = read_trial_stamp(f);
+        if (stamp && stamp->navigation != navigating)
+            throw InputError(output_folder_text(out) + " holds files of another kind (first: '" +
+                             f.filename().string() + "', of " + kind(stamp->navigation) + "): " + kind(navigating) +
+                             " go to another --out (one folder's tables cannot hold both)");
+    }
+}
+
 ExperimentOutcome run_experiment_in_folder(const std::vector<TrialConfig>& trials, const RunOptions& o,
                                            const FolderRunHooks& hooks) {
     o.check();  // before anything is written
+    check_folder_holds_one_kind(o.out, trials);
     check_runnable(trials);
     o.check_memory(trials, o.jobs);
     const OutputLock lock = lock_output_folder(o.out);

@@ -67,6 +67,11 @@ struct FolderRunHooks {
     std::function<void(const std::string&)> on_trial_done;
 };
 
+// InputError when the folder `out` already holds complete trial files of the other kind than `trials` (navigation
+// trials beside trials that record place cells): one folder's tables cannot hold both, and --force does not change
+// that. Nothing when it does not exist or holds no trial file.
+void check_folder_holds_one_kind(const std::filesystem::path& out, const std::vector<TrialConfig>& trials);
+
 // An experiment's run into the folder `o.out`: the options, the trials and the memory they need checked
 // before anything is written, the folder locked, the trials run on this machine's threads with
 // progress on standard error (Ctrl-C or SIGTERM checkpoints and exits with status 130), the
