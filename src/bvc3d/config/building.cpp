@@ -75,6 +75,18 @@ std::vector<FloorLevel> building_floors(const GazeboScene& scene) {
     return levels.empty() ? floor_levels(scene.mesh, skip, options) : levels;
 }
 
+const std::vector<std::string>& missing_models_names() {
+    static const std::vector<std::string> names{"error", "skip"};
+    return names;
+}
+
+MissingModels parse_missing_models(const std::string& text) {
+    const auto& names = missing_models_names();
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (text == names[i]) return static_cast<MissingModels>(i);
+    throw InputError("must be '" + names[0] + "' or '" + names[1] + "', got '" + text + "'");
+}
+
 WorldDescription building_world(const BuildingSpec& spec) {
     GazeboScene scene = load_gazebo_world(spec.file, spec.gazebo);
     const std::string where = "Gazebo world '" + spec.file + "'";
@@ -165,9 +177,13 @@ GazeboOptions gazebo_options_from_yaml(const YamlView& v, BuildingSpec& spec) {
     const std::string geometry = v.get("geometry", "visual");
     if (geometry != "visual" && geometry != "collision") v["geometry"].fail("must be 'visual' or 'collision'");
     o.geometry = geometry == "visual" ? GazeboOptions::Geometry::visual : GazeboOptions::Geometry::collision;
-    const std::string missing = v.get("missing_models", "error");
-    if (missing != "error" && missing != "skip") v["missing_models"].fail("must be 'error' or 'skip'");
-    o.skip_missing_models = missing == "skip";
+    if (v.has("missing_models")) try {
+            o.skip_missing_models = parse_missing_models(v["missing_models"].as_string()) == MissingModels::skip;
+        } catch (const ConfigError&) {
+            throw;
+        } catch (const InputError& e) {
+            v["missing_models"].fail(e.what());
+        }
     const std::string up = v.get("collada_up_axis", "ignored");
     if (up != "ignored" && up != "declared") v["collada_up_axis"].fail("must be 'ignored' (as Gazebo) or 'declared'");
     o.collada_up_axis = up == "ignored" ? ColladaUpAxis::ignored : ColladaUpAxis::to_z_up;

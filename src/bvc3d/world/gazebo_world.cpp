@@ -391,7 +391,7 @@ void Loader::check_errors(const sdf::Errors& errors, const std::vector<std::stri
             }
             fail(at, "model '" + uri + "' was not found on the model path (" + join(resolver_.model_path(), ", ") +
                          "): add its folder to model_path or GAZEBO_MODEL_PATH, or leave missing models out "
-                         "(missing_models: skip)");
+                         "(missing_models: skip; on the command line --missing-models skip)");
         }
         fatal.push_back(&e);
     }
