@@ -29,11 +29,11 @@ std::string flag(bool b) { return b ? "1" : "0"; }
 
 void write_tables(const fs::path& dir, const PlaceRecognitionOutcome& r) {
     std::string queries = "descriptor,query,match,distance,match_m,has_revisit,correct\n";
-    std::string summary = "descriptor,protocol,recall_at_1,f1_max,auc,queries,revisits\n";
+    std::string summary = "descriptor,protocol,recall_at_1,f1_max,auc,queries,revisits,timed\n";
     std::string pr = "descriptor,protocol,threshold,precision,recall\n";
     std::string details =
         "descriptor,protocol,uses_heading,recall_at_1,f1_max,auc,queries,revisits,correct,median_match_m,"
-        "describe_s,search_s\n";
+        "describe_s,search_s,timed\n";
     for (const auto& d : r.descriptors) {
         const auto& rows = d.result.rows;
         for (std::size_t i = 0; i < rows.query.size(); ++i)
@@ -42,11 +42,11 @@ void write_tables(const fs::path& dir, const PlaceRecognitionOutcome& r) {
                        flag(rows.correct[i]) + "\n";
         const auto& s = d.result.summary;
         summary += d.spec.label + "," + r.protocol + "," + num(s.recall_at_1) + "," + num(s.f1_max) + "," + num(s.auc) +
-                   "," + std::to_string(s.queries) + "," + std::to_string(s.revisits) + "\n";
+                   "," + std::to_string(s.queries) + "," + std::to_string(s.revisits) + "," + flag(r.timed) + "\n";
         details += d.spec.label + "," + r.protocol + "," + flag(d.spec.uses_heading()) + "," + num(s.recall_at_1) +
                    "," + num(s.f1_max) + "," + num(s.auc) + "," + std::to_string(s.queries) + "," +
                    std::to_string(s.revisits) + "," + std::to_string(s.correct) + "," + num(s.median_match_m) + "," +
-                   num(d.describe_seconds) + "," + num(d.search_seconds) + "\n";
+                   num(d.describe_seconds) + "," + num(d.search_seconds) + "," + flag(r.timed) + "\n";
         const auto& c = d.result.curve;
         for (std::size_t k = 0; k < c.threshold.size(); ++k)
             pr += d.spec.label + "," + r.protocol + "," + num(c.threshold[k]) + "," + num(c.precision[k]) + "," +
@@ -137,14 +137,15 @@ void add_place_recognition_command(CLI::App& app) {
         if (!o->database.empty()) o->run.database = analysis::parse_scan_span(o->database, "--database");
         if (!o->queries.empty()) o->run.queries = analysis::parse_scan_span(o->queries, "--queries");
         o->run.preprocess = o->preprocess.get();
-        const bool recorded = !o->scans.empty() || !o->poses.empty();
+        const bool recorded = !o->scans.empty() || !o->poses.empty() || o->recording.has_bag();
         const bool simulated = !o->world.empty() || !o->route.empty() || !o->sensor.empty();
         if (recorded == simulated)
-            throw InputError("give either a recording (--scans and --poses) or a route (--world, --route, --sensor)");
+            throw InputError(
+                "give either a recording (--scans and --poses, or --bag) or a route (--world, --route, --sensor)");
         std::unique_ptr<ScanSequence> seq;
         if (recorded) {
-            if (o->scans.empty()) throw InputError("--poses needs --scans");
-            seq = std::make_unique<RecordingSequence>(o->recording.open(o->scans, o->poses));
+            if (o->scans.empty() && !o->recording.has_bag()) throw InputError("--poses needs --scans");
+            seq = std::make_unique<RecordingSequence>(o->recording.open_any(o->scans, o->poses));
         } else {
             if (o->world.empty() || o->route.empty() || o->sensor.empty())
                 throw InputError("a simulated route needs --world, --route and --sensor");
@@ -163,9 +164,17 @@ void add_place_recognition_command(CLI::App& app) {
         const PlaceRecognitionOutcome r = run_place_recognition(*seq, descriptors, o->run);
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         write_tables(o->out, r);
-        std::printf("%s: %zu scans, %s protocol, %.1f s (reading %.1f s, describing %.1f s wall)\n", r.sequence.c_str(),
-                    static_cast<std::size_t>(r.positions.rows()), r.protocol.c_str(), wall, r.read_seconds,
-                    r.describe_wall_seconds);
+        // Wall times are parts of the total; the threads' own times (reading, describe_s) add up over the threads.
+        std::printf(
+            "%s: %zu scans, %s protocol, %.1f s in all (%.1f s describing the scans on %zu threads, which "
+            "spent %.1f s of their time reading them)\n",
+            r.sequence.c_str(), static_cast<std::size_t>(r.positions.rows()), r.protocol.c_str(), wall,
+            r.describe_wall_seconds, r.threads, r.read_seconds);
+        if (!r.timed && r.protocol == "sequential")
+            std::printf(
+                "the scans have no times (neither their list nor their poses give them): the exclusion window is "
+                "--exclude-scans %d alone, not --exclude-seconds, and the drift counts one scan a second\n",
+                o->run.loop.exclude_scans);
         std::printf("%-28s %7s %8s %11s %7s %7s %10s %11s %9s\n", "descriptor", "queries", "revisits", "recall@1",
                     "F1max", "AUC", "heading", "describe_s", "search_s");
         for (const auto& d : r.descriptors) {
@@ -174,6 +183,12 @@ void add_place_recognition_command(CLI::App& app) {
                         s.revisits, s.recall_at_1, s.f1_max, s.auc, d.spec.uses_heading() ? "uses" : "no",
                         d.describe_seconds, d.search_seconds);
         }
+        std::printf("(describe_s: the threads' time, summed; search_s: wall time)\n");
+        if (!r.descriptors.empty() && r.descriptors.front().result.summary.revisits == 0)
+            std::printf(
+                "no query has a revisit (an older scan outside the exclusion window within --revisit-m %s m): "
+                "recall, F1max and AUC are undefined (nan) and the curve is empty\n",
+                num(o->run.loop.revisit_m).c_str());
         if (!o->no_figure && run_python_module("bvc3d.place_recognition_figure", {o->out}).status != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
                              python_command().shell_line("bvc3d.place_recognition_figure", {o->out}));

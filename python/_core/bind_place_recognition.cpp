@@ -112,6 +112,7 @@ pyb::dict outcome_dict(const PlaceRecognitionOutcome& r) {
     summary["median_match_m"] = vec(s_median);
     summary["describe_s"] = vec(s_describe);
     summary["search_s"] = vec(s_search);
+    summary["timed"] = pyb::list(pyb::cast(std::vector<bool>(r.descriptors.size(), r.timed)));
     pr["descriptor"] = p_desc;
     pr["protocol"] = p_protocol;
     pr["threshold"] = vec(p_threshold);
