@@ -114,7 +114,247 @@ def test_a_recording_without_times_says_so(exported, tmp_path):
     assert all(r["timed"] == "0" for r in read_table(tmp_path / "untimed" / "details.csv"))
 
 
+# ---- 2: Python signatures as documented ----------------------------------------------------------------
+
+PYTHON_PAGE = SOURCE_DIR / "docs" / "python.md"
+CLASSES = ["Sensor", "BoundaryVectorLayer", "PlaceCellNetwork", "HeadDirectionCells", "GridCells",
+           "GrowingPlaceCells"]
+REQUIRED = {"n_bvc": 48}  # values for the parameters documented without a default
+
+
+def documented_signature(name):
+    """The parameters of `name(...)` as docs/python.md writes them: [(key, default or REQUIRED)]."""
+    text = PYTHON_PAGE.read_text()
+    m = re.search(r"`" + name + r"\(([^`]*)\)`", text)
+    assert m, f"docs/python.md gives no signature `{name}(...)`"
+    params = []
+    for part in re.split(r",\s*(?![^\[]*\])", m.group(1)):
+        key, _, value = part.partition("=")
+        key = key.strip()
+        value = re.sub(r"√([\d.]+)", r"math.sqrt(\1)", value)
+        params.append((key, eval(value, {"math": math}) if value else REQUIRED[key]))
+    return params
+
+
+def attributes(obj, keys):
+    out = {}
+    for k in keys:
+        if k == "seed" or not hasattr(obj, k):
+            continue
+        v = getattr(obj, k)
+        out[k] = list(v) if isinstance(v, (list, tuple, np.ndarray)) else v
+    return out
+
+
+def same(a, b):
+    assert a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_allclose(np.asarray(a[k], dtype=float) if not isinstance(a[k], str) else 0,
+                                   np.asarray(b[k], dtype=float) if not isinstance(b[k], str) else 0, err_msg=k)
+        if isinstance(a[k], str):
+            assert a[k] == b[k], k
+
+
+@pytest.mark.parametrize("name", CLASSES)
+def test_every_class_takes_its_documented_signature_positionally_and_by_keyword(name):
+    """Finding 2: each class's signature in docs/python.md, every parameter with its documented default,
+    works by keyword and positionally in the documented order, and each parameter with an attribute
+    holds the documented default."""
+    cls = getattr(bvc3d, name)
+    params = documented_signature(name)
+    keys = [k for k, _ in params]
+    by_keyword = cls(**dict(params))
+    positional = cls(*[v for _, v in params])
+    attrs = attributes(by_keyword, keys)
+    same(attrs, attributes(positional, keys))
+    for k, v in params:
+        if k in attrs and k not in REQUIRED:
+            same({k: attrs[k]}, {k: v})
+    # The documented signature is the whole signature: one positional argument more is refused.
+    with pytest.raises((ValueError, TypeError), match="positional"):
+        cls(*[v for _, v in params], 1)
+
+
+def test_positional_arguments_mean_what_the_docs_say():
+    """Finding 2's cases: GridCells' first argument is the spacing, not the seed; GrowingPlaceCells'
+    third is the budget."""
+    assert bvc3d.GridCells(6).spacing == 6.0
+    assert bvc3d.GridCells(4, 0.1).orientation == 0.1
+    np.testing.assert_array_equal(bvc3d.GridCells(4, 0, 8, 800, "pose", 0.01, 7).phases,
+                                  bvc3d.GridCells(seed=7).phases)
+    assert not np.array_equal(bvc3d.GridCells(seed=7).phases, bvc3d.GridCells(seed=0).phases)
+    g = bvc3d.GrowingPlaceCells(960, 0, 500)
+    assert g.budget == 500 and g.n_bvc == 960
+    assert bvc3d.GrowingPlaceCells(960, 3, 500, 10, 0.7).threshold == 0.7
+    net = bvc3d.PlaceCellNetwork(48, 1, 0, 40, 0.3)
+    assert net.n_place == 40 and net.p_connect == 0.3
+    with pytest.raises(ValueError, match="given twice"):
+        bvc3d.GridCells(5, spacing=4)
+
+
+# ---- 3: grid cells fed by path integration -------------------------------------------------------------
+
+def test_grid_cells_fed_by_the_path_integrate_it_with_noise():
+    """Finding 3: with input='path' the rates are those of the integrated estimate, which starts at the
+    path's first position and adds each step's displacement plus N(0, path_noise²) per axis (SPEC §16):
+    the estimate's error increments are independent normals of that sd, and the rates are the true
+    position's rates at the estimate."""
+    rng = np.random.default_rng(1)
+    n, sd = 20000, 0.05
+    xy = np.cumsum(rng.normal(0, 0.1, (n, 2)), axis=0)
+    pose = bvc3d.GridCells(input="pose", seed=3)
+    path = bvc3d.GridCells(input="path", path_noise=sd, seed=3)
+    estimate = path.integrate(xy)
+    assert estimate.shape == (n, 2)
+    np.testing.assert_array_equal(estimate[0], xy[0])
+    noise = np.diff(estimate - xy, axis=0)
+    assert abs(noise.mean()) < 4 * sd / math.sqrt(2 * n)
+    assert abs(noise.std() / sd - 1) < 4 / math.sqrt(2 * n)
+    assert abs(np.corrcoef(noise[:-1, 0], noise[1:, 0])[0, 1]) < 4 / math.sqrt(n)
+    assert abs(np.corrcoef(noise[:, 0], noise[:, 1])[0, 1]) < 4 / math.sqrt(n)
+    rates = path.rates(xy)
+    np.testing.assert_array_equal(rates, pose.rates(estimate))
+    assert not np.array_equal(rates, pose.rates(xy))
+    # Seeded: the same seed, the same path; another seed, another.
+    np.testing.assert_array_equal(bvc3d.GridCells(input="path", path_noise=sd, seed=3).integrate(xy), estimate)
+    assert not np.array_equal(bvc3d.GridCells(input="path", path_noise=sd, seed=4).integrate(xy), estimate)
+    # Without noise the estimate is the path (to rounding), and fed the true position nothing is integrated.
+    np.testing.assert_allclose(bvc3d.GridCells(input="path", path_noise=0).integrate(xy), xy, atol=1e-9)
+    np.testing.assert_array_equal(pose.integrate(xy), xy)
+
+
+HALL_YAML = """name: hall
+objects:
+  - box: {center: [0, -10.1, 1.5], size: [40.4, 0.2, 3]}
+  - box: {center: [0, 10.1, 1.5], size: [40.4, 0.2, 3]}
+  - box: {center: [-20.1, 0, 1.5], size: [0.2, 20.4, 3]}
+  - box: {center: [20.1, 0, 1.5], size: [0.2, 20.4, 3]}
+  - box: {center: [0, 0, 1.5], size: [24, 8, 3]}
+  - box: {center: [-14, 4, 1.5], size: [1, 1, 3]}
+  - box: {center: [12, -6, 1.5], size: [2, 1, 3]}
+walkable: {rect: [-20, -10, 20, 10]}
+"""
+
+
+# ---- 7: one page of the Python API ----------------------------------------------------------------------
+
+def python_page_code():
+    lines = PYTHON_PAGE.read_text().splitlines()
+    code, inside = [], False
+    for line in lines:
+        if line.strip() == "```python":
+            inside = True
+        elif line.strip() == "```":
+            inside = False
+        elif inside:
+            code.append(line)
+    return "\n".join(code)
+
+
+# Navigation's calls: named on the page, documented with navigation (docs/navigation.md; their Python keywords are the
+# navigation issue's).
+PLACEHOLDERS = {"navigate", "shortest_path", "HdAdjacency", "reward_readout", "combine_scales"}
+
+
+def test_the_python_page_has_a_runnable_example_of_every_class_and_call():
+    """Finding 7: every public class and function of bvc3d and bvc3d.analysis is called in a ```python block
+    of docs/python.md (test_doc_code.py runs them); navigation's calls at least named on the page."""
+    import types
+    code, page = python_page_code(), PYTHON_PAGE.read_text()
+    public = [n for n in dir(bvc3d) if not n.startswith("_") and callable(getattr(bvc3d, n))
+              and not isinstance(getattr(bvc3d, n), types.ModuleType) and n != "InputError"]
+    analysis = [n for n in dir(bvc3d.analysis) if not n.startswith("_")
+                and isinstance(getattr(bvc3d.analysis, n), (types.FunctionType, types.BuiltinFunctionType))]
+    missing = [n for n in public if n not in PLACEHOLDERS and not re.search(r"\b" + n + r"\b", code)]
+    missing += [f"analysis.{n}" for n in analysis if not re.search(r"\b" + n + r"\(", code)]
+    assert not missing, f"docs/python.md has no example calling: {missing}"
+    assert all(n in page for n in PLACEHOLDERS)
+
+
+# ---- 8: worlds as paths or objects ----------------------------------------------------------------------
+
+def test_every_call_takes_a_world_as_a_path_or_a_world(tmp_path):
+    """Finding 8: a preset name, a world file's path and a World are the same world to every call."""
+    cross = bvc3d.World.preset("cross")
+    walks = [bvc3d.random_walk(w, 0.01, 3) for w in ("cross", cross, pathlib.Path(SOURCE_DIR / "configs" / "worlds"
+                                                                                    / "cross-0.yaml"))]
+    for w in walks[1:]:
+        np.testing.assert_array_equal(w["x"], walks[0]["x"])
+    np.testing.assert_array_equal(bvc3d.flying_walk("flight-room", 0.005, 1)["z"],
+                                  bvc3d.flying_walk(bvc3d.World.preset("flight-room"), 0.005, 1)["z"])
+    np.testing.assert_array_equal(bvc3d.route("cross", [[-4, -4], [4, -4]])["x"],
+                                  bvc3d.route(cross, [[-4, -4], [4, -4]])["x"])
+    route = bvc3d.route(cross, [[-4, -4], [4, -4], [4, 4]])
+    path = tmp_path / "route.csv"
+    bvc3d.write_trajectory(path, route)
+    by_path = bvc3d.place_recognition(world="cross", route=path, sensor="horizontal", descriptors="scan-context",
+                                      exclude_scans=5, exclude_seconds=0)
+    by_world = bvc3d.place_recognition(world=cross, route=route, sensor="horizontal", descriptors="scan-context",
+                                       exclude_scans=5, exclude_seconds=0)
+    np.testing.assert_array_equal(by_path["queries"]["distance"], by_world["queries"]["distance"])
+    sim = [bvc3d.replay_simulated(w, path, "horizontal", model="2d")["bvc_rates"] for w in ("cross", cross)]
+    np.testing.assert_array_equal(sim[0], sim[1])
+    # run_trial takes a World made from a preset or a file (its trial file records that source).
+    short = dict(model="2d", explore_hours=0.002, sample_hours=0.002)
+    np.testing.assert_array_equal(bvc3d.run_trial(world=bvc3d.World.preset("cross-30"), **short)["rates"],
+                                  bvc3d.run_trial(world="cross-30", **short)["rates"])
+
+
+@pytest.mark.parametrize("call", [
+    lambda bad: bvc3d.random_walk(bad, 0.01, 0),
+    lambda bad: bvc3d.tour(bad),
+    lambda bad: bvc3d.route(bad, [[0, 0], [1, 0]]),
+    lambda bad: bvc3d.place_recognition(world=bad, route="r.csv", sensor="horizontal"),
+    lambda bad: bvc3d.place_recognition(world="cross", route=bad, sensor="horizontal"),
+    lambda bad: bvc3d.run_trial(world=bad),
+    lambda bad: bvc3d.replay_simulated(bad, "r.csv", "horizontal"),
+])
+def test_a_wrong_world_or_route_is_named_not_printed(call):
+    """Finding 8: an object that is not a world (or a route) is refused by its type, never printed."""
+    for bad in (np.arange(5000.0), {"t": np.arange(5000.0)}, object()):
+        with pytest.raises((ValueError, TypeError)) as e:
+            call(bad)
+        plain_message(str(e.value))
+
+
 # ---- 12: messages and figures -------------------------------------------------------------------------
+
+def test_head_direction_cells_say_their_count():
+    """Finding 12: spherical HD cells are the icosahedron's 20: n says so, and an n for them is refused."""
+    hd = bvc3d.HeadDirectionCells(space="spherical")
+    assert hd.n == hd.n_cells == 20
+    assert bvc3d.HeadDirectionCells().n == bvc3d.HeadDirectionCells().n_cells == 8
+    with pytest.raises(ValueError, match="n"):
+        bvc3d.HeadDirectionCells(space="spherical", n=12)
+
+
+def test_growing_place_cells_document_only_what_they_take():
+    doc = bvc3d.GrowingPlaceCells.__doc__
+    assert "n_place=" not in doc and "budget=" in doc and "gamma_pb=" in doc
+    with pytest.raises(ValueError, match="budget"):
+        bvc3d.GrowingPlaceCells(48, n_place=250)
+
+
+@pytest.mark.parametrize("make", [lambda: bvc3d.PlaceCellNetwork(960), lambda: bvc3d.GrowingPlaceCells(960)])
+def test_a_wrong_learn_flag_is_named_not_printed(make):
+    net = make()
+    with pytest.raises((ValueError, TypeError), match="learn") as e:
+        net.step(np.ones(960), learn="yes")
+    plain_message(str(e.value))
+    net.step(np.ones(960), learn=np.bool_(False))  # numpy's booleans are booleans
+
+
+def test_each_world_loader_names_the_other(tmp_path):
+    gazebo = tmp_path / "room.world"
+    gazebo.write_text('<?xml version="1.0"?>\n<sdf version="1.6"><world name="w"></world></sdf>\n')
+    with pytest.raises(ValueError, match="from_sdf") as e:
+        bvc3d.World.from_yaml(gazebo)
+    plain_message(str(e.value))
+    yaml_world = tmp_path / "room.yaml"
+    yaml_world.write_text(HALL_YAML)
+    with pytest.raises(ValueError, match="from_yaml"):
+        bvc3d.World.from_sdf(yaml_world)
+
 
 def test_place_recognition_without_revisits_says_so(tmp_path):
     """Finding 12: a drive that never comes back has no revisit: the output says why recall is nan, the
