@@ -1,4 +1,5 @@
 // bvc3d route: a route through a world from waypoints, or a tour of its floor (docs/buildings.md#routes).
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "bvc3d/core/error.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "python_module.hpp"
 
 namespace bvc3d::cli {
 
@@ -23,14 +25,18 @@ Vec2 parse_point(const std::string& text, const std::string& what) {
     return Vec2(parse_number(text.substr(0, comma), what + " x"), parse_number(text.substr(comma + 1), what + " y"));
 }
 
+// A length or a time as people read it: to a tenth.
+std::string tenths(double v) { return num(std::round(v * 10) / 10); }
+
 }  // namespace
 
 void add_route_command(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "route", "Drive a route through a world's floor, from waypoints or as a tour; write it as a trajectory file");
     struct Options {
-        std::string world, waypoints, start, out;
+        std::string world, waypoints, start, out, figure;
         bool tour = false;
+        int laps = 1;
         RouteParams route;
     };
     auto o = std::make_shared<Options>();
@@ -41,11 +47,20 @@ void add_route_command(CLI::App& app) {
     waypoints->excludes(tour);
     cmd->add_option("--start", o->start, "With --tour: where it starts and ends, X,Y (default: the floor's middle)")
         ->needs(tour);
+    cmd->add_option("--laps", o->laps,
+                    "With --tour: drive it this many times, one lap after the other (a trial that learns on one lap "
+                    "and records two can decode the last against the one before)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000))
+        ->needs(tour);
     cmd->add_option("--speed", o->route.speed, "Cruising speed, m/s")->capture_default_str();
     cmd->add_option("--lateral-acceleration", o->route.lateral_acceleration, "At most this in turns, m/s^2")
         ->capture_default_str();
     cmd->add_option("--out", o->out, "Trajectory file to write (t,x,y,z,heading rows)")
         ->required()
+        ->transform(output_path);
+    cmd->add_option("--figure", o->figure,
+                    "Also draw the route over the world's floor plan at the robot's body height (a .png)")
         ->transform(output_path);
     cmd->footer(
         "The path joins the waypoints with circular arcs (speed^2/radius never above the lateral acceleration;\n"
@@ -57,6 +72,7 @@ void add_route_command(CLI::App& app) {
         if (o->waypoints.empty() == !o->tour) throw InputError("give --waypoints FILE or --tour");
         o->route.validate();
         require_not_directory(o->out, "--out");
+        if (!o->figure.empty()) require_not_directory(o->figure, "--figure");
         const World world(config::resolve_world(o->world));
         if (const auto& out = world.description().left_out; !out.empty())
             std::cerr << "bvc3d: warning: " << out.size()
@@ -68,18 +84,33 @@ void add_route_command(CLI::App& app) {
             if (!o->start.empty()) start = parse_point(o->start, "--start");
             const Tour t = make_tour(world.description(), robot.radius, robot.height, start, {}, o->route);
             steps = t.steps;
-            std::cout << "tour of '" << world.name() << "': " << steps.size() << " model steps, " << num(t.stats.length)
-                      << " m in " << num(steps.back().t) << " s; passes within 1 m of "
+            // The tour ends where it starts: each further lap follows one model step later, from its start.
+            const double lap = t.steps.back().t + robot.model_dt;
+            for (int k = 1; k < o->laps; ++k)
+                for (ModelStep s : t.steps) {
+                    s.t += k * lap;
+                    steps.push_back(s);
+                }
+            std::cout << "tour of '" << world.name() << "': " << t.steps.size() << " model steps, "
+                      << tenths(t.stats.length) << " m in " << tenths(t.steps.back().t) << " s; passes within 1 m of "
                       << num(std::round(t.stats.coverage * 1000) / 10) << " % of the walkable region ("
                       << num(std::round(t.stats.walkable_area)) << " m2); drives "
-                      << num(std::round(t.stats.reverse_length)) << " m again in the opposite direction\n";
+                      << num(std::round(t.stats.reverse_length)) << " m again in the opposite direction"
+                      << (o->laps > 1 ? "; " + std::to_string(o->laps) + " laps: " + std::to_string(steps.size()) +
+                                            " model steps in " + tenths(steps.back().t) + " s"
+                                      : "")
+                      << "\n";
         } else {
             const BodyCollider body(world.description(), robot.radius, robot.height);
             steps = route_through(read_waypoints(o->waypoints), body, o->route);
             std::cout << "route through '" << world.name() << "': " << steps.size() << " model steps in "
-                      << num(steps.back().t) << " s\n";
+                      << tenths(steps.back().t) << " s\n";
         }
         write_trajectory_file(o->out, steps);
+        const std::vector<std::string> args{"--world", o->world, "--trajectory", o->out, "--out", o->figure};
+        if (!o->figure.empty() && run_python_module("bvc3d.route_figure", args).status != 0)
+            throw InputError("the figure failed; the route is in '" + o->out + "'; rerun it with:\n  " +
+                             python_command().shell_line("bvc3d.route_figure", args));
     });
 }
 

@@ -223,6 +223,8 @@ def test_grid_cells_fed_by_the_path_integrate_it_with_noise():
     np.testing.assert_array_equal(pose.integrate(xy), xy)
 
 
+# ---- 9: the analysis at a building's scale ----------------------------------------------------------------
+
 HALL_YAML = """name: hall
 objects:
   - box: {center: [0, -10.1, 1.5], size: [40.4, 0.2, 3]}
@@ -234,6 +236,124 @@ objects:
   - box: {center: [12, -6, 1.5], size: [2, 1, 3]}
 walkable: {rect: [-20, -10, 20, 10]}
 """
+
+
+def laps(n_laps):
+    """Laps of a 32 x 14 m rectangle around the hall's central block, 0.144 m a model step: lines, not areas."""
+    corners = np.array([[-16, -7], [16, -7], [16, 7], [-16, 7], [-16, -7]], dtype=float)
+    pts = [corners[0]]
+    for a, b in zip(corners[:-1], corners[1:]):
+        k = int(round(np.linalg.norm(b - a) / 0.144))
+        pts += [a + (b - a) * (i + 1) / k for i in range(k)]
+    lap = np.array(pts[:-1])
+    xy = np.tile(lap, (n_laps, 1))
+    heading = np.arctan2(*np.diff(np.r_[xy, xy[:1]], axis=0).T[::-1])
+    return {"t": np.arange(len(xy)) * 0.288, "x": xy[:, 0], "y": xy[:, 1], "heading": heading}, len(lap)
+
+
+def warnings_of(**kw):
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = bvc3d.run_trial(model="2d", **kw)
+    return r, [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
+
+
+def test_analysis_settings_that_cannot_work_in_a_building_are_named(tmp_path):
+    """Finding 9: the arena's settings in a 40 x 20 m hall walked along lines: the hexagons (gridsize 50) are
+    several times the arena's and the path covers lines, so no bin has 20 visited bins within 1 m and DBSCAN
+    can find no field. The warning names the keys and values to give; with them the metrics mean something.
+    One lap only: the decoded half lies where the first half never was, and the warning says so."""
+    world = tmp_path / "hall.yaml"
+    world.write_text(HALL_YAML)
+    path, n_lap = laps(3)
+    r, messages = warnings_of(world=str(world), trajectory=path, explore_hours=n_lap * 0.288 / 3600,
+                              sample_hours=2 * n_lap * 0.288 / 3600)
+    field = [m for m in messages if "min_samples = 20" in m]
+    assert len(field) == 1, messages
+    assert "no visited bin has 20 visited bins within eps = 1 m" in field[0] and "frac_active" in field[0]
+    gridsize = int(re.search(r"analysis key gridsize: (\d+)", field[0]).group(1))
+    suggested = re.search(r"analysis key min_samples, e\.g\. (\d+)", field[0])
+    min_samples = int(suggested.group(1)) if suggested else 20
+    assert r["metrics"]["frac_active"] == 0  # what the warning is about
+    # The hexagons the suggestion gives are the paper's arena's within 20 %.
+    a = bvc3d.analysis.analyze(r["x"], r["y"], r["rates"], gridsize=gridsize, min_samples=min_samples)
+    assert 0.8 < a["bin_area_m2"] / (0.5 * (9.2 / 50) * (9.2 / 28)) < 1.2
+    assert a["modality_summary"]["frac_active"] > 0.2
+    assert not any("decoding:" in m for m in messages), messages  # the second lap comes back to the first's places
+    _, one_lap = warnings_of(world=str(world), trajectory=laps(1)[0], protocol="online",
+                             sample_hours=n_lap * 0.288 / 3600)
+    decoding = [m for m in one_lap if m.startswith("decoding:") or ": decoding:" in m]
+    assert len(decoding) == 1 and "never visited" in decoding[0] and "comes back" in decoding[0], one_lap
+
+
+# ---- 10: figures of routes over their floor plan ---------------------------------------------------------
+
+def test_route_draws_its_figure_over_the_floor_plan(tmp_path):
+    """Finding 10: route --figure writes the route over the world's plan at the body's height; the plan is the
+    body's collision outline (World.floor_plan), here the hall's walls and blocks exactly."""
+    world = tmp_path / "hall.yaml"
+    world.write_text(HALL_YAML)
+    waypoints = tmp_path / "points.txt"
+    waypoints.write_text("-16 -7\n16 -7\n16 7\n")
+    proc = run_cli("route", "--world", world, "--waypoints", waypoints, "--out", tmp_path / "r.csv",
+                   "--figure", tmp_path / "r.png", check=True)
+    png = (tmp_path / "r.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20000
+    # Every printed number is rounded for people (finding 12).
+    assert not re.search(r"\d\.\d{3,}", proc.stdout), proc.stdout
+    plan = bvc3d.World.from_yaml(world).floor_plan(height=0.1)
+    seg = plan["segments"]
+    assert seg.shape[1:] == (2, 2) and np.all(plan["radii"] == 0)
+    # The central block's outline (24 x 8 m) is in the plan: its four edges' x and y extents.
+    block = seg[(np.abs(seg[:, :, 0]) <= 12 + 1e-9).all(axis=1) & (np.abs(seg[:, :, 1]) <= 4 + 1e-9).all(axis=1)]
+    assert np.isclose(block[:, :, 0].min(), -12) and np.isclose(block[:, :, 0].max(), 12)
+    assert np.isclose(block[:, :, 1].min(), -4) and np.isclose(block[:, :, 1].max(), 4)
+    # A cut above everything holds only the walkable region's edge.
+    high = bvc3d.World.from_dict({"objects": [{"box": {"center": [0, 0, 2], "size": [1, 1, 1]}}],
+                                  "walkable": {"rect": [-3, -3, 3, 3]}}).floor_plan(height=0.1)["segments"]
+    assert len(high) == 4 and np.allclose(np.abs(high).max(), 3)
+
+
+def test_view_draws_a_trajectory_over_its_world(tmp_path):
+    """Finding 10: view WORLD --trajectory FILE: the page gets the path and the model's view at its steps (the
+    exported replies are what the server gives)."""
+    import base64
+    import json
+    world = tmp_path / "hall.yaml"
+    world.write_text(HALL_YAML)
+    path, _ = laps(1)
+    track = tmp_path / "lap.csv"
+    np.savetxt(track, np.column_stack([path["t"], path["x"], path["y"], path["heading"]]), delimiter=",",
+               header="t,x,y,heading", comments="", fmt="%.17g")
+    run_cli("view", world, "--trajectory", track, "--export", tmp_path / "page", "--export-steps", 3, check=True)
+    index = (tmp_path / "page" / "data" / "index.js").read_text()
+    files = json.loads(re.search(r"files: (\{.*?\}), steps", index).group(1))
+    steps = json.loads(re.search(r"steps: (\{.*?\}), index", index).group(1))
+    assert json.loads(re.search(r"index: (\{.*?\}), data", index).group(1))["trajectory"] == "lap.csv"
+    assert steps["#trajectory"] == [0, (len(path["t"]) - 1) // 2, len(path["t"]) - 1]
+
+    def reply(key):
+        text = (tmp_path / "page" / "data" / files[key]).read_text()
+        blob = base64.b64decode(re.search(r',"([A-Za-z0-9+/=]*)"\);', text).group(1))
+        n = int.from_bytes(blob[4:8], "little")
+        header = json.loads(blob[8:8 + n])
+        arrays = {a["name"]: np.frombuffer(blob[8 + n + a["offset"]:8 + n + a["offset"] + a["bytes"]],
+                                           dtype={"f64": "<f8", "f32": "<f4", "u8": "u1", "i32": "<i4"}[a["dtype"]])
+                  for a in header["arrays"]}
+        return header, arrays
+
+    header, arrays = reply("trajectory")
+    np.testing.assert_array_equal(arrays["x"], path["x"])
+    np.testing.assert_array_equal(arrays["heading"], path["heading"])
+    probe, _ = reply(f"probe?source=hall.yaml&step={steps['#trajectory'][1]}")
+    i = steps["#trajectory"][1]
+    assert probe["step"] == i and probe["x"] == path["x"][i] and probe["y"] == path["y"][i]
+    # A path outside the world is refused; and a trajectory needs a world.
+    far = tmp_path / "far.csv"
+    far.write_text("t,x,y,heading\n0,100,0,0\n0.288,100.1,0,0\n")
+    assert "outside world" in error_line(run_cli("view", world, "--trajectory", far, "--export", tmp_path / "x"))
+    assert not (tmp_path / "x").exists()
 
 
 # ---- 7: one page of the Python API ----------------------------------------------------------------------
@@ -375,5 +495,24 @@ def test_place_recognition_without_revisits_says_so(tmp_path):
     from bvc3d import place_recognition_figure
     fig = place_recognition_figure.draw(out)
     assert any("no query has a revisit" in t.get_text() for t in fig.axes[0].texts)
+
+
+def test_view_names_the_input_a_bag_replay_differs_in(exported, tmp_path):
+    """Finding 12: a bag replayed with its pose topic, viewed with the same bag's tf: the message says it is the
+    poses that differ, and where each came from."""
+    trial = tmp_path / "replay.h5"
+    run_cli("replay", "--bag", exported / "run.bag", "--cloud-topic", "/points", "--pose-topic", "/odom", "--model",
+            "2d", "--out", trial, check=True)
+    proc = run_cli("view", trial, "--bag", exported / "run.bag", "--cloud-topic", "/points", "--tf-frames",
+                   "map,sensor", "--export", tmp_path / "page")
+    line = error_line(proc)
+    assert "its poses come from" in line and "tf map sensor" in line and "/odom" in line, line
+    assert "its scans" not in line and not (tmp_path / "page").exists()
+
+
+def test_the_pages_agree_on_the_hospitals_floor():
+    sizes = {page: re.findall(r"hospital[^.]*?(\d+ × \d+ m) floor", (SOURCE_DIR / "docs" / page).read_text())
+             for page in ("buildings.md", "place-recognition.md")}
+    assert all(sizes.values()) and len({s for v in sizes.values() for s in v}) == 1, sizes
 
 
