@@ -516,3 +516,43 @@ def test_the_pages_agree_on_the_hospitals_floor():
     assert all(sizes.values()) and len({s for v in sizes.values() for s in v}) == 1, sizes
 
 
+# ---- 13: the corpus's classes ----------------------------------------------------------------------
+
+def test_replayed_weights_of_an_old_trial_file_for_another_model_are_refused(exported, tmp_path):
+    """Finding 13: a trial file written before /weights named its model still records it at its root: weights
+    of 3d-0.1 (the same shape as 3d-0.2's) are refused for 3d-0.2, naming the model."""
+    import h5py
+    trial = tmp_path / "old.h5"
+    run_cli("run", "--model", "3d-0.1", "--hours", "0.003", "--out", trial, "--checkpoint-minutes", 0, check=True)
+    with h5py.File(trial, "a") as f:
+        for k in ("model", "model_config"):
+            del f["weights"].attrs[k]
+    proc = run_cli("replay", "--scans", exported / "run", "--poses", exported / "run" / "poses.txt", "--model",
+                   "3d-0.2", "--weights", trial, "--out", tmp_path / "r.h5")
+    line = error_line(proc)
+    assert "3d-0.1" in line and "elevations" in line and not (tmp_path / "r.h5").exists()
+    run_cli("replay", "--scans", exported / "run", "--poses", exported / "run" / "poses.txt", "--model", "3d-0.1",
+            "--weights", trial, "--out", tmp_path / "ok.h5", check=True)
+
+
+def test_aliasing_of_arrays_of_the_wrong_shape_raises():
+    """Finding 13: maps of no cells (N, 0) have no population vector to compare: refused like the other shapes
+    that are not (N, 2 or 3) centers and (N,) or (N, cells) maps."""
+    centers, maps = np.zeros((10, 2)), np.zeros((10, 3))
+    assert bvc3d.analysis.aliasing(centers, np.ones(10))[1] == 0  # (N,): one cell
+    for c, m in [(np.zeros((10, 3, 1)), maps), (np.zeros(10), maps), (centers, np.zeros((9, 3))),
+                 (centers, np.zeros((10, 0))), (np.zeros((10, 4)), maps), (centers, np.zeros((10, 3, 2)))]:
+        with pytest.raises(ValueError) as e:
+            bvc3d.analysis.aliasing(c, m)
+        plain_message(str(e.value))
+
+
+def test_localize_refuses_positions_that_are_not_finite():
+    rng = np.random.default_rng(0)
+    templates, queries = rng.random((20, 30)), rng.random((5, 30))
+    tp, qp = rng.random((20, 3)), rng.random((5, 3))
+    bvc3d.localize(templates, tp, queries, qp)
+    for a, b in [(np.where(np.arange(60).reshape(20, 3) == 3, np.nan, tp), qp), (tp, np.full((5, 3), np.inf))]:
+        with pytest.raises(ValueError, match="finite") as e:
+            bvc3d.localize(templates, a, queries, b)
+        plain_message(str(e.value))
