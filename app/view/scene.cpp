@@ -263,8 +263,8 @@ void TrialScene::resolve_recording(const fs::path& file, const GivenRecording& g
     }
     // The files must be the ones replayed, and the poses those the trial recorded.
     if (rec && !files.empty() && rec->fingerprint() != files)
-        problem = "the recording " + std::string(given ? "given" : "found") +
-                  " is not the one the trial replayed: " + differing_inputs(*rec, scans, poses) +
+        problem = "the scan and pose files " + std::string(given ? "given" : "found") +
+                  " are not those the trial replayed: " + differing_inputs(*rec, scans, poses) +
                   " (their fingerprint is " + rec->fingerprint() + ", the trial's " + files + ")";
     std::vector<ModelStep> steps;
     if (rec && problem.empty()) {

@@ -210,17 +210,43 @@ std::vector<std::string> field_warnings(const Eigen::Ref<const Points>& position
             " bins within eps, of the " + std::to_string(reach.median) + " a visited bin has there at the median)"};
 }
 
-std::vector<std::string> decoding_warnings(const RateMaps& maps, std::size_t n) {
-    if (n < 4) return {};
+std::vector<std::string> decoding_warnings(const RateMaps& maps, std::size_t n, double radius) {
+    if (n < 4 || !(radius > 0)) return {};
     const std::size_t half = n / 2;
-    std::set<int> seen(maps.bins.sample_bin.begin(), maps.bins.sample_bin.begin() + static_cast<std::ptrdiff_t>(half));
-    std::size_t unseen = 0;
-    for (std::size_t s = half; s < n; ++s) unseen += !seen.contains(maps.bins.sample_bin[s]);
-    if (2 * unseen <= n - half) return {};
-    return {"decoding: " + format_number(std::round(1000.0 * unseen / static_cast<double>(n - half)) / 10) +
-            " % of the decoded samples (the second half of those recorded) lie in bins the first half never "
-            "visited, where no template can be right: the decoding error measures where the path went, not the "
-            "place code; record a path that comes back to its places (e.g. a tour driven twice while sampling)"};
+    const Points& c = maps.bins.centers;
+    // The first half's visited bins, hashed in cubes `radius` wide: a bin within `radius` of a place lies in the
+    // place's cube or a neighbouring one.
+    using Cell = std::array<std::int64_t, 3>;
+    const auto cell_of = [&](int b) {
+        Cell k{0, 0, 0};
+        for (Eigen::Index d = 0; d < c.cols() && d < 3; ++d)
+            k[static_cast<std::size_t>(d)] = static_cast<std::int64_t>(std::floor(c(b, d) / radius));
+        return k;
+    };
+    std::map<Cell, std::vector<int>> seen;
+    std::set<int> first;
+    for (std::size_t s = 0; s < half; ++s)
+        if (const int b = maps.bins.sample_bin[s]; b >= 0 && first.insert(b).second) seen[cell_of(b)].push_back(b);
+    const int reach = c.cols() >= 3 ? 1 : 0;
+    const auto near_first = [&](int b) {
+        const Cell k = cell_of(b);
+        for (std::int64_t i = -1; i <= 1; ++i)
+            for (std::int64_t j = -1; j <= 1; ++j)
+                for (std::int64_t z = -reach; z <= reach; ++z)
+                    if (const auto it = seen.find({k[0] + i, k[1] + j, k[2] + z}); it != seen.end())
+                        for (const int f : it->second)
+                            if ((c.row(b) - c.row(f)).norm() <= radius) return true;
+        return false;
+    };
+    std::size_t away = 0;
+    for (std::size_t s = half; s < n; ++s)
+        if (const int b = maps.bins.sample_bin[s]; b >= 0 && !near_first(b)) ++away;
+    if (2 * away <= n - half) return {};
+    return {"decoding: " + format_number(std::round(1000.0 * away / static_cast<double>(n - half)) / 10) +
+            " % of the decoded samples (the second half of those recorded) lie farther than " + format_number(radius) +
+            " m (eps) from every place the first half visited, where no template can be right: the decoding error "
+            "measures where the path went, not the place code; record a path that comes back to its places (e.g. "
+            "a tour driven twice while sampling)"};
 }
 
 std::vector<std::string> scale_warnings(const Points& centers, const AnalysisParams& params) {
@@ -273,7 +299,7 @@ TrialMetrics analyze_trial(const Eigen::Ref<const Points>& positions, const Eige
     if (m.dims == 3) m.isotropy = field_isotropy(m.maps.bins.centers, m.maps.map, m.modality, params.dbscan);
     m.warnings = scale_warnings(m.maps.bins.centers, params);
     for (auto& w : field_warnings(positions, m.maps, params)) m.warnings.push_back(std::move(w));
-    for (auto& w : decoding_warnings(m.maps, n)) m.warnings.push_back(std::move(w));
+    for (auto& w : decoding_warnings(m.maps, n, params.dbscan.eps)) m.warnings.push_back(std::move(w));
     return m;
 }
 

@@ -76,8 +76,9 @@ std::vector<std::string> scale_warnings(const Points& centers, const AnalysisPar
 std::vector<std::string> field_warnings(const Eigen::Ref<const Points>& positions, const RateMaps& maps,
                                         const AnalysisParams& params);
 // Decoding reads the first half's maps at the second half's places (n samples): says so when most of the second
-// half lies in bins the first half never visited (a path that does not come back: the error measures the path).
-std::vector<std::string> decoding_warnings(const RateMaps& maps, std::size_t n);
+// half lies farther than `radius` from every bin the first half visited (a path that does not come back: the error
+// measures the path).
+std::vector<std::string> decoding_warnings(const RateMaps& maps, std::size_t n, double radius);
 
 // The grid a trial's positions are binned on: hexagons for 2-D positions (gridsize, extent), voxels
 // for 3-D ones (voxel, volume); InputError for other dimensions.
