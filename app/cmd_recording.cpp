@@ -501,15 +501,19 @@ void add_export_scans(CLI::App& app) {
         ->check(seed_check);
     cmd->add_option("--sensor", o->sensor, "horizontal, spherical (upper half) or a sensor YAML")
         ->capture_default_str();
-    cmd->add_option("--format", o->format,
-                    "pcd (float32), pcd-f8 (float64), ply, kitti (.bin); or a bag: ros1 (.bag) or mcap (ROS 2, .mcap)")
+    cmd->add_option(
+           "--format", o->format,
+           "pcd (float32), pcd-f8 (float64), ply, kitti (.bin); or a bag: ros1 (.bag), mcap (ROS 2, .mcap) or ros2 "
+           "(a ROS 2 bag folder: metadata.yaml and an .mcap)")
         ->capture_default_str();
-    cmd->add_option("--out", o->out,
-                    "Folder to write: 000000.<ext> ..., poses.txt, scans.txt; with ros1 or mcap, the bag file")
+    cmd->add_option(
+           "--out", o->out,
+           "Folder to write: 000000.<ext> ..., poses.txt, scans.txt; with ros1 or mcap, the bag file; with ros2, "
+           "the bag's folder")
         ->required()
         ->transform(output_path);
     cmd->add_option("--start-time", o->start_time,
-                    "ros1, mcap: seconds added to every stamp (ROS takes a zero stamp for 'no time')")
+                    "ros1, mcap, ros2: seconds added to every stamp (ROS takes a zero stamp for 'no time')")
         ->capture_default_str();
     cmd->footer(
         "Each scan holds the hits in the sensor's own frame (x forward, z up; tilted with the pose's pitch and\n"
@@ -519,7 +523,7 @@ void add_export_scans(CLI::App& app) {
         "and /tf (the same transform): replay it with --bag OUT --cloud-topic /points --pose-topic /odom\n"
         "(docs/ros.md#export).");
     cmd->callback([o] {
-        const bool bag = o->format == "ros1" || o->format == "mcap";
+        const bool bag = o->format == "ros1" || o->format == "mcap" || o->format == "ros2";
         const auto format = bag ? recording::ScanWriteFormat::pcd_f8 : recording::parse_scan_write_format(o->format);
         if (bag && !(o->start_time >= 0)) throw InputError("--start-time must be >= 0");
         if (o->trajectory.empty() == !o->hours.has_value()) throw InputError("give --trajectory or --hours, not both");
@@ -558,7 +562,9 @@ void add_export_scans(CLI::App& app) {
         line.done();
         if (bag) {
             recording::BagWriteOptions b;
-            b.format = o->format == "ros1" ? recording::BagFormat::ros1 : recording::BagFormat::mcap;
+            b.format = o->format == "ros1"   ? recording::BagFormat::ros1
+                       : o->format == "mcap" ? recording::BagFormat::mcap
+                                             : recording::BagFormat::ros2;
             b.start = o->start_time;
             recording::write_bag(o->out, clouds, poses, b);
         } else {
@@ -571,14 +577,19 @@ void add_export_scans(CLI::App& app) {
 // ---------------------------------------------------------------------------------------------
 // bag-info
 
+// /tf messages bag-info reads for the links (a tf tree's links all appear within its first seconds).
+constexpr std::size_t tf_messages_read = 100;
+
 void add_bag_info(CLI::App& app) {
     auto* cmd = app.add_subcommand("bag-info", "List a ROS bag's topics: types, encodings, counts and time spans");
     auto path = std::make_shared<std::string>();
     cmd->add_option("bag", *path, "A ROS 1 .bag, an .mcap file or a ROS 2 bag folder (metadata.yaml)")->required();
     cmd->footer(
         "Times are the messages' log (receive) times in seconds. For a PointCloud2 topic, the frame and size of\n"
-        "its first cloud; for /tf and /tf_static, the links parent -> child. Then read the bag as a recording\n"
-        "with --bag, --cloud-topic and --pose-topic (or --tf-frames FIXED,SENSOR) (docs/ros.md).");
+        "its first cloud; for /tf and /tf_static, the links parent -> child (of their first 100 messages).\n"
+        "Then read the bag as a recording with --bag, --cloud-topic and --pose-topic (or --tf-frames\n"
+        "FIXED,SENSOR) (docs/ros.md). A bag path may be a ROS 2 bag folder, its metadata.yaml, or a storage\n"
+        "file alone (.db3, .mcap).");
     cmd->callback([path] {
         const auto bag = recording::open_bag(*path);
         std::size_t total = 0;
@@ -598,6 +609,10 @@ void add_bag_info(CLI::App& app) {
             std::printf("%-28s %-32s %-8s %9zu %18.6f %18.6f %10.3f\n", t.name.c_str(), t.type.c_str(),
                         t.encoding_name.c_str(), t.count, t.first, t.last, t.last - t.first);
             if (t.count == 0) continue;
+            if (t.encoding == recording::MessageEncoding::unknown) {  // listed; its messages are not read
+                std::printf("    (not read: bvc3d reads cdr and ros1)\n");
+                continue;
+            }
             const auto kind = recording::message_kind(t.type);
             if (kind == recording::MessageKind::point_cloud2) {
                 const auto c = bag->cloud(i, 0);
@@ -606,8 +621,9 @@ void add_bag_info(CLI::App& app) {
                 std::printf("    frame '%s', %u x %u points, fields %s%s\n", c.frame_id.c_str(), c.height, c.width,
                             fields.c_str(), c.is_bigendian ? ", big-endian" : "");
             } else if (kind == recording::MessageKind::tf) {
+                // The links of its first messages: not every chunk of a large bag is read for them.
                 std::map<std::string, std::string> links;
-                for (std::size_t k = 0; k < t.count; ++k)
+                for (std::size_t k = 0; k < std::min<std::size_t>(t.count, tf_messages_read); ++k)
                     for (const auto& x : bag->transforms(i, k)) links[x.child] = x.parent;
                 for (const auto& [child, parent] : links) std::printf("    %s -> %s\n", parent.c_str(), child.c_str());
             } else if (kind == recording::MessageKind::odometry || kind == recording::MessageKind::pose_stamped) {

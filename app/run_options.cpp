@@ -1,11 +1,6 @@
 #include "run_options.hpp"
 
-#include <algorithm>
-#include <atomic>
 #include <cstdio>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/cancel.hpp"
@@ -65,28 +60,6 @@ void RunOptions::check_memory(const std::vector<TrialConfig>& trials, int thread
     bvc3d::check_memory(
         estimate_memory(trials, threads), what,
         "shorten sample_hours, use fewer --jobs or smaller models, or pass --no-memory-check to try anyway");
-}
-
-void run_in_parallel(std::size_t n, int jobs, const std::function<void(std::size_t)>& fn) {
-    const std::size_t threads =
-        std::min(n, jobs > 0 ? std::size_t(jobs) : std::max<std::size_t>(1, std::thread::hardware_concurrency()));
-    std::atomic<std::size_t> next{0};
-    std::mutex failed;
-    std::exception_ptr failure;
-    const auto work = [&] {
-        for (std::size_t t; (t = next++) < n;) try {
-                fn(t);
-            } catch (...) {
-                const std::lock_guard<std::mutex> lock(failed);
-                if (!failure) failure = std::current_exception();
-                next = n;
-            }
-    };
-    std::vector<std::thread> others;
-    for (std::size_t k = 1; k < threads; ++k) others.emplace_back(work);
-    work();
-    for (auto& t : others) t.join();
-    if (failure) std::rethrow_exception(failure);
 }
 
 std::string output_folder_text(const std::filesystem::path& folder) {

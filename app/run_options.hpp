@@ -47,10 +47,6 @@ struct RunOptions {
     void check_memory(const std::vector<TrialConfig>& trials, int jobs) const;
 };
 
-// fn(0) … fn(n − 1) on `jobs` threads (0: one per core); the first exception any of them throws is rethrown once
-// all have stopped (the others take no new task after it).
-void run_in_parallel(std::size_t n, int jobs, const std::function<void(std::size_t)>& fn);
-
 // "output folder 'DIR'": how messages (and the lock's holder message) name an output folder.
 std::string output_folder_text(const std::filesystem::path& folder);
 // The lock of an output folder, which is created (and must be writable) first; InputError naming

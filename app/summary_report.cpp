@@ -6,6 +6,8 @@
 #include <string>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
+#include "bvc3d/report/navigation_report.hpp"
 #include "bvc3d/report/summary.hpp"
 #include "cli_common.hpp"
 #include "python_module.hpp"
@@ -70,8 +72,35 @@ std::string report_failure(const ModuleRun& run, const std::vector<std::filesyst
 
 }  // namespace
 
+namespace {
+
+// Navigation trials' tables (report/navigation_report.hpp) and figures (bvc3d.navigation_figures).
+void summarize_navigation(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files,
+                          bool report) {
+    std::vector<NavigationTrial> trials;
+    for (const auto& f : files) trials.push_back(read_navigation_trial(f));
+    write_navigation_report(out, trials);
+    std::printf("wrote %s (starts.csv, paths.csv, learning.csv, reward_map.csv, summary.csv, summary.md)\n",
+                out.string().c_str());
+    if (!report) return;
+    const ModuleRun fig = run_python_module("bvc3d.navigation_figures", {out.string(), trials.front().world}, true);
+    if (fig.status != 0) std::fprintf(stderr, "bvc3d: warning: no figures (%s)\n", fig.last_error_line().c_str());
+}
+
+}  // namespace
+
 void summarize(const std::filesystem::path& out, const std::vector<std::filesystem::path>& files, bool report,
                bool allow_mixed) {
+    std::size_t navigating = 0;
+    for (const auto& f : files) {
+        const auto stamp = read_trial_stamp(f);
+        navigating += stamp && stamp->navigation;
+    }
+    if (navigating > 0 && navigating < files.size())
+        throw InputError(
+            "navigation trials and trials that record place cells in one folder: one table cannot hold "
+            "both (summarize them apart)");
+    if (navigating > 0) return summarize_navigation(out, files, report);
     const auto trials = read_summaries(files);
     if (const auto problem = mixing_problem(trials, files); !problem.empty() && !allow_mixed)
         throw InputError(problem + "; one table would mix them (summarize them apart, or pass --allow-mixed)");

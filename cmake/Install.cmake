@@ -15,7 +15,7 @@ set(BVC3D_PRIVATE_HEADERS
   bvc3d/bvc/bvc_kernels.hpp
   bvc3d/bvc/pruned_sums.hpp
   bvc3d/place/place_kernels.hpp
-  bvc3d/population/adjacency_kernels.hpp
+  bvc3d/navigation/adjacency_kernels.hpp
   bvc3d/core/simd.hpp
   bvc3d/analysis/point_grid.hpp
   bvc3d/analysis/cosine_kernels.hpp

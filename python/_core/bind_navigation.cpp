@@ -8,6 +8,9 @@
 #include "bvc3d/agent/shortest_path.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/experiment/navigation.hpp"
+#include "bvc3d/navigation/replay.hpp"
+#include "bvc3d/navigation/rollouts.hpp"
+#include "bvc3d/navigation/scale_mix.hpp"
 
 namespace bvc3d::py {
 
@@ -34,21 +37,22 @@ RewardParams reward_of(const pyb::kwargs& kwargs) {
 }
 
 // Keywords to whichever table names them: navigation, reward, adjacency.
-void apply_navigation(NavigationSetup& s, const pyb::kwargs& kwargs) {
+void apply_navigation(NavigationSpec& s, const pyb::kwargs& kwargs) {
     pyb::kwargs a, b, c;
     for (const auto& [k, v] : kwargs) {
         const std::string key = pyb::str(k);
         if (key == "flight") {  // the flying agent's parameters, as a YAML file's `flight:` section
             if (!pyb::isinstance<pyb::dict>(v))
                 throw InputError("flight must be a dict of the flying agent's parameters");
-            apply_kwargs(s.flight, FlightParams::table(), pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v)));
+            apply_kwargs(s.space.flight, FlightParams::table(), pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v)));
         } else if (RewardParams::table().find(key)) b[k] = v;
         else if (AdjacencyParams::table().find(key) && !NavigationParams::table().find(key)) c[k] = v;
         else a[k] = v;
     }
-    apply_kwargs(s.nav, NavigationParams::table(), a);
+    apply_kwargs(s.space.nav, NavigationParams::table(), a);
     apply_kwargs(s.reward, RewardParams::table(), b);
     apply_kwargs(s.adjacency, AdjacencyParams::table(), c);
+    s.space.n_hd = s.adjacency.n_hd;
 }
 
 }  // namespace
@@ -168,35 +172,35 @@ HdAdjacency(n_place, **params); params and their defaults:
         "navigate",
         [](const World& w, const pyb::object& goals, const std::string& model, const pyb::object& seed,
            const pyb::kwargs& kwargs) {
-            NavigationSetup s;
-            s.model = config::resolve_model(model);
+            NavigationSpec s;
+            const ModelSpec model_spec = config::resolve_model(model);
             const auto g = real_array(goals, "goals");
             if (g.ndim() != 2 || (g.shape(1) != 2 && g.shape(1) != 3))
                 throw InputError("goals must be an (N, 2) array of x, y (on the floor) or (N, 3) of x, y, z (flying)");
             for (pyb::ssize_t i = 0; i < g.shape(0); ++i)
-                s.goals.push_back(g.shape(1) == 3 ? NavigationGoal(g.at(i, 0), g.at(i, 1), g.at(i, 2))
-                                                  : NavigationGoal(g.at(i, 0), g.at(i, 1)));
-            const int dims = s.dims();
+                s.space.goals.push_back(g.shape(1) == 3 ? NavigationGoal(g.at(i, 0), g.at(i, 1), g.at(i, 2))
+                                                        : NavigationGoal(g.at(i, 0), g.at(i, 1)));
             apply_navigation(s, kwargs);
             const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
-            const auto run = interruptible([&](const std::atomic<bool>&) { return navigate(w, s, seed_value); });
-            pyb::dict d;
-            const auto n = pyb::ssize_t(run.starts.size());
-            std::vector<double> gx, gy, gz, sx, sy, sz, path, shortest, time;
-            std::vector<int> goal, success;
+            const NavigationRecord run = interruptible(
+                [&](const std::atomic<bool>& stop) { return navigate(w, model_spec, s, seed_value, &stop); });
+            const int dims = run.dims;
+            const auto n = pyb::ssize_t(run.n_starts());
+            std::vector<double> gx, gy, gz, sx, sy, sz;
             pyb::list paths;
-            for (const auto& st : run.starts) {
-                goal.push_back(st.goal), success.push_back(st.success);
-                gx.push_back(s.goals[std::size_t(st.goal)].x()), gy.push_back(s.goals[std::size_t(st.goal)].y());
-                gz.push_back(s.goals[std::size_t(st.goal)].z());
-                sx.push_back(st.start.x()), sy.push_back(st.start.y()), sz.push_back(st.start.z());
-                path.push_back(st.path_m), shortest.push_back(st.shortest_m), time.push_back(st.time_s);
-                std::vector<double> xy;
-                for (const Vec3& q : st.path)
-                    for (int k = 0; k < dims; ++k) xy.push_back(q[k]);
-                paths.append(to_numpy(xy.data(), {pyb::ssize_t(st.path.size()), dims}));
+            for (pyb::ssize_t i = 0; i < n; ++i) {
+                const auto k = std::size_t(i), goal = std::size_t(run.start_goal[k]) * std::size_t(dims);
+                gx.push_back(run.goals[goal]), gy.push_back(run.goals[goal + 1]);
+                gz.push_back(dims == 3 ? run.goals[goal + 2] : 0.0);
+                sx.push_back(run.start[k * dims]), sy.push_back(run.start[k * dims + 1]);
+                sz.push_back(dims == 3 ? run.start[k * dims + 2] : 0.0);
+                const auto from = run.path_start[k], to = run.path_start[k + 1];
+                std::vector<double> xy(run.path.begin() + std::ptrdiff_t(from * dims),
+                                       run.path.begin() + std::ptrdiff_t(to * dims));
+                paths.append(to_numpy(xy.data(), {pyb::ssize_t(to - from), dims}));
             }
-            d["goal"] = to_numpy(goal.data(), {n});
+            pyb::dict d;
+            d["goal"] = to_numpy(run.start_goal.data(), {n});
             d["goal_x"] = to_numpy(gx.data(), {n});
             d["goal_y"] = to_numpy(gy.data(), {n});
             d["start_x"] = to_numpy(sx.data(), {n});
@@ -205,15 +209,16 @@ HdAdjacency(n_place, **params); params and their defaults:
                 d["goal_z"] = to_numpy(gz.data(), {n});
                 d["start_z"] = to_numpy(sz.data(), {n});
             }
-            d["success"] = to_numpy(success.data(), {n}).attr("astype")("bool");
-            d["path_m"] = to_numpy(path.data(), {n});
-            d["shortest_m"] = to_numpy(shortest.data(), {n});
-            d["time_s"] = to_numpy(time.data(), {n});
+            d["success"] = to_numpy(run.success.data(), {n}).attr("astype")("bool");
+            d["path_m"] = to_numpy(run.path_m.data(), {n});
+            d["shortest_m"] = to_numpy(run.shortest_m.data(), {n});
+            d["time_s"] = to_numpy(run.time_s.data(), {n});
             d["paths"] = paths;
             d["learn_s"] = run.learn_s;
             d["coverage"] = run.coverage;
             d["visits"] = run.visits;
-            d["goal_cells"] = run.goal_cells;
+            d["goal_cells"] =
+                std::vector<int>(run.goal_cells.begin(), run.goal_cells.begin() + std::ptrdiff_t(run.n_goals()));
             return d;
         },
         pyb::arg("world"), pyb::arg("goals"), pyb::arg("model") = "2d", pyb::arg("seed") = 0,

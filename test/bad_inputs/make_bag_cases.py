@@ -205,6 +205,12 @@ def main():
                  "unknown message encoding 'json'")
     ros2_folder("ros2-corrupt-db", corrupt=True)
     lines.append(f"ros2-corrupt-db | {REPLAY} | bag_0.db3; SQLite")
+    ros2_folder("ros2-lz4-compressed")
+    with open(BAGS / "ros2-lz4-compressed" / "metadata.yaml", "a") as f:
+        f.write("  compression_format: lz4\n  compression_mode: FILE\n")
+    lines.append(f"ros2-lz4-compressed | bag-info {{}} | metadata.yaml; compression_format; 'lz4'")
+    (BAGS / "ros1-format-1.2.bag").write_bytes(b"#ROSRECORD V1.2\n" + bytes(64))
+    lines.append(f"ros1-format-1.2.bag | {REPLAY} | ros1-format-1.2.bag; ROS 1 bag format 1.2 is not supported")
     (BAGS / "cases.txt").write_text("\n".join(lines) + "\n")
 
 

@@ -7,6 +7,7 @@ import signal
 import subprocess
 import time
 
+import h5py
 import numpy as np
 import pytest
 
@@ -219,16 +220,33 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         bvc3d.navigate(world, [[30.0, 0.0]])
 
 
-def test_navigate_on_the_floor_keeps_the_bytes_it_wrote_before_goals_in_3d(tmp_path):
-    """The floor's navigation went behind a NavigationSpace when the flying agent's came (issue 30): a small run's
-    starts.csv and paths.csv keep the digests the code before that change wrote (same options, same machine)."""
+def six_digits(text):
+    """A CSV as the writer before exact numbers printed it: every number with 6 significant digits (C++'s ostream
+    default, printf's %g)."""
+    def field(f):
+        try:
+            return "%g" % float(f)
+        except ValueError:
+            return f
+    return "".join(",".join(field(f) for f in line.split(",")) + "\n" for line in text.splitlines())
+
+
+def test_navigate_on_the_floor_keeps_the_numbers_it_wrote_before(tmp_path):
+    """A small run's starts.csv and paths.csv: the digests the code wrote before navigation became trials of the
+    engine (issue 41; before that, the digests of the code before goals in 3-D, issue 30), from today's exact numbers
+    printed with the 6 digits that code printed; and today's exact files, pinned."""
     out = tmp_path / "out"
     r = run("navigate", "--world", "cross", "--tilt", "60", "--goals", "3.5,3.5;-3.5,-3.5", "--max-learn-hours",
             "0.2", "--starts", "3", "--seeds", "2", "--out", str(out), "--no-report")
     assert r.returncode == 0, r.stderr
-    digests = {name: hashlib.sha256((out / name).read_bytes()).hexdigest() for name in ("starts.csv", "paths.csv")}
-    assert digests == {"starts.csv": "e600565f279eff431d74855ac1dffb396389c3d8aeb0576f6799413a55a27b71",
-                       "paths.csv": "cb27ac3dfb4df6bea6b86551c483eb056cad94b502bd8cfa4d806dfd2eda082a"}
+    texts = {name: (out / name).read_text() for name in ("starts.csv", "paths.csv")}
+    digest = lambda text: hashlib.sha256(text.encode()).hexdigest()
+    assert {name: digest(six_digits(t)) for name, t in texts.items()} == {
+        "starts.csv": "e600565f279eff431d74855ac1dffb396389c3d8aeb0576f6799413a55a27b71",
+        "paths.csv": "cb27ac3dfb4df6bea6b86551c483eb056cad94b502bd8cfa4d806dfd2eda082a"}
+    assert {name: digest(t) for name, t in texts.items()} == {
+        "starts.csv": "a35c34cf5f5f68ebdf15f6260cb09c3b764cee2ab4ccd5ab3417cec93225886b",
+        "paths.csv": "f91ac95de38e64e6fd3412fd99810b6e615c6fcccc51c11db7467675b4cb62c0"}
 
 
 def test_navigate_flies_to_goals_in_3d_seeded_with_3d_paths():
@@ -285,38 +303,42 @@ def test_navigate_in_3d_writes_z_and_resumes_its_runs_to_the_same_bytes(tmp_path
     for name in ("starts.csv", "paths.csv"):
         (out / name).unlink()
     again = run(*args)
-    assert again.returncode == 0 and "already done" in again.stderr, again.stderr
+    assert again.returncode == 0 and "1 already complete" in again.stdout, again.stdout
     assert (out / "starts.csv").read_text() == starts and (out / "paths.csv").read_text() == paths
 
 
-def test_navigate_killed_resumes_from_its_finished_runs_and_writes_the_same_files(tmp_path):
-    """A navigate run killed (SIGKILL) after its first learning run and started again takes that run from
-    runs/seed-0.nav and writes byte for byte what an uninterrupted run writes; other options start afresh."""
+def test_navigate_killed_inside_a_learning_run_resumes_there_and_writes_the_same_files(tmp_path):
+    """Navigation's learning is a trial's run: a navigate run killed (SIGKILL) in the middle of a learning run, after
+    a periodic checkpoint, resumes from that checkpoint and writes byte for byte what an uninterrupted run writes;
+    other options start afresh."""
     def options(starts):
-        return ["navigate", "--world", "cross", "--goals", "3.5,3.5", "--seeds", "3", "--starts", starts,
-                "--max-learn-hours", "0.1", "--no-report"]
+        return ["navigate", "--world", "cross", "--goals", "3.5,3.5", "--seeds", "2", "--starts", starts,
+                "--max-learn-hours", "0.15", "--checkpoint-minutes", "1", "--jobs", "1", "--no-report"]
     args = options("2")
     whole = tmp_path / "whole"
     assert run(*args, "--out", str(whole)).returncode == 0
     part = tmp_path / "part"
     proc = subprocess.Popen([CLI, *args, "--out", str(part)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 300
-    while not (part / "runs" / "seed-0.nav").exists() and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.02)
+    checkpoints = part / ".checkpoints"
+    while not list(checkpoints.glob("*seed0*.h5")) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     assert proc.returncode == -signal.SIGKILL, "the run ended before it could be killed"
-    assert not (part / "starts.csv").exists() and not (part / "runs" / "seed-2.nav").exists()
+    assert list(checkpoints.glob("*seed0*.h5")) and not list(part.glob("*.h5")), "not killed inside a learning run"
     again = run(*args, "--out", str(part))
     assert again.returncode == 0, again.stderr
-    assert "seed 0: already done" in again.stderr and "seed 2: learning" in again.stderr
+    assert "2 run" in again.stdout, again.stdout
     names = sorted(p.relative_to(whole) for p in whole.rglob("*") if p.is_file())
     assert names == sorted(p.relative_to(part) for p in part.rglob("*") if p.is_file())
-    assert "starts.csv" in map(str, names) and "runs/seed-2.nav" in map(str, names)
+    assert {"starts.csv", "cross_2d_seed0.h5"} <= set(map(str, names)), names
     for name in names:
         assert (whole / name).read_bytes() == (part / name).read_bytes(), name
+    same = run(*args, "--out", str(part))
+    assert same.returncode == 0 and "0 run, 2 already complete" in same.stdout, same.stdout
     other = run(*options("1"), "--out", str(part))
-    assert other.returncode == 0 and "seed 0: learning" in other.stderr, other.stderr
+    assert other.returncode == 0 and "2 run" in other.stdout, other.stdout
 
 
 def test_navigate_config_runs_several_models_as_the_options_would(tmp_path):
@@ -349,3 +371,36 @@ def test_navigate_config_refuses_unknown_keys_and_options_beside_it(tmp_path):
     assert not (tmp_path / "out").exists()
     r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--world", "cross", "--out", str(tmp_path / "out"))
     assert r.returncode != 0 and "--world" in r.stderr, r.stderr
+
+
+def test_a_sweep_of_navigation_trials_writes_what_navigate_writes(tmp_path):
+    """A navigation experiment under `bvc3d sweep` (and so under MPI): the trial YAML's navigation: section gives the
+    trials `bvc3d navigate` makes from the same world, goals and parameters, and the same numbers in starts.csv."""
+    nav = run("navigate", "--world", "cross", "--tilt", "60", "--goals", "3.5,3.5", "--model", "2d", "--seeds", "2",
+              "--starts", "2", "--max-learn-hours", "0.1", "--out", str(tmp_path / "nav"), "--no-report")
+    assert nav.returncode == 0, nav.stderr
+    (tmp_path / "sweep.yaml").write_text(
+        "base:\n  world: {source: cross, tilt_deg: 60}\n"
+        "  navigation: {goals: [[3.5, 3.5]], starts: 2, max_learn_hours: 0.1}\n"
+        "grid:\n  model: [2d]\nseeds: 2\n")
+    sweep = run("sweep", str(tmp_path / "sweep.yaml"), "--out", str(tmp_path / "sweep"), "--no-report")
+    assert sweep.returncode == 0, sweep.stderr
+    def columns(folder):  # the numbers of each start (the world and model labels are each command's own)
+        rows = (folder / "starts.csv").read_text().splitlines()
+        return [row.split(",")[2:] for row in rows[1:]]
+    assert columns(tmp_path / "sweep") == columns(tmp_path / "nav") and len(columns(tmp_path / "nav")) == 4
+    with h5py.File(next((tmp_path / "sweep").glob("*seed1.h5"))) as h:
+        g = h["navigation"]
+        assert g.attrs["dims"] == 2 and g["path_start"][-1] == len(g["path"])
+        assert h["populations/reward/reward_weights"].shape == (1, 250)
+    # A navigation trial takes no protocol, and its goals are checked against the world before anything runs.
+    (tmp_path / "bad.yaml").write_text(
+        "base:\n  world: cross\n  protocol: {explore_hours: 1}\n  navigation: {goals: [[3.5, 3.5]]}\n"
+        "grid:\n  model: [2d]\n")
+    bad = run("sweep", str(tmp_path / "bad.yaml"), "--out", str(tmp_path / "bad"))
+    assert bad.returncode == 2 and "protocol" in bad.stderr, bad.stderr
+    (tmp_path / "wall.yaml").write_text(
+        "base:\n  world: cross\n  navigation: {goals: [[30, 0]]}\ngrid:\n  model: [2d]\n")
+    wall = run("sweep", str(tmp_path / "wall.yaml"), "--out", str(tmp_path / "wall"))
+    assert wall.returncode == 2 and "goal 1 (30, 0)" in wall.stderr, wall.stderr
+    assert not list((tmp_path / "wall").glob("*.h5"))

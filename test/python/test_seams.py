@@ -171,7 +171,7 @@ def test_analysis_defaults_are_the_cpp_table(tmp_path):
 
 # The stages from the bottom up; a stage may include only stages ranked below it (and itself).
 STAGE_RANK = {"core": 0, "world": 1, "recording": 1, "agent": 2, "sensor": 2, "bvc": 3, "place": 4, "population": 5,
-              "recorder": 6, "analysis": 7, "report": 8, "config": 9, "experiment": 10}
+              "navigation": 6, "recorder": 7, "analysis": 8, "report": 9, "config": 10, "experiment": 11}
 
 
 def test_lower_stages_never_include_higher_ones():

@@ -15,9 +15,12 @@
 #include "bvc3d/bvc/boundary_vector_layer.hpp"
 #include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/core/random.hpp"
+#include "bvc3d/navigation/packed_adjacency.hpp"
+#include "bvc3d/navigation/replay.hpp"
+#include "bvc3d/navigation/rollouts.hpp"
+#include "bvc3d/navigation/scale_mix.hpp"
+#include "bvc3d/navigation/sparse_adjacency.hpp"
 #include "bvc3d/place/place_cell_network.hpp"
-#include "bvc3d/population/packed_adjacency.hpp"
-#include "bvc3d/population/reward_cells.hpp"
 #include "bvc3d/sensor/lidar.hpp"
 
 using namespace bvc3d;

@@ -12,6 +12,7 @@
 
 #include "../support/temp_dir.hpp"
 
+#include "bvc3d/agent/learning_walk.hpp"
 #include "bvc3d/agent/shortest_path.hpp"
 #include "bvc3d/agent/voxel_path.hpp"
 #include "bvc3d/config/population_kinds.hpp"
@@ -19,9 +20,12 @@
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/navigation.hpp"
-#include "bvc3d/population/adjacency_kernels.hpp"
-#include "bvc3d/population/packed_adjacency.hpp"
-#include "bvc3d/population/reward_cells.hpp"
+#include "bvc3d/navigation/adjacency_kernels.hpp"
+#include "bvc3d/navigation/packed_adjacency.hpp"
+#include "bvc3d/navigation/replay.hpp"
+#include "bvc3d/navigation/rollouts.hpp"
+#include "bvc3d/navigation/scale_mix.hpp"
+#include "bvc3d/navigation/sparse_adjacency.hpp"
 
 using namespace bvc3d;
 
@@ -411,6 +415,65 @@ TEST(RewardCells, ReplayValueFallsAlongTheChainAndTheChoiceHeadsToTheGoal) {
 
 namespace {
 
+// A navigation run as these tests describe it, and its record split into starts.
+struct NavigationSetup {
+    ModelSpec model = model_preset("2d");
+    std::vector<NavigationGoal> goals;
+    NavigationParams nav;
+    AdjacencyParams adjacency;
+    RewardParams reward;
+    NavigationSpec spec() const {
+        NavigationSpec s;
+        s.space.goals = goals;
+        s.space.nav = nav;
+        s.space.n_hd = adjacency.n_hd;
+        s.adjacency = adjacency;
+        s.reward = reward;
+        return s;
+    }
+};
+
+struct RunStart {
+    Vec3 start = Vec3::Zero();
+    bool success = false;
+    double path_m = 0, shortest_m = 0;
+    std::vector<Vec3> path;
+};
+
+struct NavigationRun {
+    std::vector<int> goal_cells, visits;
+    double coverage = 0;
+    std::vector<RunStart> starts;
+    std::vector<double> map_reward;
+};
+
+NavigationRun navigate(const World& world, const NavigationSetup& setup, std::uint64_t seed) {
+    const NavigationRecord r = bvc3d::navigate(world, setup.model, setup.spec(), seed);
+    NavigationRun run{r.goal_cells, r.visits, r.coverage, {}, r.map_reward};
+    const auto d = std::size_t(r.dims);
+    const auto point = [&](const std::vector<double>& v, std::size_t i) {
+        Vec3 p = Vec3::Zero();
+        for (std::size_t k = 0; k < d; ++k) p[Eigen::Index(k)] = v[i * d + k];
+        return p;
+    };
+    for (std::size_t i = 0; i < r.n_starts(); ++i) {
+        RunStart s{point(r.start, i), r.success[i] != 0, r.path_m[i], r.shortest_m[i], {}};
+        for (auto k = r.path_start[i]; k < r.path_start[i + 1]; ++k) s.path.push_back(point(r.path, k));
+        run.starts.push_back(std::move(s));
+    }
+    return run;
+}
+
+void check_goals(const World& world, const NavigationSetup& setup) { bvc3d::check_goals(world, setup.spec()); }
+
+void check_model(const ModelSpec& model, const NavigationSetup& setup) {
+    navigation_trial(WorldSpec::built("test"), model, std::make_shared<NavigationSpec>(setup.spec()), 0);
+}
+
+}  // namespace
+
+namespace {
+
 World open_room(const std::filesystem::path& dir) {
     const auto file = dir / "room.yaml";
     std::ofstream(file) << "name: room\nobjects:\n"
@@ -463,7 +526,8 @@ TEST(Navigation, ReachesAGoalInSightInAnOpenRoomTheSameForTheSameSeed) {
         EXPECT_EQ(again.starts[i].path.size(), run.starts[i].path.size());
         EXPECT_EQ(again.starts[i].start, run.starts[i].start);
     }
-    EXPECT_EQ(again.rewards, run.rewards);
+    EXPECT_EQ(again.map_reward, run.map_reward);
+    EXPECT_EQ(again.goal_cells, run.goal_cells);
 }
 
 namespace {
@@ -520,7 +584,8 @@ TEST(Navigation, MultiscaleReachesAGoalInSightTheSameForTheSameSeed) {
     // same first scale's reward cell) walks other paths.
     auto single = room_setup();
     const auto alone = navigate(world, single, 3);
-    EXPECT_EQ(alone.goal_cells, run.goal_cells);
+    ASSERT_EQ(run.goal_cells.size(), 2u);  // a reward cell per scale
+    EXPECT_EQ(alone.goal_cells.front(), run.goal_cells.front());
     bool differs = false;
     for (std::size_t i = 0; i < run.starts.size(); ++i) differs = differs || alone.starts[i].path != run.starts[i].path;
     EXPECT_TRUE(differs);
@@ -747,7 +812,8 @@ TEST(Navigation, FlyingAgentReachesAGoalInSightInAnOpenVolumeTheSameForTheSameSe
     const auto again = navigate(world, setup, 1);
     ASSERT_EQ(again.starts.size(), run.starts.size());
     for (std::size_t i = 0; i < run.starts.size(); ++i) EXPECT_EQ(again.starts[i].path, run.starts[i].path) << i;
-    EXPECT_EQ(again.rewards, run.rewards);
+    EXPECT_EQ(again.map_reward, run.map_reward);
+    EXPECT_EQ(again.goal_cells, run.goal_cells);
 }
 
 TEST(Navigation, RefusesGoalsIn3DOutsideInGeometryUnreachableOrMixed) {
@@ -779,4 +845,202 @@ TEST(Navigation, RefusesGoalsIn3DOutsideInGeometryUnreachableOrMixed) {
     // A ground model on a flying run, as a trial refuses it.
     EXPECT_THROW(check_model(model_preset("2d"), setup), InputError);
     EXPECT_NO_THROW(check_model(model_preset("fly-5l"), setup));
+}
+
+namespace {
+
+// A learned adjacency of n cells: cells fire in a slow random sequence while the heading turns at random.
+HdAdjacency learned_adjacency(int n, int n_hd, unsigned seed) {
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    AdjacencyParams params;
+    params.n_hd = n_hd;
+    HdAdjacency adj(n, params);
+    for (int t = 0; t < 400; ++t) {
+        std::vector<double> v(std::size_t(n), 0.0);
+        for (int c = 0; c < 3; ++c) v[std::size_t((t / 4 + c * 7) % n)] = u(gen);
+        adj.learn(v, hd_rates(6.3 * u(gen), n_hd), t % 13 == 0);
+    }
+    return adj;
+}
+
+}  // namespace
+
+// The one product interface (navigation/adjacency_product.hpp): the reference is the definition, computed here again
+// from the weights (HdAdjacency::weight, the prune rule restated), and the fast copies agree with it — the float32
+// sparse copy to rounding, the packed copy to its 16-bit weights.
+TEST(AdjacencyProduct, BackendsAgreeWithTheReference) {
+    const int n = 48;
+    std::mt19937 gen(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int n_hd : {8, 3})
+        for (double prune : {0.0, 0.05}) {
+            const HdAdjacency adj = learned_adjacency(n, n_hd, 11);
+            const ReferenceAdjacency reference(adj, prune);
+            const SparseAdjacency sparse(adj, prune);
+            const PackedAdjacency packed(adj, prune);
+            const auto K = std::size_t(n_hd), N = std::size_t(n);
+            // Every direction's own state: a dense one, then one with a few cells (the column forms).
+            for (int few : {0, 1}) {
+                std::vector<double> X(N * K, 0.0);
+                for (std::size_t e = 0; e < X.size(); ++e)
+                    if (!few || e % 11 == 0) X[e] = u(gen);
+                std::vector<double> ref(N * K), fast(N * K), half(N * K);
+                reference.apply(std::span<const double>(X), std::span<double>(ref));
+                sparse.apply(std::span<const double>(X), std::span<double>(fast));
+                packed.apply(std::span<const double>(X), std::span<double>(half));
+                std::vector<double> top(K, 0.0);
+                for (std::size_t k = 0; k < K; ++k)
+                    for (int i = 0; i < n; ++i)
+                        for (int j = 0; j < n; ++j) top[k] = std::max(top[k], std::abs(adj.weight(int(k), i, j)));
+                for (std::size_t k = 0; k < K; ++k)
+                    for (std::size_t i = 0; i < N; ++i) {
+                        double sum = 0.0, mass = 0.0, edge = 0.0;  // edge: weights within rounding of the cut
+                        for (std::size_t j = 0; j < N; ++j) {
+                            const double w = adj.weight(int(k), int(i), int(j));
+                            const double cut = prune * top[k];
+                            if (std::abs(std::abs(w) - cut) <= 1e-6 * top[k]) edge += std::abs(w * X[j * K + k]);
+                            else if (std::abs(w) > cut) sum += w * X[j * K + k];
+                            mass += std::abs(w * X[j * K + k]);
+                        }
+                        const double at = ref[i * K + k];
+                        EXPECT_NEAR(at, sum, 1e-12 * mass + edge) << n_hd << " " << prune << " " << k << " " << i;
+                        // With few cells the copies take Wᵀ·x = −W·x (by columns): the learned W is antisymmetric to
+                        // the rounding of its float32 updates, so that form is within float32's rounding of W·x.
+                        EXPECT_NEAR(fast[i * K + k], at, (few ? 1e-6 : 1e-12) * mass)
+                            << n_hd << " " << prune << " " << k << " " << i;
+                        // binary16: each kept weight within 2⁻¹¹ of the largest; float32 sums.
+                        EXPECT_NEAR(half[i * K + k], at, std::ldexp(1.0, -11) * top[k] * double(N) + 1e-6 * mass);
+                    }
+            }
+            // Directions left out are 0 where a copy rolls one at a time; the float form gives the double form's
+            // value rounded (the sparse copy sums in double).
+            std::vector<char> which(K, 0);
+            which[1] = 1;
+            std::vector<double> X(N * K), Y(N * K, 7.0);
+            for (double& x : X) x = u(gen);
+            sparse.apply(std::span<const double>(X), std::span<double>(Y), which);
+            for (std::size_t i = 0; i < N; ++i) EXPECT_EQ(Y[i * K + 0], 0.0);
+            std::vector<float> xf(X.begin(), X.end()), yf(N * K);
+            std::vector<double> rounded(xf.begin(), xf.end()), yd(N * K);
+            sparse.apply(std::span<const float>(xf), std::span<float>(yf));
+            sparse.apply(std::span<const double>(rounded), std::span<double>(yd));
+            for (std::size_t e = 0; e < yf.size(); ++e) EXPECT_EQ(yf[e], static_cast<float>(yd[e]));
+            EXPECT_THROW(sparse.apply(std::span<const double>(X).first(N), std::span<double>(Y)), InputError);
+            EXPECT_THROW(sparse.apply(std::span<const double>(X), std::span<double>(Y), std::vector<char>(K + 1, 1)),
+                         InputError);
+            EXPECT_EQ(reference.entries(), sparse.entries());
+        }
+}
+
+// The rollouts are one algorithm over any copy: through the reference and the sparse copy they give the same
+// returns, and replay the same weights, to the float32 rounding of the learned W's antisymmetry (the sparse copy
+// multiplies a few active cells by columns).
+TEST(AdjacencyProduct, RolloutsAndReplayReadAnyCopy) {
+    const int n = 48;
+    const HdAdjacency adj = learned_adjacency(n, 8, 3);
+    const ReferenceAdjacency reference(adj, 0.0);
+    const SparseAdjacency sparse(adj, 0.0);
+    RewardParams p;
+    p.lambda = 4;
+    const auto w_ref = replay(reference, 5, p), w = replay(sparse, 5, p);
+    for (int i = 0; i < n; ++i) EXPECT_NEAR(w[std::size_t(i)], w_ref[std::size_t(i)], 1e-6 * std::abs(w_ref[i]) + 1e-9);
+    std::vector<double> v(std::size_t(n), 0.0);
+    v[20] = 0.8, v[21] = 0.4;
+    const auto r_ref = direction_returns(reference, w, v, p), r = direction_returns(sparse, w, v, p);
+    for (int k = 0; k < 8; ++k) EXPECT_NEAR(r[std::size_t(k)], r_ref[std::size_t(k)], 1e-6 * std::abs(r_ref[k]) + 1e-9);
+}
+
+// Reward cells (population/reward_cells.hpp): a goal binds the most active place cell at learning steps inside its
+// radius (in the plane for goals x, y), not outside it nor while frozen; the rates are the read-out w·v / |v|₁.
+TEST(RewardCells, BindTheMostActiveCellNearTheGoalAndReadOutTheirWeights) {
+    RewardCellParams p;
+    p.goals = {1.0, 1.0, -2.0, 0.0};
+    p.radius = 0.5;
+    RewardCells cells(4, p);
+    ASSERT_EQ(cells.size(), 2u);
+    const auto at = [](double t, const Pose& pose) { return ModelStep{t, pose, false, std::nullopt}; };
+    const std::vector<ModelStep> steps{at(0.0, Pose::on_floor(1.2, 1.1, 0.0)),   // near goal 1
+                                       at(0.3, Pose::on_floor(1.2, 1.1, 0.0)),   // near goal 1, frozen
+                                       at(0.6, Pose::on_floor(5.0, 5.0, 0.0)),   // near none
+                                       at(0.9, Pose{-2.0, 0.3, 9.0, 0, 0, 0})};  // near goal 2 in the plane
+    const std::vector<char> learn{1, 0, 1, 1};
+    const std::vector<double> place{0.1, 0.5, 0.2, 0.0,   // goal 1 binds cell 1
+                                    0.0, 0.0, 0.0, 0.9,   // frozen: no binding
+                                    0.9, 0.0, 0.0, 0.0,   // far from both
+                                    0.3, 0.0, 0.6, 0.1};  // goal 2 binds cell 2
+    std::vector<double> out(8);
+    const std::span<const double> in(place);
+    cells.step(StepBlock{steps, learn, 0}, std::span<const std::span<const double>>(&in, 1), out);
+    EXPECT_EQ(cells.bound(0), 1);
+    EXPECT_EQ(cells.bound(1), 2);
+    for (double r : out) EXPECT_EQ(r, 0.0);  // no weights before replay
+    // Weights as replay would set them: the read-out of each step's rates.
+    auto state = cells.state();
+    for (auto& a : state)
+        if (a.name == "reward_weights") a.values = std::vector<double>{1, 2, 3, 4, 0, 0, 1, 0};
+    RewardCells again(4, p);
+    again.restore(state);
+    EXPECT_EQ(again.bound(0), 1);
+    again.step(StepBlock{steps, std::vector<char>(4, 0), 0}, std::span<const std::span<const double>>(&in, 1), out);
+    EXPECT_NEAR(out[0], (0.1 + 1.0 + 0.6) / 0.8, 1e-12);
+    EXPECT_NEAR(out[7], 0.6 / 1.0, 1e-12);
+    state.front().values = std::vector<double>{1, 7};  // cell 7 of 4
+    EXPECT_THROW(again.restore(state), InputError);
+    p.goals = {1.0, 1.0, 2.0};
+    EXPECT_THROW(RewardCells(4, p), InputError);
+}
+
+// The learning walk (agent/learning_walk.hpp) is the robot's random walk step for step until each goal has been
+// visited and the coverage reached, then has no steps left; saved and restored half way, it goes on the same.
+TEST(LearningWalk, WalksAsTheRandomWalkUntilItsCriteriaAndResumesExactly) {
+    test::TempDir dir;
+    const World world = open_room(dir.path());
+    NavigationSpaceSpec spec;
+    spec.goals = {{2.5, 2.5}};
+    spec.nav.goal_visits = 2;
+    spec.nav.coverage = 0.6;
+    const LearningWalkSpec learning(spec);
+    const auto agent = learning.make(&world, 4);
+    const auto plain = RandomWalkSpec(spec.robot).make(&world, 4);
+    std::vector<Pose> poses;
+    std::string half;
+    while (const auto s = agent->next(1e6)) {
+        const auto p = plain->next(1e6);
+        ASSERT_TRUE(p.has_value());
+        EXPECT_EQ(s->pose.x, p->pose.x);
+        EXPECT_EQ(s->pose.y, p->pose.y);
+        poses.push_back(s->pose);
+        if (poses.size() == 300) half = agent->save_state();
+    }
+    EXPECT_TRUE(agent->finished());
+    ASSERT_GT(poses.size(), 300u);
+    const auto report = agent->report();
+    ASSERT_EQ(report.size(), 3u);
+    EXPECT_EQ(report[0].second, agent->time());
+    EXPECT_GE(report[1].second, 0.6);
+    EXPECT_GE(report[2].second, 2.0);
+    // The criteria were met at the last step, not before: the coverage of the steps before it, by the space's cells.
+    const auto space = make_navigation_space(world.description(), spec);
+    std::vector<char> seen(space->coverage_size(), 0);
+    std::size_t covered = 0;
+    for (std::size_t i = 0; i + 1 < poses.size(); ++i)
+        if (const auto c = space->coverage_cell(poses[i].position()); c && !seen[*c]) seen[*c] = 1, ++covered;
+    int visits = 0;
+    bool inside = false;
+    for (std::size_t i = 0; i + 1 < poses.size(); ++i) {
+        const bool in = space->distance(poses[i].position(), spec.goals[0].p) <= spec.nav.goal_radius;
+        visits += in && !inside;
+        inside = in;
+    }
+    EXPECT_TRUE(double(covered) / double(space->coverage_cells()) < 0.6 || visits < 2);
+    const auto resumed = learning.make(&world, 99);
+    resumed->restore_state(half);
+    for (std::size_t i = 300; i < poses.size(); ++i) {
+        const auto s = resumed->next(1e6);
+        ASSERT_TRUE(s.has_value()) << i;
+        EXPECT_EQ(s->pose.x, poses[i].x) << i;
+        EXPECT_EQ(s->pose.heading, poses[i].heading) << i;
+    }
+    EXPECT_FALSE(resumed->next(1e6).has_value());
 }

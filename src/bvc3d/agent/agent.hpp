@@ -9,6 +9,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bvc3d/core/geometry.hpp"
 #include "bvc3d/core/params.hpp"
@@ -43,6 +45,9 @@ public:
     // Everything needed to continue exactly where it stopped.
     virtual std::string save_state() const = 0;
     virtual void restore_state(const std::string& state) = 0;  // InputError if it does not fit
+    // What the agent reports of its run, as named numbers (a learning walk: the coverage it reached, each goal's
+    // visits); a name may repeat, one value per item.
+    virtual std::vector<std::pair<std::string, double>> report() const { return {}; }
 };
 
 // How an agent moves, which decides the model presets made for it: on the floor (the ground robot's

@@ -148,16 +148,20 @@ GazeboOptions gazebo_options_from_yaml(const YamlView& v, BuildingSpec& spec) {
     };
     spec.file = in_yaml_dir(v["sdf"].as_string());
     if (!is_gazebo_file(spec.file)) v["sdf"].fail("must name a Gazebo world file (.world or .sdf)");
-    if (v.has("model_path")) {
-        const YamlView mp = v["model_path"];
-        if (!mp.is_sequence()) mp.fail("must be a list of folders");
-        for (std::size_t i = 0; i < mp.size(); ++i) {
-            const std::string dir = in_yaml_dir(mp.at(i).as_string());
+    // Lists of folders, relative to the YAML, that must exist.
+    const auto folders = [&](const char* key, std::vector<std::string>& out) {
+        if (!v.has(key)) return;
+        const YamlView list = v[key];
+        if (!list.is_sequence()) list.fail("must be a list of folders");
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            const std::string dir = in_yaml_dir(list.at(i).as_string());
             std::error_code ec;
-            if (!fs::is_directory(dir, ec)) mp.at(i).fail("folder '" + dir + "' does not exist");
-            o.model_path.push_back(dir);
+            if (!fs::is_directory(dir, ec)) list.at(i).fail("folder '" + dir + "' does not exist");
+            out.push_back(dir);
         }
-    }
+    };
+    folders("model_path", o.model_path);
+    folders("resource_path", o.resource_path);
     const std::string geometry = v.get("geometry", "visual");
     if (geometry != "visual" && geometry != "collision") v["geometry"].fail("must be 'visual' or 'collision'");
     o.geometry = geometry == "visual" ? GazeboOptions::Geometry::visual : GazeboOptions::Geometry::collision;

@@ -41,7 +41,7 @@ WorldDescription building_world(const BuildingSpec& spec);
 // Gazebo's ground plane is a floor only when there is no other.
 std::vector<FloorLevel> building_floors(const GazeboScene& scene);
 
-// A world YAML with an `sdf` key (docs/buildings.md#world-yaml): sdf, model_path, geometry,
+// A world YAML with an `sdf` key (docs/buildings.md#world-yaml): sdf, model_path, resource_path, geometry,
 // missing_models, collada_up_axis, floor_z, step_height, name, start, flight_volume.
 WorldDescription building_from_yaml(const YamlView& v);
 // The files such a YAML's world depends on (for fingerprints): see gazebo_world_files().

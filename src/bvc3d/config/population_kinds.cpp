@@ -89,6 +89,45 @@ PopulationSpec bvc_layer_spec(const std::string& name, const BvcParams& p) {
     return s;
 }
 
+PopulationSpec adjacency_spec(const std::string& name, const AdjacencyParams& p, std::vector<std::string> inputs) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "adjacency";
+    s.inputs = std::move(inputs);
+    s.recorded = false;  // it has no rates
+    s.key = key_of(s.kind, p);
+    s.make = [p](const PopulationContext& c) -> std::unique_ptr<Population> {
+        if (c.input_sizes.size() != 2) throw InputError("an adjacency reads a place-cell and an HD population");
+        if (c.input_sizes[1] != static_cast<std::size_t>(p.n_hd))
+            throw InputError("an adjacency of n_hd " + std::to_string(p.n_hd) + " reads an HD population of " +
+                             std::to_string(c.input_sizes[1]) + " cells");
+        return std::make_unique<AdjacencyPopulation>(static_cast<int>(c.input_sizes[0]), p);
+    };
+    s.footprint = [p](const std::vector<std::size_t>& in) {
+        return PopulationFootprint{0, HdAdjacency::bytes(in.empty() ? 0 : static_cast<int>(in[0]), p.n_hd)};
+    };
+    return s;
+}
+
+PopulationSpec reward_cells_spec(const std::string& name, const RewardCellParams& p, std::vector<std::string> inputs) {
+    p.validate();
+    PopulationSpec s;
+    s.name = name;
+    s.kind = "reward";
+    s.inputs = std::move(inputs);
+    s.recorded = false;  // their rates mean something once navigation has replayed
+    s.key = key_of(s.kind, p);
+    s.make = [p](const PopulationContext& c) -> std::unique_ptr<Population> {
+        if (c.input_sizes.size() != 1) throw InputError("reward cells read one place-cell population");
+        return std::make_unique<RewardCells>(c.input_sizes[0], p);
+    };
+    s.footprint = [p](const std::vector<std::size_t>& in) {
+        return PopulationFootprint{p.n_goals(), 8.0 * double(p.n_goals()) * double(in.empty() ? 0 : in[0])};
+    };
+    return s;
+}
+
 namespace {
 
 // A growing network's keys: its own and the place cells' dynamics (n_place aside: its cells are budget, n_initial).
@@ -169,6 +208,23 @@ const std::vector<PopulationKind>& population_kinds() {
              BvcParams p;
              read_table(v, p, BvcParams::table(), item_keys);
              return bvc_layer_spec(name, p);
+         }},
+        {"adjacency",
+         "the HD-conditioned adjacency of place cells that navigation rolls forward (inputs: [place cells, HD cells]); "
+         "no rates, its matrices kept",
+         keys_of<AdjacencyParams>(), 2,
+         [](const YamlView& v, const std::string& name, std::vector<std::string> inputs) {
+             AdjacencyParams p;
+             read_table(v, p, AdjacencyParams::table(), item_keys);
+             return adjacency_spec(name, p, std::move(inputs));
+         }},
+        {"reward", "reward cells, one per goal, bound to the most active place cell near it (inputs: [place cells])",
+         keys_of<RewardCellParams>(), 1,
+         [](const YamlView& v, const std::string& name, std::vector<std::string> inputs) {
+             RewardCellParams p;
+             read_table(v, p, RewardCellParams::table(), item_keys);
+             check_at(v, [&] { p.validate(); });
+             return reward_cells_spec(name, p, std::move(inputs));
          }},
         {"place", "place cells fed by BVCs and grid cells (inputs: [a BVC population, a grid population])",
          keys_of<PlaceParams>(), 2,

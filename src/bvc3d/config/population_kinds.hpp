@@ -14,7 +14,9 @@
 #include "bvc3d/place/place_cell_network.hpp"
 #include "bvc3d/population/grid_cells.hpp"
 #include "bvc3d/population/growing_place_cells.hpp"
+#include "bvc3d/population/hd_adjacency.hpp"
 #include "bvc3d/population/head_direction_cells.hpp"
+#include "bvc3d/population/reward_cells.hpp"
 
 namespace bvc3d::config {
 
@@ -40,6 +42,10 @@ PopulationSpec bvc_layer_spec(const std::string& name, const BvcParams& p);
 // Place cells reading `inputs` = {a BVC population, a grid population} (SPEC §16; place/place_cell_network.hpp).
 // Their weights and mask come from the trial's seed hashed with `name`: each network draws its own.
 PopulationSpec grid_place_spec(const std::string& name, const PlaceParams& p, std::vector<std::string> inputs);
+// The HD-conditioned adjacency of navigation, reading `inputs` = {a place-cell population, an HD population of n_hd}.
+PopulationSpec adjacency_spec(const std::string& name, const AdjacencyParams& p, std::vector<std::string> inputs);
+// Reward cells, one per goal, reading `inputs` = {a place-cell population}.
+PopulationSpec reward_cells_spec(const std::string& name, const RewardCellParams& p, std::vector<std::string> inputs);
 
 }  // namespace bvc3d::config
 

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/navigation_spec.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
@@ -30,11 +31,13 @@ std::uint64_t text_hash(const std::string& s) {
 
 WorldDescription WorldSpec::resolve() const {
     if (is_none()) throw InputError("this trial has no world (its returns are recorded data)");
+    if (in_memory) throw InputError("world '" + source + "' was built in code: give its preset or file to rebuild it");
     return config::resolve_world(source, tilt_deg, lean);
 }
 
 std::string WorldSpec::label() const {
     if (is_none()) return "none";
+    if (in_memory) return source;
     if (config::world_preset_takes_tilt(source)) {
         std::string l = source + "-" + format_number(tilt_deg.value_or(0.0));
         return lean == "+x+y" ? l : l + "_" + lean;
@@ -46,6 +49,7 @@ std::string WorldSpec::label() const {
 
 std::string WorldSpec::fingerprint() const {
     if (is_none()) return "none";
+    if (in_memory) return "built in code: " + source;
     const auto presets = config::world_preset_names();
     if (std::find(presets.begin(), presets.end(), source) != presets.end())
         return "preset " + source + " tilt " + format_number(tilt_deg.value_or(0.0)) + " lean " + lean;
@@ -65,28 +69,44 @@ const params::Table<Protocol>& Protocol::table() {
     using namespace params;
     static const Table<Protocol> t(
         "protocol",
-        {choice("kind", &Protocol::kind, {{Kind::explore_then_sample, "explore_then_sample"}, {Kind::online, "online"}},
-                "explore_then_sample (learn, then record frozen) or online (record while learning)"),
+        {choice("kind", &Protocol::kind,
+                {{Kind::explore_then_sample, "explore_then_sample"}, {Kind::online, "online"}, {Kind::learn, "learn"}},
+                "explore_then_sample (learn, then record frozen), online (record while learning) or learn (learn "
+                "until explore_hours or the agent's end, record nothing: navigation's learning)"),
          real("explore_hours", &Protocol::explore_hours, closed(0, max_agent_hours),
               "h of exploration, learning on, not recorded"),
-         real("sample_hours", &Protocol::sample_hours, open_closed(0, max_agent_hours),
-              "h recorded (online: the one phase)"),
+         real("sample_hours", &Protocol::sample_hours, closed(0, max_agent_hours),
+              "h recorded (online: the one phase); more than 0 unless the kind is learn"),
          flag("record_bvc", &Protocol::record_bvc, "also record the BVC rates")});
     return t;
 }
 
-void Protocol::validate() const { table().check(*this); }
-
-double Protocol::seconds() const {
-    return 3600.0 * (kind == Kind::online ? sample_hours : explore_hours + sample_hours);
+void Protocol::validate() const {
+    table().check(*this);
+    if (records() && !(sample_hours > 0))
+        table().fail("sample_hours", "must be in (0, " + format_number(max_agent_hours) + "] (0 only for kind learn)");
 }
 
-std::string protocol_name(Protocol::Kind k) { return k == Protocol::Kind::online ? "online" : "explore_then_sample"; }
+double Protocol::seconds() const {
+    switch (kind) {
+        case Kind::online:
+            return 3600.0 * sample_hours;
+        case Kind::learn:
+            return 3600.0 * explore_hours;
+        default:
+            return 3600.0 * (explore_hours + sample_hours);
+    }
+}
+
+std::string protocol_name(Protocol::Kind k) {
+    return k == Protocol::Kind::online ? "online" : k == Protocol::Kind::learn ? "learn" : "explore_then_sample";
+}
 
 Protocol::Kind parse_protocol(const std::string& name) {
     if (name == "explore_then_sample" || name == "paper") return Protocol::Kind::explore_then_sample;
     if (name == "online") return Protocol::Kind::online;
-    throw InputError("protocol '" + name + "' is not one of explore_then_sample, online");
+    if (name == "learn") return Protocol::Kind::learn;
+    throw InputError("protocol '" + name + "' is not one of explore_then_sample, online, learn");
 }
 
 void TrialConfig::set_agent(std::shared_ptr<const AgentSpec> a) {
@@ -191,7 +211,7 @@ void TrialConfig::validate() const {
             throw InputError("weights from '" + weights->source + "' were trained by model '" + weights->model +
                              "', whose BVCs are not model '" + model.name + "''s: " + why);
     // Decoding compares two halves of the recorded samples: at least two model steps are needed.
-    if (protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
+    if (protocol.records() && protocol.sample_hours * 3600.0 * agent->steps_per_second() < 2.0)
         Protocol::table().fail("sample_hours",
                                "= " + format_number(protocol.sample_hours) + " h records fewer than 2 model steps");
 }
@@ -238,7 +258,8 @@ std::string TrialConfig::canonical() const {
         extent = params::to_text(std::vector<double>{analysis.extent->xmin, analysis.extent->xmax,
                                                      analysis.extent->ymin, analysis.extent->ymax});
     lines.insert(lines.find("  decoding_templates:"), "  extent: " + extent + "\n");
-    return walk_key() + config::model_to_yaml(model) + (weights ? weights->key() : "") + "analysis:\n" + lines;
+    return walk_key() + config::model_to_yaml(model) + (weights ? weights->key() : "") + "analysis:\n" + lines +
+           (navigation ? navigation->canonical() : "");
 }
 
 analysis::AnalysisParams TrialConfig::analysis_params(const WorldDescription& w) const {

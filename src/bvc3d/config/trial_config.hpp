@@ -25,7 +25,11 @@ struct WorldSpec {
     std::optional<double> tilt_deg;
     std::string lean = "+x+y";
 
+    // A world built in code (a Python World): its name labels it; it cannot be found again from the spec.
+    bool in_memory = false;
+
     static WorldSpec none() { return WorldSpec{"", std::nullopt, "+x+y"}; }
+    static WorldSpec built(const std::string& name) { return WorldSpec{name, std::nullopt, "+x+y", true}; }
     bool is_none() const { return source.empty(); }
     WorldDescription resolve() const;  // InputError for none
     // "cross-45", "two-rooms", ...: used in file names and tables.
@@ -35,7 +39,8 @@ struct WorldSpec {
 };
 
 struct Protocol {
-    enum class Kind { explore_then_sample, online } kind = Kind::explore_then_sample;
+    // learn: learning on until explore_hours or the agent's end (navigation's learning walk), nothing recorded
+    enum class Kind { explore_then_sample, online, learn } kind = Kind::explore_then_sample;
     double explore_hours = 4.0;  // learning on, nothing recorded
     double sample_hours = 4.0;   // learning off, every step recorded (online: the one recorded phase)
     bool record_bvc = false;     // also record the BVC rates
@@ -43,6 +48,7 @@ struct Protocol {
     static const params::Table<Protocol>& table();
     void validate() const;
     double seconds() const;  // agent time the protocol runs
+    bool records() const { return kind != Kind::learn; }
 };
 
 // Place-cell weights to start from (a trained network, e.g. from a trial file) instead of the
@@ -64,6 +70,8 @@ std::shared_ptr<const InitialWeights> weights_from_trial_file(const std::filesys
 // sensor and the place cells' dynamics may differ (a trained network on a real sensor's scans).
 std::string weights_model_mismatch(const std::string& trained, const ModelSpec& model);
 
+struct NavigationSpec;  // config/navigation_spec.hpp
+
 struct TrialConfig {
     WorldSpec world;
     ModelSpec model = model_preset("3d-0.2");
@@ -74,6 +82,8 @@ struct TrialConfig {
     analysis::AnalysisParams analysis;              // defaults as the paper; its extent is set from arena_extent
     bool arena_extent = false;                      // bin over the walkable region's bounds, not the trajectory's
     std::uint64_t seed = 0;
+    // A navigation trial (config/navigation_spec.hpp): after its learning run, episodes to goals. Null for others.
+    std::shared_ptr<const NavigationSpec> navigation;
 
     // The experimental condition this trial belongs to (its seeds are its replicates) and the
     // values that define it, e.g. {model: 3d-0.2, world: cross-45}. Labels only: they do not

@@ -5,6 +5,7 @@
 
 #include "bvc3d/config/agent_kinds.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/navigation_spec.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/format.hpp"
 
@@ -66,10 +67,33 @@ void analysis_from(const YamlView& v, TrialConfig& t) {
     t.arena_extent = extent == "arena";
 }
 
+// `navigation:` (docs/navigation.md#as-a-trial): goals ([[x, y], ...] or [[x, y, z], ...]), the navigation table's
+// keys, and adjacency: and reward: tables; the bodies from the trial's robot: or flight: section.
+std::shared_ptr<NavigationSpec> navigation_from(const YamlView& v, const YamlView& trial) {
+    auto nav = std::make_shared<NavigationSpec>();
+    read_table(v, nav->space.nav, NavigationParams::table(), {"goals", "adjacency", "reward"});
+    if (!v.has("goals")) v.fail("needs goals: a list of [x, y] (on the floor) or [x, y, z] (flying)");
+    const YamlView goals = v["goals"];
+    if (!goals.is_sequence() || goals.size() == 0) goals.fail("must be a list of [x, y] or of [x, y, z]");
+    for (std::size_t i = 0; i < goals.size(); ++i) {
+        const auto g = goals.at(i).as_doubles();
+        if (g.size() == 2) nav->space.goals.emplace_back(g[0], g[1]);
+        else if (g.size() == 3) nav->space.goals.emplace_back(g[0], g[1], g[2]);
+        else goals.at(i).fail("must be [x, y] (on the floor) or [x, y, z] (flying)");
+    }
+    if (v.has("adjacency")) read_table(v["adjacency"], nav->adjacency, AdjacencyParams::table());
+    if (v.has("reward")) read_table(v["reward"], nav->reward, RewardParams::table());
+    if (trial.has("robot")) read_table(trial["robot"], nav->space.robot, RobotParams::table());
+    if (trial.has("flight")) read_table(trial["flight"], nav->space.flight, FlightParams::table());
+    nav->space.n_hd = nav->adjacency.n_hd;
+    check_at(v, [&] { nav->validate(); });
+    return nav;
+}
+
 }  // namespace
 
 std::vector<std::string> trial_keys() {
-    std::vector<std::string> keys{"world", "model", "seed", "protocol", "analysis"};
+    std::vector<std::string> keys{"world", "model", "seed", "protocol", "navigation", "analysis"};
     const auto agents = agent_yaml_keys();
     keys.insert(keys.end() - 1, agents.begin(), agents.end());
     return keys;
@@ -84,6 +108,20 @@ TrialConfig trial_from_yaml(const YamlView& v) {
     if (v.has("protocol")) read_table(v["protocol"], t.protocol, Protocol::table());
     t.set_agent(agent_from_yaml(v));
     if (v.has("analysis")) analysis_from(v["analysis"], t);
+    if (v.has("navigation")) {
+        if (v.has("protocol"))
+            v["protocol"].fail(
+                "a navigation trial learns until its criteria or navigation.max_learn_hours, then runs "
+                "its episodes: it takes no protocol");
+        if (v.has("trajectory")) v["trajectory"].fail("a navigation trial walks on its own: it takes no trajectory");
+        const auto nav = navigation_from(v["navigation"], v);
+        check_at(v["navigation"], [&] {
+            TrialConfig n = navigation_trial(t.world, t.model, nav, t.seed);
+            n.analysis = t.analysis;
+            n.arena_extent = t.arena_extent;
+            t = std::move(n);
+        });
+    }
     t.origin = v.file();
     // What the sections allow one by one may still not fit together (too short a protocol for
     // two samples, too many weights): reported at the key the check names.

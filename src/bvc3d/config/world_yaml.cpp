@@ -331,8 +331,8 @@ bool world_preset_takes_tilt(const std::string& name) {
 WorldDescription world_from_yaml(const YamlView& v) {
     const bool sdf = v.has("sdf");  // a Gazebo building (config/building.hpp)
     if (sdf)
-        v.expect_map({"name", "sdf", "model_path", "geometry", "missing_models", "collada_up_axis", "floor_z",
-                      "step_height", "walkable", "start", "flight_volume"});
+        v.expect_map({"name", "sdf", "model_path", "resource_path", "geometry", "missing_models", "collada_up_axis",
+                      "floor_z", "step_height", "walkable", "start", "flight_volume"});
     else v.expect_map({"name", "objects", "walkable", "start", "flight_volume"});
     WorldDescription w;
     std::optional<WorldDescription> arena;

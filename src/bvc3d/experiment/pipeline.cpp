@@ -8,6 +8,7 @@
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/experiment/episodes.hpp"
 #include "bvc3d/recorder/checkpoint_file.hpp"
 
 namespace bvc3d {
@@ -83,15 +84,60 @@ std::optional<World> group_world(const std::vector<TrialConfig>& trials) {
     return World(trials.front().world.resolve());
 }
 
+// The episodes of each navigation trial of the group after its learning run (experiment/episodes.hpp): each trial's
+// populations' states taken from the group's (its nodes: "bvc", "place", then its ModelSpec::populations, model after
+// model), its NavigationRecord and the reward cells' weights after replay into its record.
+void run_navigation(const World& world, const std::vector<TrialConfig>& trials, GroupResult& result,
+                    const RunControl& control) {
+    std::size_t first = 0;
+    for (std::size_t k = 0; k < trials.size(); ++k) {
+        const std::size_t nodes = 2 + trials[k].model.populations.size();
+        const std::size_t from = first;
+        first += nodes;
+        if (!trials[k].navigation) continue;
+        std::vector<std::vector<StateArray>> learned(std::make_move_iterator(result.states.begin() + from),
+                                                     std::make_move_iterator(result.states.begin() + from + nodes));
+        EpisodeOutcome done = run_episodes(world, trials[k], std::move(learned), EpisodeControl{control.stop, {}});
+        NavigationRecord& rec = done.record;
+        for (const auto& [name, value] : result.stats.agent_report) {
+            if (name == "learn_s") rec.learn_s = value;
+            if (name == "coverage") rec.coverage = value;
+            if (name == "visits") rec.visits.push_back(static_cast<int>(value));
+        }
+        ModelRecord& model = result.models[k];
+        model.navigation = {std::move(rec)};
+        // What the trial keeps of its populations, as the episodes leave them (the reward cells' replayed weights).
+        for (std::size_t j = 0; j < model.populations.size(); ++j)
+            for (StateArray& kept : model.populations[j].kept)
+                for (StateArray& now : done.states[2 + j])
+                    if (now.name == kept.name) kept = std::move(now);
+    }
+    result.states.clear();
+}
+
 }  // namespace
 
 GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunControl& control) {
     if (trials.empty()) throw InputError("a trial group needs at least one trial");
     const std::optional<World> world = group_world(trials);
+    return run_and_analyze(world ? &*world : nullptr, trials, control);
+}
+
+GroupOutcome run_and_analyze(const World* world, const std::vector<TrialConfig>& trials, const RunControl& control) {
+    if (trials.empty()) throw InputError("a trial group needs at least one trial");
     const WorldDescription none;
     GroupOutcome out;
-    out.result = run_trial_group(world ? &*world : nullptr, trials, control);
+    const bool navigating = std::any_of(trials.begin(), trials.end(), [](const auto& t) { return bool(t.navigation); });
+    RunControl run = control;
+    run.keep_states = run.keep_states || navigating;
+    run.checkpoint_at_end = run.checkpoint_at_end || navigating;
+    out.result = run_trial_group(world, trials, run);
+    if (navigating) run_navigation(*world, trials, out.result, control);
     for (std::size_t k = 0; k < trials.size(); ++k) {
+        if (!trials[k].protocol.records()) {  // nothing recorded to analyse (navigation's learning)
+            out.trials.emplace_back();
+            continue;
+        }
         out.trials.push_back(analyze(trials[k], world ? world->description() : none, out.result, k));
         for (const auto& w : out.trials.back().metrics.warnings) {
             const std::string message = trials[k].name() + ": " + w;
@@ -111,10 +157,11 @@ GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std
         std::vector<std::pair<std::string, MetricsRecord>> populations;
         for (const auto& [name, p] : out.trials[k].populations)
             populations.emplace_back(name, metrics_record(p.metrics, p.params));
-        write_trial_file(
-            paths[k], trial_identity(trials[k], world), out.result, k,
-            metrics_record(out.trials[k].metrics, out.trials[k].params, !trials[k].place_cells_untrained()),
-            populations);
+        write_trial_file(paths[k], trial_identity(trials[k], world), out.result, k,
+                         trials[k].protocol.records() ? metrics_record(out.trials[k].metrics, out.trials[k].params,
+                                                                       !trials[k].place_cells_untrained())
+                                                      : MetricsRecord{},
+                         populations);
     }
     if (!control.checkpoint.empty()) remove_checkpoint(control.checkpoint);
     return out;
@@ -241,7 +288,8 @@ analysis::Extent arena_extent(const TrialFileData& file, const std::filesystem::
 bool trial_file_complete(const std::filesystem::path& path, const TrialConfig& t) {
     const auto stamp = read_trial_stamp(path);
     if (!stamp || stamp->fingerprint != t.fingerprint()) return false;
-    if (t.place_cells_untrained()) return true;  // no metrics written
+    if (!t.protocol.records()) return !t.navigation || stamp->navigation;  // nothing recorded to analyse
+    if (t.place_cells_untrained()) return true;                            // no metrics written
     for (const auto& name : analysis::metric_names(t.agent->dims()))
         if (std::find(stamp->metric_attributes.begin(), stamp->metric_attributes.end(), name) ==
             stamp->metric_attributes.end())

@@ -28,8 +28,12 @@ struct GroupOutcome {
     std::vector<AnalyzedTrial> trials;  // in the order of the group's trials
 };
 
-// Runs the group (sharing one agent) and analyzes each trial.
+// Runs the group (sharing one agent) and analyzes each trial; a navigation trial's episodes run after its learning
+// (episodes.hpp) and its record is in the result's model record.
 GroupOutcome run_and_analyze(const std::vector<TrialConfig>& trials, const RunControl& control = {});
+// The same in a world already built from trials.front().world, or none (null) for a trial without one.
+GroupOutcome run_and_analyze(const World* world, const std::vector<TrialConfig>& trials,
+                             const RunControl& control = {});
 // The same, then writes trial k to paths[k] (atomically) and removes the group's checkpoint.
 GroupOutcome run_analyze_write(const std::vector<TrialConfig>& trials, const std::vector<std::filesystem::path>& paths,
                                const RunControl& control = {});

@@ -73,7 +73,7 @@ struct GroupRun {
     }
     GroupCheckpoint checkpoint(const std::string& fingerprint);
     void restore(const GroupCheckpoint& c);
-    GroupResult finish();
+    GroupResult finish(bool keep_states);
 };
 
 GroupCheckpoint GroupRun::checkpoint(const std::string& fingerprint) {
@@ -113,10 +113,12 @@ void GroupRun::restore(const GroupCheckpoint& c) {
     reserve(expected);
 }
 
-GroupResult GroupRun::finish() {
+GroupResult GroupRun::finish(bool keep_states) {
     models.network.flush();
     result.stats.full_scan_fallbacks = fallbacks();
     result.stats.end_time = agent->time();
+    result.stats.agent_report = agent->report();
+    if (keep_states) result.states = models.network.state();
     result.models = models.records(0, true);
     return std::move(result);
 }
@@ -167,7 +169,7 @@ GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& 
     const Protocol& p = trials.front().protocol;
     const bool online = p.kind == Protocol::Kind::online;
     const double t_explore = online ? 0.0 : p.explore_hours * 3600.0;
-    const double t_end = t_explore + p.sample_hours * 3600.0;
+    const double t_end = t_explore + (p.records() ? p.sample_hours * 3600.0 : 0.0);
     const double ckpt_every = control.checkpoint_minutes * 60.0;
     double next_ckpt = ckpt_every > 0 ? (std::floor(run->agent->time() / ckpt_every) + 1) * ckpt_every : INFINITY;
 
@@ -175,7 +177,7 @@ GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& 
         const bool sampling = run->agent->time() >= t_explore;
         const auto s = run->agent->next(sampling ? t_end : t_explore);
         if (!s) {
-            if (sampling) break;
+            if (sampling || (!p.records() && run->agent->finished())) break;
             if (run->agent->finished())
                 throw InputError(
                     "the agent's path ends after " + format_number(run->agent->time() / 3600) +
@@ -195,7 +197,13 @@ GroupResult run_trial_group(const World* world, const std::vector<TrialConfig>& 
         }
         if (stop) throw Interrupted();
     }
-    GroupResult result = run->finish();
+    // A learning run that others go on from (navigation) keeps its end as a checkpoint: an interrupt after it resumes
+    // there.
+    if (!control.checkpoint.empty() && control.checkpoint_at_end) {
+        GroupCheckpoint c = run->checkpoint(fingerprint);
+        write_checkpoint(control.checkpoint, c);
+    }
+    GroupResult result = run->finish(control.keep_states);
     if (control.progress) control.progress(run->agent->time(), run->step_index);
     return result;
 }

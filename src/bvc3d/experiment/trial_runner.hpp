@@ -30,6 +30,8 @@ struct RunControl {
     double checkpoint_minutes = 0;      // > 0: also every this many simulated minutes
     // Warnings (a checkpoint that cannot be used, ...); default: a line on standard error.
     std::function<void(const std::string& message)> warn;
+    bool checkpoint_at_end = false;  // also checkpoint when the run ends (a learning run that more work goes on from)
+    bool keep_states = false;        // GroupResult::states: every population's state at the end
 };
 
 // Where each model's returns come from (config/returns_spec.hpp): `sources` if given, else the

@@ -1,31 +1,19 @@
 #pragma once
-// Population stage: the head-direction-conditioned adjacency of place cells (SPEC §16), what navigation
-// (SPEC §17, docs/navigation.md) rolls forward to look ahead. Takes: place-cell rates v (n cells) and
-// head-direction rates v_hd (n_hd cells) at each learning step. Gives: one transition matrix per HD cell,
-// W_rec[k] (n × n), and products W_rec[k]·x.
+// Population stage: the head-direction-conditioned adjacency of place cells (SPEC §16), what navigation (SPEC §17,
+// docs/navigation.md) rolls forward to look ahead. Takes: place-cell rates v (n cells) and head-direction rates v_hd
+// (n_hd cells) at each learning step. Gives: one transition matrix per HD cell, W_rec[k] (n × n).
 //
 // The update, per learning step (η = 0.096, τ_x = 3, τ_hd = 0.1, a = 0.3, δ = 10⁻⁴):
 //   x   += (η/τ_x)(v − x)                  trace of the place cells
 //   Υ   += (η/τ_hd)(v_hd − Υ)              trace of the HD cells
 //   W_rec[k] += a·Υ_k·(v xᵀ − x vᵀ)        for each HD cell k, skipped on a step that bumps
 //   W_rec[k] *= (1 − δ)                    every learning step (bumps too), after the update
-// so W_rec[k][i][j] > 0 says "i follows j when heading along k": antisymmetric, as each update is. The
-// traces are updated first and the update reads the new ones (SPEC's order). HD rates are SPEC §16's
-// cells, v_k = cos(h − 2πk/n_hd) (hd_rates below), unless a model gives an HD population.
+// so W_rec[k][i][j] > 0 says "i follows j when heading along k": antisymmetric, as each update is. The traces are
+// updated first and the update reads the new ones (SPEC's order).
 //
-// Memory while learning: n_hd dense float32 matrices, n_hd·n²·4 bytes (8 HD cells: 2 MB for the paper's 250
-// place cells, 128 MB for 2 000, 392 MB for 3 500): checked against the free memory before it is taken. The decay
-// is a common scale factor (W = scale·M, folded back into M when it falls below 10⁻⁶), and the update touches
-// only the rows and columns of the active cells: a step costs O(n_hd · active · n), not O(n_hd · n²).
-//
-// Products for navigation (replay, the rollouts) read a SparseAdjacency, a frozen copy in compressed rows (the
-// rollouts, with `rollout_weights: float16`, a PackedAdjacency keeping the same weights: packed_adjacency.hpp). With
-// `prune` = 0 (the default) it keeps every non-zero weight and gives exactly the dense products' bits. The trace x
-// of a cell never returns to exactly 0 once it fired, so W_rec[k][i][j] becomes non-zero for nearly every pair of
-// cells ever active within a few thousand steps of each other (the copy then holds ~all n² entries), but only the
-// pairs active together within ~τ_x/η ≈ 30 steps carry weights near the largest. `prune` = p leaves out the
-// weights with |w| ≤ p · max|W_rec[k]|: at p = 10⁻² the copy keeps 2–25 % of the entries (docs/performance.md),
-// and the far cells no longer rise a hair above 0 in a rollout's tanh([Wx − x]+).
+// Memory while learning: n_hd dense float32 matrices, n_hd·n²·4 bytes, checked against the free memory before it is
+// taken. The decay is a common scale factor and the update touches only the rows and columns of the active cells
+// (docs/navigation.md#the-adjacency). Navigation multiplies frozen copies of it (navigation/adjacency_product.hpp).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -94,49 +82,13 @@ private:
     bool antisymmetric_ = true;  // as learned; a hand-made W need not be
     std::vector<double> x_, u_;
     std::vector<int> active_;
-    friend class SparseAdjacency;
+    friend class SparseAdjacency;  // navigation/: the frozen copies read the stored weights and the kept rule
     friend class PackedAdjacency;
+    friend class ReferenceAdjacency;
 };
 
-// Whether a frozen copy's product is taken by columns (Wᵀ·x = −W·x, antisymmetric W only, over the rows of the
-// non-zero cells: `work` entries of `entries`) rather than by rows: where that reads under a third of the entries.
-inline bool by_columns(bool antisymmetric, std::size_t work, std::size_t entries) {
-    return antisymmetric && 3 * work < entries;
-}
-
-// A frozen copy of an adjacency for products (see above): per HD cell, the weights with |w| > prune·max|W_rec[k]|
-// in compressed rows (column index as uint16 and float32 value, 6 bytes an entry: at most 65 536 place cells; the
-// products stream the entries from memory, so their size is their speed). With prune 0, apply() gives the same bits
-// as HdAdjacency::apply; pruned, the products of the matrices with the left-out weights set to 0 (by columns where
-// that reads under a third of the entries, else each row in 16 lanes: adjacency_kernels.hpp).
-class SparseAdjacency {
-public:
-    explicit SparseAdjacency(const HdAdjacency& adj) : SparseAdjacency(adj, adj.params().prune) {}
-    SparseAdjacency(const HdAdjacency& adj, double prune);
-
-    int n_place() const { return n_; }
-    int n_hd() const { return static_cast<int>(rows_.size()); }
-    // out = W_rec[k]·x (n each).
-    void apply(int k, std::span<const double> x, std::span<double> out) const;
-    std::size_t entries() const;
-    double bytes() const;
-
-private:
-    struct Rows {
-        std::vector<std::uint32_t> start;  // n + 1 offsets into col and w
-        std::vector<std::uint16_t> col;
-        std::vector<float> w;
-    };
-    int n_;
-    double scale_;
-    bool antisymmetric_;
-    bool pruned_;
-    std::vector<Rows> rows_;
-};
-
-// The adjacency as a population of a model: reads the place cells (and an HD population, if a second input
-// is given; else SPEC's 8 HD cells from the step's heading), learns on the learning steps, gives no rates;
-// keeps its matrices at the end of a trial.
+// The adjacency as a population of a model (kind "adjacency"): reads a place-cell population and an HD population
+// of n_hd cells, learns on the learning steps, gives no rates; keeps its matrices at the end of a trial.
 class AdjacencyPopulation : public Population {
 public:
     AdjacencyPopulation(int n_place, const AdjacencyParams& params = {});

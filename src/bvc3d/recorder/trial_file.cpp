@@ -69,6 +69,34 @@ void write_populations(hid_t f, const ModelRecord& rec, std::size_t n,
             write_metrics(h5::create_group(all, entry.first), entry.second);
 }
 
+std::vector<std::int64_t> ints(const std::vector<int>& v) { return {v.begin(), v.end()}; }
+
+// /navigation (docs/trial-files.md#navigation): the learning walk's end, the reward cells, every start and its path,
+// the first scale's reward map. Numbers as computed (float64), counts and indices as int64.
+void write_navigation(hid_t f, const NavigationRecord& r) {
+    const auto g = h5::create_group(f, "navigation");
+    const auto d = static_cast<std::size_t>(r.dims), G = r.n_goals(), N = r.n_starts();
+    h5::write_attr(g, "dims", static_cast<std::int64_t>(r.dims));
+    h5::write_attr(g, "learn_s", r.learn_s);
+    h5::write_attr(g, "coverage", r.coverage);
+    std::string scales;
+    for (const auto& name : r.scales) scales += (scales.empty() ? "" : "\n") + name;
+    h5::write_attr(g, "scales", scales);
+    h5::write(g, "goals", r.goals, {G, d});
+    h5::write(g, "visits", ints(r.visits), {G});
+    h5::write(g, "goal_cells", ints(r.goal_cells), {r.scales.size(), G});
+    h5::write(g, "start_goal", ints(r.start_goal), {N});
+    h5::write(g, "start", r.start, {N, d});
+    h5::write(g, "success", ints(r.success), {N});
+    h5::write(g, "path_m", r.path_m, {N});
+    h5::write(g, "shortest_m", r.shortest_m, {N});
+    h5::write(g, "time_s", r.time_s, {N});
+    h5::write(g, "path_start", std::vector<std::int64_t>(r.path_start.begin(), r.path_start.end()), {N + 1});
+    h5::write(g, "path", r.path, {r.path.size() / d, d});
+    h5::write(g, "map_points", r.map_points, {r.map_points.size() / 2, 2});
+    h5::write(g, "map_reward", r.map_reward, {G, r.map_points.size() / 2});
+}
+
 }  // namespace
 
 void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id, const GroupResult& group,
@@ -107,6 +135,7 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
         h5::write_attr(w, "end_time", group.stats.end_time);
         write_metrics(f, metrics);
         write_populations(f, rec, n, population_metrics);
+        for (const NavigationRecord& nav : rec.navigation) write_navigation(f, nav);
         image = h5::file_image(f);
     }
     out.write(image);
@@ -139,8 +168,8 @@ std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
         if (h5::read_attr_string(f, "format") != "bvc3d-trial") return std::nullopt;
         version = format_version(f);
         if (h5::exists(f, "metrics"))
-            stamp =
-                TrialStamp{h5::read_attr_string(f, "fingerprint"), h5::attribute_names(h5::open_group(f, "metrics"))};
+            stamp = TrialStamp{h5::read_attr_string(f, "fingerprint"),
+                               h5::attribute_names(h5::open_group(f, "metrics")), h5::exists(f, "navigation")};
     } catch (const InputError&) {
         return std::nullopt;
     }
@@ -319,6 +348,74 @@ TrialFileData read_trial_samples(const std::filesystem::path& path) {
     d.rates = r.finite<float>(s, "/samples/", "rates", rates[1]);
     d.n_place = rates[1];
     return d;
+}
+
+TrialNavigation read_trial_navigation(const std::filesystem::path& path) {
+    auto lock = h5::hdf5_lock();
+    const TrialReader r(path);
+    TrialNavigation out;
+    static_cast<TrialIdentity&>(out) = read_identity(r);
+    const auto g = r.group("navigation");
+    const std::string where = "/navigation/";
+    NavigationRecord& n = out.record;
+    const double dims = r.number(g, where, "dims");
+    if (dims != 2 && dims != 3) r.fail(": attribute '/navigation/dims' is not 2 or 3");
+    n.dims = static_cast<int>(dims);
+    n.learn_s = r.number(g, where, "learn_s");
+    n.coverage = r.number(g, where, "coverage");
+    for (std::string rest = r.text(g, where, "scales"); !rest.empty();) {
+        const auto cut = rest.find('\n');
+        n.scales.push_back(rest.substr(0, cut));
+        rest = cut == std::string::npos ? "" : rest.substr(cut + 1);
+    }
+    // A dataset of the expected shape (0 in `shape`: any length there), as float64 or int64.
+    const auto check_shape = [&](const std::string& name, std::vector<std::size_t> shape, H5T_class_t type) {
+        if (!h5::exists(g, name)) r.fail(": dataset '" + where + name + "' is missing");
+        if (r.guarded("dataset '" + where + name + "'", [&] { return h5::dataset_class(g, name); }) != type)
+            r.fail(": dataset '" + where + name + "' does not hold " + (type == H5T_FLOAT ? "numbers" : "integers"));
+        const auto d = r.guarded("dataset '" + where + name + "'", [&] { return h5::dims(g, name); });
+        bool ok = d.size() == shape.size();
+        for (std::size_t k = 0; ok && k < d.size(); ++k) ok = shape[k] == 0 || d[k] == shape[k];
+        if (!ok) r.fail(": dataset '" + where + name + "' has the wrong shape");
+        return d;
+    };
+    const auto reals = [&](const std::string& name, std::vector<std::size_t> shape) {
+        check_shape(name, std::move(shape), H5T_FLOAT);
+        return r.finite<double>(g, where, name);
+    };
+    const auto integers = [&](const std::string& name, std::vector<std::size_t> shape, std::int64_t lo,
+                              std::int64_t hi) {
+        check_shape(name, std::move(shape), H5T_INTEGER);
+        const auto v = r.guarded("dataset '" + where + name + "'", [&] { return h5::read_ints(g, name); });
+        for (std::size_t k = 0; k < v.size(); ++k)
+            if (v[k] < lo || v[k] > hi)
+                r.fail(": dataset '" + where + name + "' holds " + std::to_string(v[k]) + " at " + std::to_string(k) +
+                       ", outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return v;
+    };
+    const auto d = static_cast<std::size_t>(n.dims);
+    n.goals = reals("goals", {0, d});
+    const std::size_t G = n.n_goals();
+    const auto as_int = [](const std::vector<std::int64_t>& v) { return std::vector<int>(v.begin(), v.end()); };
+    n.visits = as_int(integers("visits", {G}, 0, INT32_MAX));
+    n.goal_cells = as_int(integers("goal_cells", {n.scales.size(), G}, -1, INT32_MAX));
+    n.start_goal = as_int(integers("start_goal", {0}, 0, std::int64_t(G) - 1));
+    const std::size_t N = n.start_goal.size();
+    n.start = reals("start", {N, d});
+    n.success = as_int(integers("success", {N}, 0, 1));
+    n.path_m = reals("path_m", {N});
+    n.shortest_m = reals("shortest_m", {N});
+    n.time_s = reals("time_s", {N});
+    n.path = reals("path", {0, d});
+    const auto starts = integers("path_start", {N + 1}, 0, std::int64_t(n.path.size() / d));
+    for (std::size_t k = 0; k + 1 < starts.size(); ++k)
+        if (starts[k] > starts[k + 1]) r.fail(": dataset '/navigation/path_start' is not ascending");
+    if (!starts.empty() && std::size_t(starts.back()) != n.path.size() / d)
+        r.fail(": dataset '/navigation/path_start' does not end at the path's last point");
+    n.path_start.assign(starts.begin(), starts.end());
+    n.map_points = reals("map_points", {0, 2});
+    n.map_reward = reals("map_reward", {G, n.map_points.size() / 2});
+    return out;
 }
 
 TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc) {

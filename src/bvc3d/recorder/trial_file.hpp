@@ -76,6 +76,7 @@ void write_trial_file(const std::filesystem::path& path, const TrialIdentity& id
 struct TrialStamp {
     std::string fingerprint;
     std::vector<std::string> metric_attributes;
+    bool navigation = false;  // it holds /navigation (a navigation trial's episodes)
 };
 std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path);
 
@@ -115,6 +116,13 @@ TrialWeights read_trial_weights(const std::filesystem::path& path);
 // InputError when the file is missing, broken or not a trial file, or the dataset holds neither
 // numbers nor integers. For readers that show a file (`bvc3d view`), not for the analysis.
 std::optional<NamedArray> read_trial_array(const std::filesystem::path& path, const std::string& dataset);
+
+// A navigation trial's /navigation group, checked as it is read (InputError naming the file and the dataset: missing,
+// of the wrong shape, non-finite numbers, indices out of range); with the trial's identity.
+struct TrialNavigation : TrialIdentity {
+    NavigationRecord record;
+};
+TrialNavigation read_trial_navigation(const std::filesystem::path& path);
 
 // The named scalar metrics of a file, for summaries; a metric the file lacks (written before it
 // existed) reads as NaN. `parameters`: the named /metrics attributes (the analysis parameters) as

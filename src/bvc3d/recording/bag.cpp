@@ -104,8 +104,12 @@ std::unique_ptr<BagReader> open_bag(const fs::path& path) {
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext == ".mcap") return open_mcap(path);
-    if (ext == ".db3" || ext == ".yaml")
-        throw InputError(quoted_path(path) + " is part of a ROS 2 bag: give the bag's folder");
+    if (path.filename() == "metadata.yaml") return open_ros2_bag(path.has_parent_path() ? path.parent_path() : ".");
+    if (ext == ".db3") return open_ros2_storage(path);  // a storage file alone, without its metadata
+    if (ext == ".zstd")
+        throw InputError(quoted_path(path) +
+                         " is a zstd-compressed storage file of a ROS 2 bag: give the bag's "
+                         "folder (its metadata.yaml says how it is compressed)");
     return open_ros1_bag(path);
 }
 

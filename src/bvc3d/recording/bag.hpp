@@ -63,13 +63,17 @@ private:
     std::filesystem::path path_;
 };
 
-// Opens a bag by what `path` is: a folder (ROS 2: metadata.yaml), a `.mcap` file, or a ROS 1 bag.
+// Opens a bag by what `path` is: a folder (ROS 2), its metadata.yaml, a `.db3` or `.mcap` file, or a
+// ROS 1 bag.
 std::unique_ptr<BagReader> open_bag(const std::filesystem::path& path);
 
 // The three kinds, for tests and tools that know which they have.
 std::unique_ptr<BagReader> open_ros1_bag(const std::filesystem::path& file);
 std::unique_ptr<BagReader> open_mcap(const std::filesystem::path& file);
+// A folder: with metadata.yaml as it says (zstd FILE or MESSAGE compression undone); without, from its
+// .db3 or .mcap files (as `ros2 bag reindex` would). A storage file alone (.db3 or .mcap).
 std::unique_ptr<BagReader> open_ros2_bag(const std::filesystem::path& folder);
+std::unique_ptr<BagReader> open_ros2_storage(const std::filesystem::path& file);
 
 // ROS 1 serialization of the same messages (through the Debian message packages' own code). The
 // generated ROS 1 headers need C++17 (std::allocator<void>::rebind), so only ros1_bag.cpp, compiled

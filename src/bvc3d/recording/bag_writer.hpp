@@ -1,7 +1,8 @@
 #pragma once
 // Writing simulated scans as a bag that ROS tools play (docs/ros.md#export). Takes: clouds in the
 // sensor's frame and each scan's world-from-sensor pose with its time. Gives: a ROS 1 bag (Debian's
-// rosbag storage library) or an MCAP file (ROS 2: CDR, ros2msg schemas, zstd chunks) with
+// rosbag storage library), an MCAP file (ROS 2: CDR, ros2msg schemas, zstd chunks, indexed) or a ROS 2
+// bag folder (metadata.yaml and that MCAP file, as `ros2 bag record -s mcap` writes them) with
 //   /points  sensor_msgs/PointCloud2  x, y, z as FLOAT64 (point_step 24), frame `sensor`
 //   /odom    nav_msgs/Odometry        map ← sensor (the sensor's pose; zero covariance and twist)
 //   /tf      tf2_msgs/TFMessage       the same transform, map → sensor
@@ -16,7 +17,7 @@
 
 namespace bvc3d::recording {
 
-enum class BagFormat { ros1, mcap };
+enum class BagFormat { ros1, mcap, ros2 };
 
 struct BagWriteOptions {
     BagFormat format = BagFormat::ros1;

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -211,6 +212,16 @@ void check_index(FileBytes& file, const Record& index, const std::vector<std::ui
 
 void check_framing(const std::filesystem::path& file) {
     FileBytes bytes(file);
+    // Older ROS 1 bags start "#ROSRECORD V1.2" (or V1.1): a format the storage library does not read.
+    const std::string start = bytes.read(0, std::min<std::uint64_t>(bytes.size(), 20));
+    for (const char* magic : {"#ROSRECORD V", "#ROSBAG V"})
+        if (start.rfind(magic, 0) == 0 && start.rfind("#ROSBAG V2.0\n", 0) != 0) {
+            const std::string rest = start.substr(std::strlen(magic));
+            const std::string version = rest.substr(0, rest.find_first_not_of("0123456789."));
+            throw InputError(quoted_path(file) + ": ROS 1 bag format " + version +
+                             " is not supported (bvc3d reads format 2.0; `rosbag filter IN OUT True` rewrites it "
+                             "as 2.0)");
+        }
     if (bytes.size() < 13 || bytes.read(0, 13) != "#ROSBAG V2.0\n")
         throw InputError(quoted_path(file) + ": not a ROS 1 bag (no '#ROSBAG V2.0' at its start)");
     const Faults fault(quoted_path(file) + ", ", "");

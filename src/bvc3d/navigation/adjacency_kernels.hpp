@@ -1,7 +1,7 @@
 #pragma once
-// The inner loops of the adjacency's frozen copies (hd_adjacency.hpp, packed_adjacency.hpp), vectorised (see
-// core/simd.hpp). Each fixes an order of its additions that every instruction set keeps, so every one gives the same
-// bits.
+// Navigation stage: the inner loops of the adjacency's frozen copies (sparse_adjacency.hpp, packed_adjacency.hpp),
+// vectorised (see core/simd.hpp). Each fixes an order of its additions that every instruction set keeps, so every one
+// gives the same bits.
 //
 // row_sums16: a matrix in compressed rows (uint16 column indices, float32 weights), a dense vector x: each row's sum
 // Σ_e w_e·x[col_e] in 16 lanes — entry o of a row (counted from the row's first) goes to lane o mod 16, each lane sums

@@ -1,4 +1,4 @@
-#include "bvc3d/population/adjacency_kernels.hpp"
+#include "bvc3d/navigation/adjacency_kernels.hpp"
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -86,10 +86,9 @@ BVC3D_TARGET_V3 inline __m256 half_times(const std::uint16_t* h, const float* x)
     return _mm256_mul_ps(half_weights(h), _mm256_loadu_ps(x));
 }
 
-// The weights are fetched this many entries (4 KB) ahead of their use: measured on Zen 4, the row products took
-// 0.69–0.80 × the time with it (16–64 entries ahead: 0.88–0.98 ×; 512 and more: a little slower than 256;
-// docs/performance.md). A prefetch never faults: past the end it fetches a line for nothing (the address is formed
-// as an integer, not as a pointer past the array).
+// The weights are fetched this many entries (4 KB) ahead of their use: the distance measured fastest
+// (docs/performance.md#navigation-issue-30). A prefetch never faults: past the end it fetches a line for nothing
+// (the address is formed as an integer, not as a pointer past the array).
 constexpr std::size_t prefetch_entries = 256;
 inline void prefetch_weights(const std::uint16_t* h) {
     const auto ahead = reinterpret_cast<std::uintptr_t>(h) + sizeof(*h) * 8 * prefetch_entries;  // 8 weights an entry
@@ -136,7 +135,7 @@ BVC3D_TARGET_V3 void half_rows_v3(const HalfTiles& t, const float* x, const floa
 
 // Entries e … e + N − 1 of one segment into their sums, y[col] −= h·x: all N sums are loaded before any is stored.
 // A segment's columns are distinct, so this is the same as one by one; taken eight at a time, the loads need not
-// wait on the stores before them, which took the columns form to 0.71–0.75 × the time on Zen 4.
+// wait on the stores before them (docs/performance.md#navigation-issue-30).
 template <int N>
 BVC3D_TARGET_V3 inline void column_updates_v3(const HalfTiles& t, std::uint32_t e, __m256 xr, float* y) {
     float* yr[N];

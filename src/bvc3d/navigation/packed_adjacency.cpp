@@ -1,4 +1,4 @@
-#include "bvc3d/population/packed_adjacency.hpp"
+#include "bvc3d/navigation/packed_adjacency.hpp"
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -6,7 +6,8 @@
 #include <string>
 
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/population/adjacency_kernels.hpp"
+#include "bvc3d/navigation/adjacency_kernels.hpp"
+#include "bvc3d/navigation/sparse_adjacency.hpp"
 
 namespace bvc3d {
 
@@ -38,16 +39,21 @@ std::shared_ptr<const kernels::HalfTiles> PackedAdjacency::pack(const HdAdjacenc
     return std::make_shared<const kernels::HalfTiles>(start.data(), col.data(), half.data(), n_, n_hd_, 64, panel);
 }
 
-void PackedAdjacency::apply(std::span<const float> x, std::span<float> y) const {
+void PackedAdjacency::apply(std::span<const float> x, std::span<float> y, std::span<const char> which) const {
     const auto K = std::size_t(n_hd_);
-    if (x.size() != std::size_t(n_) * K || y.size() != x.size())
-        throw InputError("PackedAdjacency: states of " + std::to_string(x.size()) + " and " + std::to_string(y.size()) +
-                         " values for " + std::to_string(n_) + " cells × " + std::to_string(K) + " directions");
+    check(x.size(), y.size(), which.size());
     std::size_t work = 0;
     for (std::size_t j = 0; j < std::size_t(n_); ++j)
         if (std::any_of(&x[j * K], &x[j * K] + K, [](float v) { return v != 0.0f; })) work += row_entries_[j];
     if (by_columns(antisymmetric_, work, entries())) kernels::half_columns(*tiles_, x.data(), factor_.data(), y.data());
     else kernels::half_rows(*tiles_, x.data(), factor_.data(), y.data());
+}
+
+void PackedAdjacency::apply(std::span<const double> X, std::span<double> Y, std::span<const char> which) const {
+    check(X.size(), Y.size(), which.size());
+    std::vector<float> x(X.begin(), X.end()), y(Y.size());
+    apply(x, y, which);
+    std::copy(y.begin(), y.end(), Y.begin());
 }
 
 std::size_t PackedAdjacency::entries() const { return tiles_->col.size(); }

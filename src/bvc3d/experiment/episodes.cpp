@@ -1,0 +1,181 @@
+#include "bvc3d/experiment/episodes.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include "bvc3d/agent/navigation_space.hpp"
+#include "bvc3d/config/navigation_spec.hpp"
+#include "bvc3d/core/cancel.hpp"
+#include "bvc3d/core/error.hpp"
+#include "bvc3d/core/random.hpp"
+#include "bvc3d/experiment/model_network.hpp"
+#include "bvc3d/navigation/replay.hpp"
+#include "bvc3d/navigation/rollout_policy.hpp"
+#include "bvc3d/population/reward_cells.hpp"
+
+namespace bvc3d {
+
+namespace {
+
+// The trial's model as the episodes step it: one model step at a time, learning off, and each scale's place-cell
+// rates after the step.
+class Senses {
+public:
+    Senses(const World& world, const TrialConfig& trial) : net_(&world, {trial}, {}, false, 1) {
+        for (const std::string& name : trial.model.place_scales()) scales_.push_back(node_of(trial.model, name));
+        rates_.resize(scales_.size());
+    }
+    // The node of the model's population `name` ("place" or one of ModelSpec::populations).
+    std::size_t node_of(const ModelSpec& model, const std::string& name) const {
+        const auto& nodes = net_.nodes.front();
+        if (name == "place") return nodes.place;
+        for (std::size_t k = 0; k < model.populations.size(); ++k)
+            if (model.populations[k].name == name) return nodes.others[k];
+        throw std::logic_error("navigation: the model has no population '" + name + "'");
+    }
+    std::size_t size() const { return net_.network.size(); }
+    Population& population(std::size_t node) { return *net_.network.node(node).population; }
+    // One model step at `pose`; each scale's place-cell rates after it.
+    const std::vector<std::vector<double>>& step(const Pose& pose, bool bumped = false, double t = 0.0) {
+        net_.network.step(ModelStep{t, pose, bumped, std::nullopt}, index_++, false, false);
+        for (std::size_t s = 0; s < scales_.size(); ++s) {
+            const auto v = net_.network.latest(scales_[s]);
+            rates_[s].assign(v.begin(), v.end());
+        }
+        return rates_;
+    }
+    const std::vector<std::vector<double>>& rates() const { return rates_; }
+    // Every population back to rest (a new start), what it learned kept.
+    void reset() {
+        for (std::size_t i = 0; i < net_.network.size(); ++i) net_.network.node(i).population->reset_activity();
+    }
+    void settle(const Pose& pose, int steps) {
+        reset();
+        for (int k = 0; k < std::max(1, steps); ++k) step(pose);
+    }
+
+private:
+    ModelNetwork net_;
+    std::vector<std::size_t> scales_;  // the nodes of the place-cell scales
+    std::int64_t index_ = 0;
+    std::vector<std::vector<double>> rates_;
+};
+
+const StateArray& array_named(const std::vector<StateArray>& arrays, const std::string& name) {
+    for (const StateArray& a : arrays)
+        if (a.name == name) return a;
+    throw InputError("navigation: a learned state lacks '" + name + "'");
+}
+
+}  // namespace
+
+EpisodeOutcome run_episodes(const World& world, const TrialConfig& trial, std::vector<std::vector<StateArray>> learned,
+                            const EpisodeControl& control) {
+    if (!trial.navigation) throw std::logic_error("run_episodes: not a navigation trial");
+    const NavigationSpec& nav = *trial.navigation;
+    const NavigationParams& p = nav.space.nav;
+    const auto space = make_navigation_space(world.description(), nav.space);
+    Senses senses(world, trial);
+    if (learned.size() != senses.size())
+        throw InputError("navigation: the learned state holds " + std::to_string(learned.size()) +
+                         " populations, the model " + std::to_string(senses.size()));
+    const ModelSpec& model = trial.model;
+    const auto scale_names = model.place_scales();
+    const std::size_t n_scales = scale_names.size(), n_goals = nav.space.goals.size();
+    const AdjacencyParams adjacency = nav.adjacency_params();
+
+    EpisodeOutcome out;
+    NavigationRecord& rec = out.record;
+    rec.dims = nav.space.dims();
+    for (const NavigationGoal& g : nav.space.goals)
+        for (int d = 0; d < rec.dims; ++d) rec.goals.push_back(g.p[d]);
+    rec.scales = scale_names;
+
+    // Per scale: the frozen copies of its adjacency (the learned matrices let go once copied), its reward cells'
+    // bound cells and, by replay from them, their weights.
+    std::vector<ScaleMemory> memory;
+    std::vector<char> as_made(learned.size(), 0);
+    for (std::size_t s = 0; s < n_scales; ++s) {
+        const std::size_t adj_node = senses.node_of(model, NavigationSpec::adjacency_name(model, s));
+        as_made[adj_node] = 1;
+        const std::size_t reward_node = senses.node_of(model, NavigationSpec::reward_name(model, s));
+        const auto n_place = static_cast<int>(senses.population(senses.node_of(model, scale_names[s])).size());
+        {
+            HdAdjacency adj(n_place, adjacency);
+            adj.restore(learned[adj_node]);
+            learned[adj_node].clear();
+            memory.push_back(scale_memory(adj, adjacency, nav.reward.for_scale(s)));
+        }
+        auto& reward_state = learned[reward_node];
+        const auto& cells = std::get<std::vector<double>>(array_named(reward_state, "reward_cells").values);
+        std::vector<double> weights;
+        for (std::size_t g = 0; g < n_goals; ++g) {
+            const int cell = static_cast<int>(cells[g]);
+            rec.goal_cells.push_back(cell);
+            memory[s].rewards.push_back(cell >= 0 ? replay(*memory[s].sparse, cell, memory[s].reward)
+                                                  : std::vector<double>(std::size_t(n_place), 0.0));
+            weights.insert(weights.end(), memory[s].rewards.back().begin(), memory[s].rewards.back().end());
+        }
+        for (StateArray& a : reward_state)
+            if (a.name == "reward_weights") a.values = std::move(weights);
+    }
+    // The model as learned; its adjacencies stay as made (navigation reads the frozen copies, and nothing learns).
+    for (std::size_t i = 0; i < learned.size(); ++i)
+        if (!as_made[i]) senses.population(i).restore(learned[i]);
+
+    // The first scale's reward map: the model settled at each point, read out for every goal.
+    const auto points = space->map_points(p.reward_map_cell);
+    rec.map_reward.assign(n_goals * points.size(), 0.0);
+    for (std::size_t m = 0; m < points.size(); ++m) {
+        rec.map_points.push_back(points[m].x());
+        rec.map_points.push_back(points[m].y());
+        senses.settle(Pose::on_floor(points[m].x(), points[m].y(), 0.0), p.settle_steps);
+        for (std::size_t g = 0; g < n_goals; ++g)
+            rec.map_reward[g * points.size() + m] = reward_readout(memory.front().rewards[g], senses.rates().front());
+    }
+
+    const std::size_t total = n_goals * std::size_t(p.starts);
+    rec.path_start.push_back(0);
+    for (std::size_t g = 0; g < n_goals; ++g) {
+        const NavigationGoal& goal = nav.space.goals[g];
+        Rng rng(hash_u64(trial.seed, 0x6e617669676174ULL, g), Stream::walk);
+        for (int i = 0; i < p.starts; ++i) {
+            if (control.stop && control.stop->load()) throw Interrupted();
+            const Vec3 start = space->draw_start(rng, g, goal, p.min_start_distance);
+            const double shortest = space->shortest(start, goal.p);
+            const Pose pose = space->start_pose(start, rng);
+            senses.settle(pose, p.settle_steps);
+            RolloutPolicy policy(memory, g, senses.rates(), nav.reward, rng);
+            const auto agent = space->seeker(policy, pose);
+            bool success = false;
+            std::size_t points_here = 1;
+            for (int d = 0; d < rec.dims; ++d) rec.path.push_back(start[d]);
+            while (true) {
+                if (space->distance(agent->pose().position(), goal.p) <= p.success_radius) {
+                    success = true;
+                    break;
+                }
+                if (agent->travelled() >= p.max_path_ratio * shortest) break;
+                const auto step = agent->next(p.max_hours * 3600);
+                if (!step) break;
+                senses.step(step->pose, step->bumped, step->t);
+                const Vec3 at = step->pose.position();
+                for (int d = 0; d < rec.dims; ++d) rec.path.push_back(at[d]);
+                ++points_here;
+            }
+            rec.start_goal.push_back(static_cast<int>(g));
+            for (int d = 0; d < rec.dims; ++d) rec.start.push_back(start[d]);
+            rec.success.push_back(success ? 1 : 0);
+            rec.path_m.push_back(agent->travelled());
+            rec.shortest_m.push_back(shortest);
+            rec.time_s.push_back(agent->time());
+            rec.path_start.push_back(rec.path_start.back() + points_here);
+            if (control.progress) control.progress(rec.n_starts(), total);
+        }
+    }
+    out.states = std::move(learned);
+    return out;
+}
+
+}  // namespace bvc3d
