@@ -405,6 +405,8 @@ def test_every_call_takes_a_world_as_a_path_or_a_world(tmp_path):
                                   bvc3d.flying_walk(bvc3d.World.preset("flight-room"), 0.005, 1)["z"])
     np.testing.assert_array_equal(bvc3d.route("cross", [[-4, -4], [4, -4]])["x"],
                                   bvc3d.route(cross, [[-4, -4], [4, -4]])["x"])
+    np.testing.assert_array_equal(bvc3d.shortest_path("cross", [-4.0, 4.0], [-2.0, 4.0])["points"],
+                                  bvc3d.shortest_path(cross, [-4.0, 4.0], [-2.0, 4.0])["points"])
     route = bvc3d.route(cross, [[-4, -4], [4, -4], [4, 4]])
     path = tmp_path / "route.csv"
     bvc3d.write_trajectory(path, route)
@@ -429,6 +431,8 @@ def test_every_call_takes_a_world_as_a_path_or_a_world(tmp_path):
     lambda bad: bvc3d.place_recognition(world="cross", route=bad, sensor="horizontal"),
     lambda bad: bvc3d.run_trial(world=bad),
     lambda bad: bvc3d.replay_simulated(bad, "r.csv", "horizontal"),
+    lambda bad: bvc3d.shortest_path(bad, [0, 0], [1, 0]),
+    lambda bad: bvc3d.navigate(bad, [[0, 0]]),
 ])
 def test_a_wrong_world_or_route_is_named_not_printed(call):
     """Finding 8: an object that is not a world (or a route) is refused by its type, never printed."""
