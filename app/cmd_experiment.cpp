@@ -318,6 +318,9 @@ void add_analyze(CLI::App& app) {
             if (untrained)
                 std::printf("  no place-cell metrics: its place cells never learned (place_weights untrained)\n");
             const auto m = analysis::analyze_trial<float>(positions, rates, params[i]);
+            if (!untrained)  // settings that cannot work at this trial's scale, as `run` says them
+                for (const auto& w : m.warnings)
+                    std::fprintf(stderr, "bvc3d: warning: %s: %s\n", printable(d.name).c_str(), printable(w).c_str());
             const auto values = untrained ? std::vector<std::pair<std::string, double>>{} : analysis::scalar_metrics(m);
             csv.field(o->files[i]).field(d.name);
             for (std::size_t c = 0; c < columns.size(); ++c) {

@@ -33,19 +33,19 @@ void write_tables(const fs::path& dir, const PlaceRecognitionOutcome& r) {
     CsvWriter queries(queries_file.stream()), summary(summary_file.stream()), details(details_file.stream()),
         pr(pr_file.stream()), scans(scans_file.stream());
     queries.row("descriptor", "query", "match", "distance", "match_m", "has_revisit", "correct");
-    summary.row("descriptor", "protocol", "recall_at_1", "f1_max", "auc", "queries", "revisits");
+    summary.row("descriptor", "protocol", "recall_at_1", "f1_max", "auc", "queries", "revisits", "timed");
     pr.row("descriptor", "protocol", "threshold", "precision", "recall");
     details.row("descriptor", "protocol", "uses_heading", "recall_at_1", "f1_max", "auc", "queries", "revisits",
-                "correct", "median_match_m", "describe_s", "search_s");
+                "correct", "median_match_m", "describe_s", "search_s", "timed");
     for (const auto& d : r.descriptors) {
         const auto& rows = d.result.rows;
         for (std::size_t i = 0; i < rows.query.size(); ++i)
             queries.row(d.spec.label, rows.query[i], rows.match[i], rows.distance[i], rows.match_m[i],
                         bool(rows.has_revisit[i]), bool(rows.correct[i]));
         const auto& s = d.result.summary;
-        summary.row(d.spec.label, r.protocol, s.recall_at_1, s.f1_max, s.auc, s.queries, s.revisits);
+        summary.row(d.spec.label, r.protocol, s.recall_at_1, s.f1_max, s.auc, s.queries, s.revisits, r.timed);
         details.row(d.spec.label, r.protocol, d.spec.uses_heading(), s.recall_at_1, s.f1_max, s.auc, s.queries,
-                    s.revisits, s.correct, s.median_match_m, d.describe_seconds, d.search_seconds);
+                    s.revisits, s.correct, s.median_match_m, d.describe_seconds, d.search_seconds, r.timed);
         const auto& c = d.result.curve;
         for (std::size_t k = 0; k < c.threshold.size(); ++k)
             pr.row(d.spec.label, r.protocol, c.threshold[k], c.precision[k], c.recall[k]);
@@ -124,14 +124,15 @@ void add_place_recognition_command(CLI::App& app) {
         if (!o->database.empty()) o->run.database = analysis::parse_scan_span(o->database, "--database");
         if (!o->queries.empty()) o->run.queries = analysis::parse_scan_span(o->queries, "--queries");
         o->run.preprocess = o->preprocess.get();
-        const bool recorded = !o->scans.empty() || !o->poses.empty();
+        const bool recorded = !o->scans.empty() || !o->poses.empty() || o->recording.has_bag();
         const bool simulated = o->world.given() || !o->route.empty() || !o->sensor.empty();
         if (recorded == simulated)
-            throw InputError("give either a recording (--scans and --poses) or a route (--world, --route, --sensor)");
+            throw InputError(
+                "give either a recording (--scans and --poses, or --bag) or a route (--world, --route, --sensor)");
         std::unique_ptr<ScanSequence> seq;
         if (recorded) {
-            if (o->scans.empty()) throw InputError("--poses needs --scans");
-            seq = std::make_unique<RecordingSequence>(o->recording.open(o->scans, o->poses));
+            if (o->scans.empty() && !o->recording.has_bag()) throw InputError("--poses needs --scans");
+            seq = std::make_unique<RecordingSequence>(o->recording.open_any(o->scans, o->poses));
         } else {
             if (o->world.world.empty() || o->route.empty() || o->sensor.empty())
                 throw InputError("a simulated route needs --world, --route and --sensor");
@@ -151,9 +152,17 @@ void add_place_recognition_command(CLI::App& app) {
         const PlaceRecognitionOutcome r = run_place_recognition(*seq, descriptors, o->run);
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         write_tables(o->out, r);
-        std::printf("%s: %zu scans, %s protocol, %.1f s (reading %.1f s, describing %.1f s wall)\n", r.sequence.c_str(),
-                    static_cast<std::size_t>(r.positions.rows()), r.protocol.c_str(), wall, r.read_seconds,
-                    r.describe_wall_seconds);
+        // Wall times are parts of the total; the threads' own times (reading, describe_s) add up over the threads.
+        std::printf(
+            "%s: %zu scans, %s protocol, %.1f s in all (%.1f s describing the scans on %zu threads, which "
+            "spent %.1f s of their time reading them)\n",
+            r.sequence.c_str(), static_cast<std::size_t>(r.positions.rows()), r.protocol.c_str(), wall,
+            r.describe_wall_seconds, r.threads, r.read_seconds);
+        if (!r.timed && r.protocol == "sequential")
+            std::printf(
+                "the scans have no times (neither their list nor their poses give them): the exclusion window is "
+                "--exclude-scans %d alone, not --exclude-seconds, and the drift counts one scan a second\n",
+                o->run.loop.exclude_scans);
         std::printf("%-28s %7s %8s %11s %7s %7s %10s %11s %9s\n", "descriptor", "queries", "revisits", "recall@1",
                     "F1max", "AUC", "heading", "describe_s", "search_s");
         for (const auto& d : r.descriptors) {
@@ -162,6 +171,12 @@ void add_place_recognition_command(CLI::App& app) {
                         s.revisits, s.recall_at_1, s.f1_max, s.auc, d.spec.uses_heading() ? "uses" : "no",
                         d.describe_seconds, d.search_seconds);
         }
+        std::printf("(describe_s: the threads' time, summed; search_s: wall time)\n");
+        if (!r.descriptors.empty() && r.descriptors.front().result.summary.revisits == 0)
+            std::printf(
+                "no query has a revisit (an older scan outside the exclusion window within --revisit-m %s m): "
+                "recall, F1max and AUC are undefined (nan) and the curve is empty\n",
+                num(o->run.loop.revisit_m).c_str());
         if (!o->no_figures && run_python_module("bvc3d.place_recognition_figure", {o->out}).status != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
                              python_command().shell_line("bvc3d.place_recognition_figure", {o->out}));

@@ -1,4 +1,5 @@
 // bvc3d route: a route through a world from waypoints, or a tour of its floor (docs/buildings.md#routes).
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -12,6 +13,7 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "option_groups.hpp"
+#include "python_module.hpp"
 #include "table_options.hpp"
 
 namespace bvc3d::cli {
@@ -25,6 +27,9 @@ Vec2 parse_point(const std::string& text, const std::string& what) {
     return Vec2(parse_number(text.substr(0, comma), what + " x"), parse_number(text.substr(comma + 1), what + " y"));
 }
 
+// A length or a time as people read it: to a tenth.
+std::string tenths(double v) { return num(std::round(v * 10) / 10); }
+
 }  // namespace
 
 void add_route_command(CLI::App& app) {
@@ -32,8 +37,9 @@ void add_route_command(CLI::App& app) {
         "route", "Drive a route through a world's floor, from waypoints or as a tour; write it as a trajectory file");
     struct Options {
         WorldOptions world;
-        std::string waypoints, start, out;
+        std::string waypoints, start, out, figure;
         bool tour = false;
+        int laps = 1;
         TableOptions<RouteParams> route{RouteParams::table()};
         Outputs outputs;
     };
@@ -45,10 +51,18 @@ void add_route_command(CLI::App& app) {
     waypoints->excludes(tour);
     cmd->add_option("--start", o->start, "With --tour: where it starts and ends, X,Y (default: the floor's middle)")
         ->needs(tour);
+    cmd->add_option("--laps", o->laps,
+                    "With --tour: drive it this many times, one lap after the other (a trial that learns on one lap "
+                    "and records two can decode the last against the one before)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000))
+        ->needs(tour);
     static const RouteParams defaults;
     o->route.add_to(*cmd, {"speed", "lateral_acceleration"}, &defaults);
     o->outputs.add(*cmd, "--out", o->out, OutputKind::file, "Trajectory file to write (t,x,y,z,heading rows)")
         ->required();
+    o->outputs.add(*cmd, "--figure", o->figure, OutputKind::file,
+                   "Also draw the route over the world's floor plan at the robot's body height (a .png)");
     cmd->footer(
         "The path joins the waypoints with circular arcs (speed^2/radius never above the lateral acceleration;\n"
         "tight corners are stops and turns in place), heading along the motion, one row per model step (0.288 s)\n"
@@ -69,18 +83,33 @@ void add_route_command(CLI::App& app) {
             if (!o->start.empty()) start = parse_point(o->start, "--start");
             const Tour t = make_tour(world.description(), robot.radius, robot.height, start, {}, route);
             steps = t.steps;
-            std::cout << "tour of '" << world.name() << "': " << steps.size() << " model steps, " << num(t.stats.length)
-                      << " m in " << num(steps.back().t) << " s; passes within 1 m of "
+            // The tour ends where it starts: each further lap follows one model step later, from its start.
+            const double lap = t.steps.back().t + robot.model_dt;
+            for (int k = 1; k < o->laps; ++k)
+                for (ModelStep s : t.steps) {
+                    s.t += k * lap;
+                    steps.push_back(s);
+                }
+            std::cout << "tour of '" << world.name() << "': " << t.steps.size() << " model steps, "
+                      << tenths(t.stats.length) << " m in " << tenths(t.steps.back().t) << " s; passes within 1 m of "
                       << num(std::round(t.stats.coverage * 1000) / 10) << " % of the walkable region ("
                       << num(std::round(t.stats.walkable_area)) << " m2); drives "
-                      << num(std::round(t.stats.reverse_length)) << " m again in the opposite direction\n";
+                      << num(std::round(t.stats.reverse_length)) << " m again in the opposite direction"
+                      << (o->laps > 1 ? "; " + std::to_string(o->laps) + " laps: " + std::to_string(steps.size()) +
+                                            " model steps in " + tenths(steps.back().t) + " s"
+                                      : "")
+                      << "\n";
         } else {
             const BodyCollider body(world.description(), robot.radius, robot.height);
             steps = route_through(read_waypoints(o->waypoints), body, route);
             std::cout << "route through '" << world.name() << "': " << steps.size() << " model steps in "
-                      << num(steps.back().t) << " s\n";
+                      << tenths(steps.back().t) << " s\n";
         }
         write_trajectory_file(o->out, steps);
+        const std::vector<std::string> args{"--world", o->world.world, "--trajectory", o->out, "--out", o->figure};
+        if (!o->figure.empty() && run_python_module("bvc3d.route_figure", args).status != 0)
+            throw InputError("the figure failed; the route is in '" + o->out + "'; rerun it with:\n  " +
+                             python_command().shell_line("bvc3d.route_figure", args));
     });
 }
 

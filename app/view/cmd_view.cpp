@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 
+#include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
@@ -68,7 +69,8 @@ fs::path common_folder(const fs::path& a, const fs::path& b) {
 
 // What the arguments ask to show (see the command's help).
 view::ViewTarget make_target(const std::vector<std::string>& args, const std::string& scans, const std::string& poses,
-                             const RecordingOptions& recording, const std::string& model) {
+                             const RecordingOptions& recording, const std::string& model,
+                             const std::string& trajectory) {
     view::ViewTarget t;
     config::resolve_model(model);  // an unknown model is refused before anything is served
     t.model = model;
@@ -127,6 +129,17 @@ view::ViewTarget make_target(const std::vector<std::string>& args, const std::st
     }
     if (args.empty() && !t.recording) t.world = "cross";
     t.worlds = list_worlds(t.root);
+    if (!trajectory.empty()) {
+        if (t.world.empty())
+            throw InputError(
+                "--trajectory draws a path over a world: give a world (a preset, a world YAML or a "
+                "Gazebo world), not a trial file, a results folder or a recording (which show their own)");
+        const auto spec = TrajectorySpec(read_trajectory_file(trajectory), trajectory, 2);
+        const fs::path world_file = t.root.empty() ? fs::path(t.world) : t.root / t.world;
+        spec.check_world(config::resolve_world(t.root.empty() ? t.world : world_file.string()));
+        t.trajectory_name = fs::path(trajectory).filename().string();
+        t.trajectory = spec.steps();
+    }
     return t;
 }
 
@@ -146,7 +159,7 @@ void add_view_command(CLI::App& app) {
     struct Options {
         std::vector<std::string> paths;
         int port = 0;
-        std::string export_dir, scans, poses, model = "3d-0.2";
+        std::string export_dir, scans, poses, model = "3d-0.2", trajectory;
         std::size_t export_steps = 40;
         RecordingOptions recording;
         Outputs outputs;
@@ -163,6 +176,9 @@ void add_view_command(CLI::App& app) {
     o->recording.add_to(*cmd);
     add_model_option(*cmd, o->model, ModelCount::one, "--model",
                      "Whose scanner and BVCs the page of a recording or a world shows: ");
+    cmd->add_option("--trajectory", o->trajectory,
+                    "With a world: a path to draw over it (a route, a tour, a walk: t, x, y, [z], heading rows), "
+                    "with a slider along it and the model's BVCs at each step");
     o->outputs.add(*cmd, "--export", o->export_dir, OutputKind::folder,
                    "Write the page as static files into this folder instead of serving it (--force replaces only a "
                    "page exported earlier)");
@@ -174,7 +190,7 @@ void add_view_command(CLI::App& app) {
         "Serves the page on http://127.0.0.1:PORT/ only (never on other interfaces), read-only, until Ctrl-C.\n"
         "Everything the page uses is installed with bvc3d; it fetches nothing from elsewhere.");
     cmd->callback([o] {
-        view::ViewData data(make_target(o->paths, o->scans, o->poses, o->recording, o->model));
+        view::ViewData data(make_target(o->paths, o->scans, o->poses, o->recording, o->model, o->trajectory));
         const fs::path web = web_dir();
         if (!o->export_dir.empty()) {
             const auto s = view::export_view(data, web, o->export_dir, o->export_steps, o->outputs.force);

@@ -133,6 +133,19 @@ ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::pat
                 w.add("probe", {{"source", shown.world}, {"x", p["x"]}, {"y", p["y"]}, {"heading", p["heading"]}});
             }
         }
+        // A trajectory over the world: the path, and the probe at evenly spaced steps of it.
+        if (const std::size_t n = shown.trajectory.size(); n > 0) {
+            w.add("trajectory", {});
+            json kept = json::array();
+            const std::size_t count = std::min(n, std::max<std::size_t>(steps, 1));
+            for (std::size_t k = 0; k < count; ++k) {
+                const std::size_t i = count > 1 ? k * (n - 1) / (count - 1) : 0;
+                w.add("probe", {{"source", shown.world}, {"step", std::to_string(i)}});
+                kept.push_back(i);
+                ++w.summary.steps;
+            }
+            step_index["#trajectory"] = kept;
+        }
     }
     // A recording given with trial files is theirs: shown through them, not on its own.
     if (const std::size_t n = data.recording_scans(); n > 0 && shown.trials.empty()) {

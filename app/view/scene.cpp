@@ -198,6 +198,32 @@ std::string attribute(const TrialIdentity& id, const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// A recording's input as the trial's attributes name it, compared by what it reads: a file's name, or a bag's
+// file name and what follows it (its topic, or "tf FIXED SENSOR").
+std::string input_key(const std::string& source) {
+    const auto colon = source.rfind(':');  // a bag's "<bag>:<topic>" or "<bag>:tf FIXED SENSOR"
+    if (colon == std::string::npos || colon == 0) return fs::path(source).filename().string();
+    return fs::path(source.substr(0, colon)).filename().string() + ":" + source.substr(colon + 1);
+}
+
+// Which of the recording's inputs (its scans, its poses) differ from those the trial replayed, in words.
+std::string differing_inputs(const recording::Recording& rec, const std::string& scans, const std::string& poses) {
+    std::string out;
+    const auto compare = [&](const std::string& what, const std::string& mine, const std::string& theirs) {
+        if (theirs.empty() || input_key(mine) == input_key(theirs)) return;
+        out += (out.empty() ? "" : "; ") + what + " come from '" + mine + "', the trial's from '" + theirs + "'";
+    };
+    compare("its scans", rec.scans_source.string(), scans);
+    compare("its poses", rec.poses_source.string(), poses);
+    return out.empty() ? "its scans and poses are named as the trial's, but their contents (the pose file's bytes, "
+                         "the scans' names and sizes, a bag's topics) differ"
+                       : out;
+}
+
+}  // namespace
+
 void TrialScene::resolve_recording(const fs::path& file, const GivenRecording& given) {
     replayed_ = attribute(data_, "recording");
     if (replayed_.empty()) return;
@@ -237,8 +263,9 @@ void TrialScene::resolve_recording(const fs::path& file, const GivenRecording& g
     }
     // The files must be the ones replayed, and the poses those the trial recorded.
     if (rec && !files.empty() && rec->fingerprint() != files)
-        problem = "the scan and pose files found are not those the trial replayed (their fingerprint is " +
-                  rec->fingerprint() + ", the trial's " + files + ")";
+        problem = "the scan and pose files " + std::string(given ? "given" : "found") +
+                  " are not those the trial replayed: " + differing_inputs(*rec, scans, poses) +
+                  " (their fingerprint is " + rec->fingerprint() + ", the trial's " + files + ")";
     std::vector<ModelStep> steps;
     if (rec && problem.empty()) {
         try {
@@ -430,7 +457,7 @@ std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model,
             f32_array("bvc", std::span<const double>(rates))};
 }
 
-std::string probe_blob(const World& world, const ModelSpec& model, const Pose& p) {
+std::string probe_blob(const World& world, const ModelSpec& model, const Pose& p, std::optional<std::size_t> step) {
     json header = {{"kind", "probe"},
                    {"x", p.x},
                    {"y", p.y},
@@ -438,6 +465,7 @@ std::string probe_blob(const World& world, const ModelSpec& model, const Pose& p
                    {"heading", p.heading},
                    {"model", model_json(model)},
                    {"drawn_sensor", sensor_json(drawn_sensor(model.sensor))}};
+    if (step) header["step"] = *step;
     auto arrays = sensed_arrays(world, model, p, header);
     return encode_blob(std::move(header), arrays);
 }

@@ -30,7 +30,8 @@ std::string world_blob(const WorldDescription& world, const std::string& source,
 std::vector<BlobArray> sensed_arrays(const World& world, const ModelSpec& model, const Pose& pose,
                                      nlohmann::json& header);
 // The same at a pose of the page's choosing, in a world shown on its own.
-std::string probe_blob(const World& world, const ModelSpec& model, const Pose& pose);
+std::string probe_blob(const World& world, const ModelSpec& model, const Pose& pose,
+                       std::optional<std::size_t> step = std::nullopt);  // step: of the trajectory shown
 
 // The scanner drawn at each step: the model's own, except that a spherical scanner is drawn with
 // all its rows (the model keeps some), so the page shows the full scan.

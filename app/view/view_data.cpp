@@ -9,6 +9,7 @@
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
+#include "view/blob.hpp"
 #include "view/safe_path.hpp"
 
 namespace bvc3d::view {
@@ -80,6 +81,7 @@ Reply ViewData::route(const std::string& endpoint, const Query& query) {
                       {"world", target_.world},
                       {"worlds", target_.worlds},
                       {"recording", target_.recording != nullptr},
+                      {"trajectory", target_.trajectory_name},
                       {"model", target_.model}};
         return Reply{200, "application/json", index.dump()};
     }
@@ -95,11 +97,19 @@ Reply ViewData::route(const std::string& endpoint, const Query& query) {
     if (endpoint == "world") return blob_reply(world_reply(query));
     if (endpoint == "probe") {
         const auto world = world_by_source(param(query, "source"));
+        if (query.count("step")) {  // step i of the trajectory shown
+            const std::size_t i = index_param(query, "step");
+            if (i >= target_.trajectory.size())
+                throw RequestError(404, "step " + std::to_string(i) + " is past the trajectory's " +
+                                            std::to_string(target_.trajectory.size()));
+            return blob_reply(probe_blob(*world, config::resolve_model(target_.model), target_.trajectory[i].pose, i));
+        }
         const Pose pose =
             Pose::on_floor(number_param(query, "x"), number_param(query, "y"), number_param(query, "heading"));
         return blob_reply(probe_blob(*world, config::resolve_model(target_.model), pose));
     }
     if (endpoint == "recording") return blob_reply(recording().blob());
+    if (endpoint == "trajectory") return blob_reply(trajectory_reply());
     if (endpoint == "scan") {
         const std::size_t i = index_param(query, "i");
         if (i >= recording().size())
@@ -114,6 +124,7 @@ std::shared_ptr<const TrialScene> ViewData::trial(const std::string& relative) {
     const auto file = path_inside(target_.root, relative);
     if (!file) throw RequestError(403, "'" + relative + "' is not inside the served folder");
     std::error_code ec;
+    if (fs::is_directory(*file, ec)) throw RequestError(422, "trial file '" + relative + "' is a folder, not a file");
     if (!fs::is_regular_file(*file, ec)) throw RequestError(404, "trial file '" + relative + "' does not exist");
     {
         std::lock_guard lock(mutex_);
@@ -165,11 +176,29 @@ std::shared_ptr<const World> ViewData::world_by_source(const std::string& source
         const auto file = path_inside(target_.root, source);
         if (target_.root.empty() || !file) throw RequestError(403, "'" + source + "' is not inside the served folder");
         std::error_code ec;
+        if (fs::is_directory(*file, ec))
+            throw RequestError(422, "world file '" + source + "' is a folder, not a world file");
         if (!fs::is_regular_file(*file, ec)) throw RequestError(404, "world file '" + source + "' does not exist");
         world = std::make_shared<World>(config::resolve_world(file->string()));  // YAML or Gazebo (.world, .sdf)
     }
     std::lock_guard lock(mutex_);
     return worlds_.emplace(source, std::move(world)).first->second;
+}
+
+std::string ViewData::trajectory_reply() const {
+    const auto& steps = target_.trajectory;
+    if (steps.empty()) throw RequestError(404, "no trajectory is being shown (bvc3d view WORLD --trajectory FILE)");
+    std::vector<double> t, x, y, z, heading;
+    for (const ModelStep& s : steps) {
+        t.push_back(s.t);
+        x.push_back(s.pose.x);
+        y.push_back(s.pose.y);
+        z.push_back(s.pose.z);
+        heading.push_back(s.pose.heading);
+    }
+    return encode_blob(
+        {{"name", target_.trajectory_name}, {"steps", steps.size()}},
+        {f64_array("t", t), f64_array("x", x), f64_array("y", y), f64_array("z", z), f64_array("heading", heading)});
 }
 
 const RecordingScene& ViewData::recording() {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bvc3d/agent/agent.hpp"
 #include "bvc3d/config/model_spec.hpp"
 #include "view/scene.hpp"
 
@@ -24,6 +25,9 @@ struct ViewTarget {
     std::vector<std::string> worlds;  // the worlds offered: presets and YAML files under root
     std::shared_ptr<const bvc3d::recording::Recording> recording;  // a recording (scan files or a bag), opened
     std::string model = "3d-0.2";                                  // the model whose BVCs a recording's page shows
+    // A path drawn over the world (`--trajectory FILE`: a route, a tour, a walk), its rows as the file has them.
+    std::string trajectory_name;
+    std::vector<ModelStep> trajectory;
 };
 
 struct Reply {
@@ -39,9 +43,11 @@ public:
     explicit ViewData(ViewTarget target);
     const ViewTarget& target() const { return target_; }
 
-    // index, trial?path=, step?path=&i=, world?source= | world?trial= | world?recording=1, probe?source=&x=&y=&heading=
-    // (the default model's view at that pose), recording, scan?i=. Errors are replies with a status and {"error":
-    // message}: 400 bad request, 403 a path outside the served folder, 404 missing, 422 a file that cannot be read.
+    // index, trial?path=, step?path=&i=, world?source= | world?trial= | world?recording=1,
+    // probe?source=&x=&y=&heading= | probe?source=&step= (the default model's view at that pose, or at the trajectory's
+    // step), recording, scan?i=, trajectory (the path drawn over the world). Errors are replies with a status and
+    // {"error": message}: 400 bad request, 403 a path outside the served folder, 404 missing, 422 a file that cannot
+    // be read (or a folder where a file is named).
     Reply get(const std::string& endpoint, const Query& query);
 
     std::size_t recording_scans() const { return recording_ ? recording_->size() : 0; }
@@ -52,6 +58,7 @@ public:
 private:
     Reply route(const std::string& endpoint, const Query& query);
     std::string world_reply(const Query& query);
+    std::string trajectory_reply() const;
     std::shared_ptr<const World> world_by_source(const std::string& source);
     const RecordingScene& recording();
 

@@ -73,6 +73,10 @@ void bind_buildings(pyb::module_& m) {
             [](const std::filesystem::path& path, const std::vector<std::string>& model_path,
                const std::string& geometry, std::optional<double> floor_z, const std::string& missing_models,
                bool flight_volume, const std::string& name, const std::vector<std::string>& resource_path) {
+                if (const auto ext = path.extension().string(); ext == ".yaml" || ext == ".yml")
+                    throw InputError("'" + path.string() +
+                                     "' is a world YAML: read it with World.from_yaml (or World.preset, which reads "
+                                     "any world file; a YAML with `sdf:` reads a Gazebo world with its options)");
                 config::BuildingSpec spec;
                 spec.file = path.string();
                 spec.name = name;
@@ -87,8 +91,16 @@ void bind_buildings(pyb::module_& m) {
                 spec.gazebo.skip_missing_models = missing_models == "skip";
                 spec.floor_z = floor_z;
                 if (flight_volume) spec.flight = config::StoreyFlight{};
-                pyb::gil_scoped_release release;
-                return World(config::building_world(spec));
+                std::optional<World> w;
+                {
+                    pyb::gil_scoped_release release;
+                    w.emplace(config::building_world(spec));
+                }
+                // With its defaults the file alone is the world (what a trial records); options need a world YAML.
+                const bool defaults = model_path.empty() && resource_path.empty() && geometry == "visual" && !floor_z &&
+                                      missing_models == "error" && !flight_volume && name.empty();
+                if (!defaults) return pyb::cast(std::move(*w));
+                return with_source(std::move(*w), WorldSpec{path.string(), std::nullopt, "+x+y"});
             },
             pyb::arg("path"), pyb::arg("model_path") = std::vector<std::string>{}, pyb::arg("geometry") = "visual",
             pyb::arg("floor_z") = pyb::none(), pyb::arg("missing_models") = "error", pyb::arg("flight_volume") = false,
@@ -173,13 +185,14 @@ flight volume filling the storey. The chosen floor is moved to z = 0 (World.floo
 
     m.def(
         "route",
-        [](const World& w, const pyb::object& waypoints, const pyb::kwargs& kwargs) {
+        [](const pyb::object& world_arg, const pyb::object& waypoints, const pyb::kwargs& kwargs) {
+            const auto w = world_of(world_arg, "route: world");
             RouteParams route;
             apply_kwargs(route, RouteParams::table(), kwargs);
             const auto points = points_of(waypoints, "waypoints");
             const RobotParams robot;
             const auto steps = interruptible([&](const std::atomic<bool>&) {
-                const BodyCollider body(w.description(), robot.radius, robot.height);
+                const BodyCollider body(w->description(), robot.radius, robot.height);
                 return route_through(points, body, route);
             });
             return steps_dict(steps);
@@ -191,7 +204,8 @@ flight volume filling the storey. The chosen floor is moved to z = 0 (World.floo
             .c_str());
     m.def(
         "tour",
-        [](const World& w, const pyb::object& start, const pyb::kwargs& kwargs) {
+        [](const pyb::object& world_arg, const pyb::object& start, const pyb::kwargs& kwargs) {
+            const auto w = world_of(world_arg, "tour: world");
             RouteParams route;
             TourParams tour;
             apply_split(route, tour, kwargs);
@@ -199,7 +213,7 @@ flight volume filling the storey. The chosen floor is moved to z = 0 (World.floo
             if (!start.is_none()) from = points_of(pyb::list(pyb::make_tuple(start)), "start").front();
             const RobotParams robot;
             const Tour t = interruptible([&](const std::atomic<bool>&) {
-                return make_tour(w.description(), robot.radius, robot.height, from, tour, route);
+                return make_tour(w->description(), robot.radius, robot.height, from, tour, route);
             });
             pyb::dict d = steps_dict(t.steps);
             std::vector<double> flat;

@@ -59,12 +59,7 @@ pyb::kwargs dict_argument(const pyb::object& obj, const std::string& key, const 
 // A text argument (a name or a path): anything else is refused naming the argument.
 std::string text_argument(const pyb::object& obj, const std::string& key, const std::string& what) {
     if (pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__")) return pyb::str(obj).cast<std::string>();
-    if (pyb::isinstance<World>(obj))
-        throw InputError("run_trial: " + key + "= takes " + what +
-                         ", not a World object (a trial file records where its world came from, so a trial "
-                         "rebuilds it: give the preset name or the YAML file the World was made from)");
-    throw InputError("run_trial: " + key + "= must be " + what + ", not " +
-                     pyb::str(pyb::type::of(obj).attr("__name__")).cast<std::string>());
+    throw InputError("run_trial: " + key + "= must be " + what + ", not " + type_name(obj));
 }
 
 // The keywords run_trial takes besides the protocol's, and their hint for keys of other places.
@@ -110,7 +105,10 @@ TrialConfig trial_of(const pyb::object& model, const pyb::object& world, const p
     }
     std::optional<double> tilt;
     if (!tilt_deg.is_none()) tilt = std::get<double>(to_value(tilt_deg, params::Kind::real, "tilt_deg"));
-    t.world = WorldSpec{text_argument(world, "world", "a world preset name or a world YAML path"), tilt, t.world.lean};
+    t.world = world_source_of(world, "run_trial: world");
+    if (tilt && pyb::isinstance<World>(world))
+        throw InputError("run_trial: tilt_deg goes with a world's name; the World given has its own tilt");
+    if (tilt) t.world.tilt_deg = tilt;
     t.seed = seed_of(seed, "seed");
     const auto agent = kwargs.contains("agent") ? agent_by_name(pyb::str(kwargs["agent"])) : nullptr;
     const bool flight = agent && dynamic_cast<const FlightSpec*>(agent.get());
@@ -237,7 +235,8 @@ void bind_experiment(pyb::module_& m) {
         pyb::arg("tilt_deg") = pyb::none(), pyb::arg("seed") = 0,
         (R"doc(One trial at full speed, as `bvc3d run` does it, returned as numpy arrays: t, x, y, z, heading
 (samples,), rates (samples, n_place) float32, weights (n_place, n_bvc), bvc_rates if recorded, and
-metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset or world YAML;
+metrics (dict of the scalar metrics). model: a preset or model YAML; world: a preset, a world file or a World
+made from one (World.preset, World.from_yaml: the trial file records where it came from);
 tilt_deg: for world="cross" or "cross-webots"; trajectory: a file path or a dict of arrays t, x, y, heading[, z,
 pitch, roll] to follow instead of the random walk, its rows resampled to model steps model_dt=0.288 s apart
 (positions linearly, headings along the shorter arc) unless they are at that step already (step_per_row=True:
@@ -257,11 +256,11 @@ Protocol keywords and their defaults:
             .c_str());
     m.def(
         "choose_elevations",
-        [](const std::optional<std::string>& world, std::optional<double> tilt_deg, const std::string& agent_name,
+        [](const pyb::object& world, std::optional<double> tilt_deg, const std::string& agent_name,
            const std::optional<std::string>& sensor, std::uint64_t seed,
            std::optional<std::vector<std::vector<double>>> sets, int jobs,
            const std::shared_ptr<recording::Recording>& recorded, const pyb::kwargs& kwargs) {
-            if (recorded && (world || tilt_deg || agent_name != "ground"))
+            if (recorded && (!world.is_none() || tilt_deg || agent_name != "ground"))
                 throw InputError("a recording is its own walk: give recording or world (and agent), not both");
             const auto agent = agent_by_name(agent_name);
             const ChooserDefaults defaults = chooser_defaults(*agent);
@@ -288,6 +287,15 @@ Protocol keywords and their defaults:
             base.sensor = config::resolve_sensor(sensor.value_or(defaults.sensor));
             const auto analysis = analysis::AnalysisParams::defaults(agent->dims());
             std::optional<ReplaySource> source;
+            // A World given is used as it is; a name or a path is read on the worker (a building takes seconds).
+            std::shared_ptr<const World> given;
+            std::string world_name = WorldSpec{}.source;
+            if (pyb::isinstance<World>(world)) {
+                if (tilt_deg) throw InputError("choose_elevations: tilt_deg goes with a world's name, not a World");
+                given = world_of(world, "choose_elevations: world");
+            } else if (!world.is_none()) {
+                world_name = world_source_of(world, "choose_elevations: world").source;
+            }
             if (recorded) {
                 RecordedReturnParams preprocess;
                 apply_kwargs(preprocess, RecordedReturnParams::table(), kwargs, ChooserParams::table().keys());
@@ -298,10 +306,11 @@ Protocol keywords and their defaults:
                 if (source)
                     return choose_elevations_on(*source, base, p, analysis,
                                                 sets.value_or(std::vector<std::vector<double>>{}));
-                const World w(config::resolve_world(world.value_or(WorldSpec{}.source), tilt_deg));
-                agent->check_world(w.description());
-                return sets ? choose_from_sets(w, base, *agent, *sets, p, analysis)
-                            : choose_elevations(w, base, *agent, p, analysis);
+                const auto w =
+                    given ? given : std::make_shared<const World>(config::resolve_world(world_name, tilt_deg));
+                agent->check_world(w->description());
+                return sets ? choose_from_sets(*w, base, *agent, *sets, p, analysis)
+                            : choose_elevations(*w, base, *agent, p, analysis);
             });
             return choice_to_dict(c);
         },
@@ -313,8 +322,8 @@ does it: the criterion (MSAI of the place-cell network on the walk, lower is bet
 candidate set of the greedy search, or of the given `sets` (lists of elevations, rad). Returns a
 dict: elevations, n_per_axis, msai (of the chosen set), candidates (a list of dicts: elevations,
 n_per_axis, round, msai, frac_multimodal, bvc_msai: the same MSAI over the BVC population's
-rate maps, shown, not used), walk_steps, model_yaml. world: a preset or world YAML (default: the
-cross arena); agent: "ground" (the paper's robot, sensor "spherical", 3d-0.2's cells) or "flying"
+rate maps, shown, not used), walk_steps, model_yaml. world: a preset, a world file or a World (default:
+the cross arena); agent: "ground" (the paper's robot, sensor "spherical", 3d-0.2's cells) or "flying"
 (the flying agent, sensor "spherical-full", fly-5l's cells, candidates from -elevation_max unless
 elevation_min is given; 3-D analysis); sensor: another sensor preset or YAML; seed: the walk's (on a
 recording: the initial weights'); jobs: threads (0: every core). recording: a Recording instead of a

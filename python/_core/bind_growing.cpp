@@ -28,27 +28,34 @@ void bind_growing(pyb::module_& m) {
         (R"doc(
 A growing place-cell network (docs/model-reference.md#growing-place-cells): the paper's network of its recruited cells
 (§6, Oja), which recruits a cell on every sample_every-th learning step where no cell's rate reaches threshold, its
-weights (p_connect·n_bvc)·v_b/Σv_b, up to budget cells. GrowingPlaceCells(n_bvc, seed=0, **params).
-step(bvc_rates, learn=True) takes (n_bvc,) rates and gives the budget's (budget,) rates, cells not recruited 0.
+weights (p_connect·n_bvc)·v_b/Σv_b, up to budget cells. GrowingPlaceCells(n_bvc, seed=0, **params), positionally
+in that order and then the parameters below, growing ones first. step(bvc_rates, learn=True) takes (n_bvc,) rates and
+gives the budget's (budget,) rates, cells not recruited 0.
 Growing parameters and their defaults:
 )doc" + describe(GrowingParams::table(), GrowingParams{}) +
-         "Place-cell dynamics (n_place aside) and their defaults:\n" + describe(PlaceParams::table(), PlaceParams{}))
+         "Place-cell dynamics and their defaults (the place cells' n_place aside: the cells are budget and "
+         "n_initial):\n" +
+         describe(PlaceParams::table(), PlaceParams{}, {"n_place"}))
             .c_str());
-    cls.def(pyb::init([](int n_bvc, const pyb::object& seed, const pyb::kwargs& kwargs) {
-                if (kwargs.contains("n_place"))
-                    throw InputError(
-                        "growing place cells: n_place is not a parameter (the cells are budget and "
-                        "n_initial)");
-                GrowingParams g;
-                PlaceParams p;
-                apply_kwargs(g, GrowingParams::table(), kwargs, keys(PlaceParams::table()));
-                apply_kwargs(p, PlaceParams::table(), kwargs, keys(GrowingParams::table()));
-                return std::make_unique<G>(n_bvc, p, g, seed_of(seed, "seed"));
-            }),
-            pyb::arg("n_bvc"), pyb::arg("seed") = 0)
+    cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
+           if (kwargs.contains("n_place"))
+               throw InputError("growing place cells: n_place is not a parameter (the cells are budget and n_initial)");
+           std::vector<std::string> names{"n_bvc", "seed"};
+           for (const auto& k : keys_of(GrowingParams::table())) names.push_back(k);
+           for (const auto& k : keys_of(PlaceParams::table(), {"n_place"})) names.push_back(k);
+           pyb::kwargs given = named_arguments("GrowingPlaceCells", args, kwargs, names, {"n_bvc"});
+           const int n_bvc = count_of(given.attr("pop")("n_bvc"), "n_bvc");
+           const auto seed = seed_of(given.attr("pop")("seed", 0), "seed");
+           GrowingParams g;
+           PlaceParams p;
+           apply_kwargs(g, GrowingParams::table(), given, keys(PlaceParams::table()));
+           apply_kwargs(p, PlaceParams::table(), given, keys(GrowingParams::table()));
+           return std::make_unique<G>(n_bvc, p, g, seed);
+       }))
         .def(
             "step",
-            [](G& net, const pyb::object& obj, bool learn) {
+            [](G& net, const pyb::object& obj, const pyb::object& learn_obj) {
+                const bool learn = flag_of(learn_obj, "learn");
                 const ArrayD b = real_array(obj, "bvc_rates");
                 if (b.ndim() != 1) throw InputError("bvc_rates must be a 1-D array");
                 return as_float64(net.step({b.data(), static_cast<std::size_t>(b.shape(0))}, learn));

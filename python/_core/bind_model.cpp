@@ -83,18 +83,27 @@ void bind_network(pyb::module_& m) {
                                              (R"doc(
 Place cells driven by BVCs, with Oja learning (docs/model-reference.md#place-cell-network), and optionally by grid
 cells too (n_grid > 0, grid_influence g: docs/model-reference.md#place-cells-fed-by-grid-cells).
-PlaceCellNetwork(n_bvc, seed=0, n_grid=0, **params); params and their defaults:
+PlaceCellNetwork(n_bvc, seed=0, n_grid=0, **params), positionally in that order and then the params'; params and their
+defaults:
 )doc" + describe(PlaceParams::table(), PlaceParams{}))
                                                  .c_str());
-    cls.def(pyb::init([](int n_bvc, const pyb::object& seed, int n_grid, const pyb::kwargs& kwargs) {
-                PlaceParams p;
-                apply_kwargs(p, PlaceParams::table(), kwargs);
-                return PlaceCellNetwork(n_bvc, p, seed_of(seed, "seed"), n_grid);
-            }),
-            pyb::arg("n_bvc"), pyb::arg("seed") = 0, pyb::arg("n_grid") = 0)
+    cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
+           std::vector<std::string> names{"n_bvc", "seed", "n_grid"};
+           const auto params = keys_of(PlaceParams::table());
+           names.insert(names.end(), params.begin(), params.end());
+           pyb::kwargs given = named_arguments("PlaceCellNetwork", args, kwargs, names, {"n_bvc"});
+           const int n_bvc = count_of(given.attr("pop")("n_bvc"), "n_bvc");
+           const auto seed = seed_of(given.attr("pop")("seed", 0), "seed");
+           const int n_grid = count_of(given.attr("pop")("n_grid", 0), "n_grid");
+           PlaceParams p;
+           apply_kwargs(p, PlaceParams::table(), given);
+           return PlaceCellNetwork(n_bvc, p, seed, n_grid);
+       }))
         .def(
             "step",
-            [](PlaceCellNetwork& net, const pyb::object& obj, bool learn, const pyb::object& grid_obj) {
+            [](PlaceCellNetwork& net, const pyb::object& obj, const pyb::object& learn_obj,
+               const pyb::object& grid_obj) {
+                const bool learn = flag_of(learn_obj, "learn");
                 const ArrayD bvc_rates = real_array(obj, "bvc_rates");
                 if (bvc_rates.ndim() != 1) throw InputError("bvc_rates must be a 1-D array");
                 const std::span<const double> in(bvc_rates.data(), static_cast<std::size_t>(bvc_rates.shape(0)));

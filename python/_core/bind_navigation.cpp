@@ -152,9 +152,10 @@ HdAdjacency(n_place, **params); params and their defaults:
         pyb::arg("w"), pyb::arg("v"), "r = w·v / max(|v|₁, 1e-4)");
     m.def(
         "shortest_path",
-        [](const World& w, const pyb::object& start, const pyb::object& goal, double cell, double inflate) {
+        [](const pyb::object& world, const pyb::object& start, const pyb::object& goal, double cell, double inflate) {
+            const auto w = world_of(world, "shortest_path: world");
             const RobotParams robot;
-            const BodyCollider body(w.description(), robot.radius, robot.height);
+            const BodyCollider body(w->description(), robot.radius, robot.height);
             const FreeSpaceGrid grid(body, cell);
             const auto p = shortest_path(grid, point_of(start, "start"), point_of(goal, "goal"), inflate);
             pyb::dict d;
@@ -170,8 +171,9 @@ HdAdjacency(n_place, **params); params and their defaults:
         "(m), points (N, 2)");
     m.def(
         "navigate",
-        [](const World& w, const pyb::object& goals, const std::string& model, const pyb::object& seed,
+        [](const pyb::object& world, const pyb::object& goals, const std::string& model, const pyb::object& seed,
            const pyb::kwargs& kwargs) {
+            const auto w = world_of(world, "navigate: world");
             NavigationSpec s;
             const ModelSpec model_spec = config::resolve_model(model);
             const auto g = real_array(goals, "goals");
@@ -183,7 +185,7 @@ HdAdjacency(n_place, **params); params and their defaults:
             apply_navigation(s, kwargs);
             const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
             const NavigationRecord run = interruptible(
-                [&](const std::atomic<bool>& stop) { return navigate(w, model_spec, s, seed_value, &stop); });
+                [&](const std::atomic<bool>& stop) { return navigate(*w, model_spec, s, seed_value, &stop); });
             const int dims = run.dims;
             const auto n = pyb::ssize_t(run.n_starts());
             std::vector<double> gx, gy, gz, sx, sy, sz;

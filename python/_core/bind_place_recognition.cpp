@@ -112,6 +112,7 @@ pyb::dict outcome_dict(const PlaceRecognitionOutcome& r) {
     summary["median_match_m"] = vec(s_median);
     summary["describe_s"] = vec(s_describe);
     summary["search_s"] = vec(s_search);
+    summary["timed"] = pyb::list(pyb::cast(std::vector<bool>(r.descriptors.size(), r.timed)));
     pr["descriptor"] = p_desc;
     pr["protocol"] = p_protocol;
     pr["threshold"] = vec(p_threshold);
@@ -222,13 +223,24 @@ void bind_place_recognition(pyb::module_& m) {
             } else {
                 if (world.is_none() || route.is_none() || sensor.is_none())
                     throw InputError("a simulated route needs world, route and sensor");
-                const std::string route_file = pyb::str(route);
+                // The route's rows are the scans: a file's, or a dict's (one scan per row, as given).
+                pyb::kwargs per_row;
+                per_row["step_per_row"] = true;
+                if (!pyb::isinstance<pyb::str>(route) && !pyb::hasattr(route, "__fspath__") &&
+                    !pyb::isinstance<pyb::dict>(route))
+                    throw InputError(
+                        "route must be a trajectory file's path or a dict of arrays t, x, y, heading "
+                        "(and optionally z, pitch, roll), not " +
+                        type_name(route));
+                const auto rows = trajectory_of(route, per_row);
+                if (!pyb::isinstance<pyb::str>(sensor) && !pyb::isinstance<LidarSpec>(sensor))
+                    throw InputError("sensor must be a sensor's name, a sensor YAML's path or a Sensor, not " +
+                                     type_name(sensor));
                 const LidarSpec s = pyb::isinstance<pyb::str>(sensor)
                                         ? config::resolve_sensor(sensor.cast<std::string>())
                                         : sensor.cast<LidarSpec>();
-                seq = std::make_unique<SimulatedSequence>(
-                    std::make_shared<const World>(config::resolve_world(pyb::str(world).cast<std::string>())),
-                    read_trajectory_file(route_file), route_file, s, o.seed);
+                seq = std::make_unique<SimulatedSequence>(world_of(world, "place_recognition: world"), rows->rows(),
+                                                          rows->source(), s, o.seed);
             }
             const PlaceRecognitionOutcome r =
                 interruptible([&](const std::atomic<bool>&) { return run_place_recognition(*seq, specs, o); });
@@ -241,15 +253,15 @@ void bind_place_recognition(pyb::module_& m) {
         pyb::arg("pose_format") = "auto", pyb::arg("time_tolerance") = 0.05,
         (std::string(
              R"doc(Place recognition, the field's protocol (docs/place-recognition.md), as `bvc3d place-recognition`:
-on a recording (scans, poses; or a Recording as scans) or a simulated route (world, route = a trajectory
-file, sensor).
+on a recording (scans, poses; or a Recording as scans) or a simulated route (world: a World, a preset or a world
+file; route: a trajectory file or a dict of arrays t, x, y, heading[, z], one scan per row; sensor).
 descriptors: a comma-separated string or a list of bvc:MODEL, bvc-drift:MODEL, bvc-free:MODEL,
 place-cells:MODEL, scan-context. database, queries: (first, last) or "A:B" scans (both included) for
 the split protocol; else sequential loop closure. Returns a dict of tables, each a dict of columns:
 queries (descriptor, query, match, distance, match_m, has_revisit, correct), summary (descriptor,
 protocol, recall_at_1, f1_max, auc, queries, revisits, uses_heading, median_match_m, describe_s,
-search_s), pr (descriptor, protocol, threshold, precision, recall), scans (scan, t, x, y, z, heading,
-drift); and sequence, protocol. Keywords: )doc") +
+search_s, timed: whether every scan had a time), pr (descriptor, protocol, threshold, precision, recall), scans
+(scan, t, x, y, z, heading, drift); and sequence, protocol. Keywords: )doc") +
          describe(analysis::LoopClosureParams::table(), analysis::LoopClosureParams{}) +
          describe(RecordedReturnParams::table(), RecordedReturnParams{}))
             .c_str());

@@ -45,6 +45,11 @@ Keyword arguments and their defaults:
     cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
            HeadDirectionParams p;
            apply_args(p, HeadDirectionParams::table(), args, kwargs);
+           // The spherical cells are the icosahedron's 20, whatever n says: an n other than that is a mistake.
+           const bool n_given = args.size() > 0 || kwargs.contains("n");
+           if (p.space == HdSpace::spherical && n_given && p.n != 20)
+               throw InputError("head-direction cells: n = " + std::to_string(p.n) +
+                                " is the planar cells' count; the spherical cells are the icosahedron's 20");
            return HeadDirectionCells(p);
        }))
         .def(
@@ -86,26 +91,35 @@ Keyword arguments and their defaults:
             "Preferred headings (n,) (planar) or unit directions (20, 3) (spherical)")
         .def_property_readonly("n_cells", &HeadDirectionCells::size);
     for (const auto& f : HeadDirectionParams::table().fields())
-        cls.def_property_readonly(
-            f.key.c_str(), [get = f.get](const HeadDirectionCells& c) { return from_value(get(c.params())); },
-            f.doc.c_str());
+        if (f.key != "n")
+            cls.def_property_readonly(
+                f.key.c_str(), [get = f.get](const HeadDirectionCells& c) { return from_value(get(c.params())); },
+                f.doc.c_str());
+    cls.def_property_readonly("n", &HeadDirectionCells::size, "cells: n planar ones, or the 20 spherical ones");
 }
 
 void bind_grid(pyb::module_& m) {
     auto cls = pyb::class_<GridCells>(m, "GridCells",
                                       (R"doc(
-Grid cells, the sum of three cosines (docs/model-reference.md#grid-cells). GridCells(seed=0, **params): cell c has
-orientation α + (c mod n_orientations)·2π/n_orientations and a phase spread over the lattice's unit cell (scrambled
-Sobol, from the seed). rates(xy) takes (M, 2) positions and gives (M, n) rates in [0, 1].
+Grid cells, the sum of three cosines (docs/model-reference.md#grid-cells). GridCells(spacing=4, orientation=0,
+n_orientations=8, n=800, input='pose', path_noise=0.01, seed=0), positionally in that order: cell c has orientation
+α + (c mod n_orientations)·2π/n_orientations and a phase spread over the lattice's unit cell (scrambled Sobol, from
+the seed). rates(xy) takes (M, 2) positions and gives (M, n) rates in [0, 1]; with input='path' the rows are
+successive model steps, and the cells read the position integrated along them from the first, each step's
+displacement with Gaussian noise of sd path_noise per axis (integrate(xy) gives that estimate), as in a trial.
 Keyword arguments and their defaults:
-)doc" + describe(GridParams::table(), GridParams{}))
+)doc" + describe(GridParams::table(), GridParams{}) +
+                                       "  seed=0  the phases' and the path noise's seed\n")
                                           .c_str());
-    cls.def(pyb::init([](const pyb::object& seed, const pyb::kwargs& kwargs) {
-                GridParams p;
-                apply_kwargs(p, GridParams::table(), kwargs);
-                return GridCells(p, seed_of(seed, "seed"));
-            }),
-            pyb::arg("seed") = 0)
+    cls.def(pyb::init([](const pyb::args& args, const pyb::kwargs& kwargs) {
+           auto names = keys_of(GridParams::table());
+           names.push_back("seed");
+           pyb::kwargs given = named_arguments("GridCells", args, kwargs, names);
+           const auto seed = seed_of(given.attr("pop")("seed", 0), "seed");
+           GridParams p;
+           apply_kwargs(p, GridParams::table(), given);
+           return GridCells(p, seed);
+       }))
         .def(
             "rates",
             [](const GridCells& cells, const pyb::object& obj) {
@@ -116,12 +130,37 @@ Keyword arguments and their defaults:
                 std::vector<double> out(static_cast<std::size_t>(rows) * n);
                 {
                     pyb::gil_scoped_release release;
-                    for (pyb::ssize_t i = 0; i < rows; ++i)
-                        cells.rates(a.data()[2 * i], a.data()[2 * i + 1], {out.data() + i * n, n});
+                    GridCells path = cells;  // a fresh estimate along this path (the object's own is untouched)
+                    for (pyb::ssize_t i = 0; i < rows; ++i) {
+                        const auto [x, y] =
+                            path.read_position(a.data()[2 * i], a.data()[2 * i + 1], static_cast<std::uint64_t>(i));
+                        cells.rates(x, y, {out.data() + i * n, n});
+                    }
                 }
                 return result(out, rows, static_cast<pyb::ssize_t>(n), single);
             },
-            pyb::arg("xy"), "Rates (M, n) at positions (M, 2), m; one position (2,) gives (n,)")
+            pyb::arg("xy"),
+            "Rates (M, n) at positions (M, 2), m (one position (2,) gives (n,)); input='path': of the position "
+            "integrated along the rows")
+        .def(
+            "integrate",
+            [](const GridCells& cells, const pyb::object& obj) {
+                pyb::ssize_t rows = 0;
+                bool single = false;
+                const ArrayD a = rows_of(obj, "xy", 2, rows, single);
+                std::vector<double> out(static_cast<std::size_t>(2 * rows));
+                GridCells path = cells;
+                for (pyb::ssize_t i = 0; i < rows; ++i) {
+                    const auto [x, y] =
+                        path.read_position(a.data()[2 * i], a.data()[2 * i + 1], static_cast<std::uint64_t>(i));
+                    out[static_cast<std::size_t>(2 * i)] = x;
+                    out[static_cast<std::size_t>(2 * i + 1)] = y;
+                }
+                return result(out, rows, 2, single);
+            },
+            pyb::arg("xy"),
+            "The positions (M, 2) the cells read along the path xy (M, 2), one model step a row: xy itself with "
+            "input='pose'; with input='path' the estimate integrated from xy[0] with the path noise")
         .def(
             "interference",
             [](const GridCells& cells, const pyb::object& obj) {

@@ -236,14 +236,14 @@ void bind_recording(pyb::module_& m) {
     bind_recording_class(m);
     m.def(
         "replay_simulated",
-        [](const std::string& world, const pyb::object& trajectory, const pyb::object& sensor, const std::string& model,
+        [](const pyb::object& world, const pyb::object& trajectory, const pyb::object& sensor, const std::string& model,
            bool learn, const pyb::object& weights, std::uint64_t seed, const pyb::kwargs& kwargs) {
+            const WorldSpec where = world_source_of(world, "replay_simulated: world");
             const auto path = trajectory_of(trajectory, kwargs);
             const LidarSpec s = pyb::isinstance<pyb::str>(sensor) ? config::resolve_sensor(sensor.cast<std::string>())
                                                                   : sensor.cast<LidarSpec>();
-            return run(simulated_source(WorldSpec{world, std::nullopt, "+x+y"}, path, s,
-                                        preprocess_of(kwargs, trajectory_keywords())),
-                       model, learn, weights, seed);
+            return run(simulated_source(where, path, s, preprocess_of(kwargs, trajectory_keywords())), model, learn,
+                       weights, seed);
         },
         pyb::arg("world"), pyb::arg("trajectory"), pyb::arg("sensor"), pyb::arg("model") = "3d-0.2",
         pyb::arg("learn") = false, pyb::arg("weights") = pyb::none(), pyb::arg("seed") = 0,

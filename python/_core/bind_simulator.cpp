@@ -1,10 +1,12 @@
 // World, Sensor, agents (random walk, trajectories).
 #include "bindings.hpp"
 
+#include "bvc3d/agent/body_collider.hpp"
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
+#include "bvc3d/world/gazebo_world.hpp"
 
 namespace bvc3d::py {
 
@@ -72,8 +74,15 @@ Sensor.horizontal() and Sensor.spherical() are the paper's two scanners; Sensor(
     def_fields<LidarSpec>(cls);
 }
 
+// A Gazebo world's file given to the YAML reader: say which loader reads it (not what YAML makes of XML).
+void refuse_gazebo_file(const std::filesystem::path& path) {
+    if (is_gazebo_file(path.string()))
+        throw InputError("'" + path.string() + "' is a Gazebo world (" + path.extension().string() +
+                         "): read it with World.from_sdf (or World.preset, which reads any world file)");
+}
+
 void bind_world(pyb::module_& m) {
-    pyb::class_<World>(m, "World",
+    pyb::class_<World>(m, "World", pyb::dynamic_attr(),
                        "A 3-D world: triangles, a walkable floor region and a start region (docs/worlds.md)")
         .def_static(
             "cross",
@@ -81,14 +90,18 @@ void bind_world(pyb::module_& m) {
                 CrossArenaParams p;
                 p.tilt_deg = tilt_deg;
                 p.lean = lean;
-                return World::cross(p);
+                return with_source(World::cross(p), WorldSpec{"cross", tilt_deg, lean});
             },
             pyb::arg("tilt_deg") = CrossArenaParams{}.tilt_deg, pyb::arg("lean") = CrossArenaParams{}.lean,
             "The paper's cross arena")
         .def_static(
             "from_yaml",
-            [](const std::filesystem::path& path) { return World(config::load_world_file(path.string())); },
-            pyb::arg("path"))
+            [](const std::filesystem::path& path) {
+                refuse_gazebo_file(path);
+                return with_source(World(config::load_world_file(path.string())),
+                                   WorldSpec{path.string(), std::nullopt, "+x+y"});
+            },
+            pyb::arg("path"), "A world YAML file (docs/worlds.md); a Gazebo world is World.from_sdf's")
         .def_static(
             "from_yaml_text",
             [](const std::string& text, const std::string& name) {
@@ -98,13 +111,34 @@ void bind_world(pyb::module_& m) {
             "A world from the text of a world YAML (docs/worlds.md); errors name `name` and the key")
         .def_static(
             "preset",
-            [](const std::string& name, std::optional<double> tilt_deg) {
-                return World(config::resolve_world(name, tilt_deg));
+            [](const std::filesystem::path& name, std::optional<double> tilt_deg) {
+                return with_source(World(config::resolve_world(name.string(), tilt_deg)),
+                                   WorldSpec{name.string(), tilt_deg, "+x+y"});
             },
             pyb::arg("name"), pyb::arg("tilt_deg") = pyb::none(),
-            "A preset name (cross, cross-30, ..., cross-webots, flight-room, atrium) or a world YAML file; tilt_deg "
-            "for cross and cross-webots")
+            "A preset name (cross, cross-30, ..., cross-webots, flight-room, atrium) or a world file (YAML, Gazebo "
+            ".world or .sdf); tilt_deg for cross and cross-webots")
         .def_property_readonly("name", &World::name)
+        .def(
+            "floor_plan",
+            [](const World& w, double height) {
+                const BodyCollider body(w.description(), RobotParams{}.radius, height);
+                std::vector<double> ends, radii;
+                for (const auto& s : body.segments()) {
+                    ends.insert(ends.end(), {s.a.x(), s.a.y(), s.b.x(), s.b.y()});
+                    radii.push_back(s.radius);
+                }
+                const auto n = static_cast<pyb::ssize_t>(radii.size());
+                pyb::dict d;
+                d["segments"] = to_numpy(ends.data(), {n, 2, 2});
+                d["radii"] = to_numpy(radii.data(), {n});
+                return d;
+            },
+            pyb::arg("height") = RobotParams{}.height,
+            R"doc(The floor plan the ground robot's body meets, cut at its height (default the paper's robot, 0.1 m):
+what its collision reads (docs/worlds.md). A dict: segments (S, 2, 2), the outline of every surface between
+the floor (or the world's step height) and `height`, the walkable region's edge and the drop edges; radii
+(S,), 0 for a segment, a sphere's cut for a point cloud's point (its disc: a == b).)doc")
         .def_property_readonly(
             "triangles",
             [](const World& w) {
@@ -165,16 +199,53 @@ floor; the sensor sits its own height above it and tilts with pitch (nose up) an
 
 }  // namespace
 
+// The source a World was made from, as an attribute of its Python object.
+constexpr const char* source_attribute = "_bvc3d_source";
+
+pyb::object with_source(World world, const WorldSpec& source) {
+    pyb::object obj = pyb::cast(std::move(world));
+    obj.attr(source_attribute) = pyb::make_tuple(source.source, source.tilt_deg, source.lean);
+    return obj;
+}
+
+namespace {
+bool is_path(const pyb::handle& obj) { return pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__"); }
+std::string path_text(const pyb::handle& obj) {
+    return pyb::str(pyb::module_::import("os").attr("fspath")(obj)).cast<std::string>();
+}
+const char* const world_kinds = "a World, a preset name or a world file's path";
+}  // namespace
+
+std::shared_ptr<const World> world_of(const pyb::handle& obj, const std::string& key) {
+    if (pyb::isinstance<World>(obj))
+        return std::shared_ptr<const World>(std::shared_ptr<const World>{}, &obj.cast<const World&>());
+    if (is_path(obj)) return std::make_shared<const World>(config::resolve_world(path_text(obj)));
+    throw InputError(key + " must be " + world_kinds + ", not " + type_name(obj));
+}
+
+WorldSpec world_source_of(const pyb::handle& obj, const std::string& key) {
+    if (is_path(obj)) return WorldSpec{path_text(obj), std::nullopt, "+x+y"};
+    if (!pyb::isinstance<World>(obj)) throw InputError(key + " must be " + world_kinds + ", not " + type_name(obj));
+    if (!pyb::hasattr(obj, source_attribute))
+        throw InputError(key +
+                         ": this World was built in Python (from_dict, from_triangles, from_yaml_text, or "
+                         "from_sdf with options), and what runs here records where its world came from: give "
+                         "a preset name or a world file (a world YAML can say how to read a Gazebo world)");
+    const auto t = obj.attr(source_attribute).cast<pyb::tuple>();
+    return WorldSpec{t[0].cast<std::string>(), t[1].cast<std::optional<double>>(), t[2].cast<std::string>()};
+}
+
 void bind_simulator(pyb::module_& m) {
     bind_sensor(m);
     bind_world(m);
     m.def(
         "random_walk",
-        [](const World& w, double hours, const pyb::object& seed, const pyb::kwargs& robot) {
+        [](const pyb::object& world, double hours, const pyb::object& seed, const pyb::kwargs& robot) {
+            const auto w = world_of(world, "random_walk: world");
             const std::uint64_t s = seed_of(seed, "seed");
             RobotParams p;
             apply_kwargs(p, RobotParams::table(), robot);
-            const auto steps = interruptible([&](const std::atomic<bool>&) { return random_walk(w, hours, s, p); });
+            const auto steps = interruptible([&](const std::atomic<bool>&) { return random_walk(*w, hours, s, p); });
             return steps_to_dict(steps);
         },
         pyb::arg("world"), pyb::arg("hours"), pyb::arg("seed"),
@@ -184,13 +255,14 @@ void bind_simulator(pyb::module_& m) {
             .c_str());
     m.def(
         "flying_walk",
-        [](const World& w, double hours, std::uint64_t seed, const pyb::kwargs& kwargs) {
+        [](const pyb::object& world, double hours, std::uint64_t seed, const pyb::kwargs& kwargs) {
+            const auto w = world_of(world, "flying_walk: world");
             FlightParams params;
             apply_kwargs(params, FlightParams::table(), kwargs);
             std::vector<ModelStep> steps;
             {
                 pyb::gil_scoped_release release;
-                steps = flying_walk(w, hours, seed, params);
+                steps = flying_walk(*w, hours, seed, params);
             }
             return steps_to_dict(steps);
         },

@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -17,11 +18,13 @@
 #include <vector>
 
 #include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/config/trial_config.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/parallel.hpp"
 #include "bvc3d/core/params.hpp"
 #include "bvc3d/recorder/trial_record.hpp"
+#include "bvc3d/world/world.hpp"
 
 namespace bvc3d::py {
 
@@ -56,6 +59,36 @@ pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(
 
 // A seed: a Python integer 0 .. 2^64 - 1 (InputError naming `name` otherwise; no bools, no floats).
 std::uint64_t seed_of(const pyb::handle& obj, const std::string& name);
+// A whole number 0 .. 2^31 - 1 (a count of cells), InputError naming `name` otherwise.
+int count_of(const pyb::handle& obj, const std::string& name);
+// True or False (Python's or numpy's); anything else is an InputError naming `name` and the value's type.
+bool flag_of(const pyb::handle& obj, const std::string& name);
+// The name of a Python value's type, for messages that must not print the value (an array, a repr).
+std::string type_name(const pyb::handle& obj);
+
+// A call's arguments by name: positional ones take `names` in order, keywords their own; `required` must be given.
+// A name given twice, too many positional arguments or a missing required one is an InputError naming `what`.
+pyb::kwargs named_arguments(const std::string& what, const pyb::args& args, const pyb::kwargs& kwargs,
+                            const std::vector<std::string>& names, const std::vector<std::string>& required = {});
+// The keys of a parameter table, in its order.
+template <class S>
+std::vector<std::string> keys_of(const params::Table<S>& table, const std::vector<std::string>& skip = {}) {
+    std::vector<std::string> keys;
+    for (const auto& f : table.fields())
+        if (std::find(skip.begin(), skip.end(), f.key) == skip.end()) keys.push_back(f.key);
+    return keys;
+}
+
+// A world argument (`key` names it in errors): a World, or a preset name or a world file's path (str or
+// os.PathLike), resolved. Anything else is an InputError naming its type, never its value. A World given is
+// not copied: the pointer lives as long as the call's argument.
+std::shared_ptr<const World> world_of(const pyb::handle& obj, const std::string& key);
+// Where a world comes from, for what records it (a trial, a replay): a preset name or a file's path, or a World
+// made from one (World.preset, World.cross, World.from_yaml, World.from_sdf without options). A World built in
+// Python (from_dict, from_triangles, from_yaml_text, from_sdf with options) has none: an InputError says so.
+WorldSpec world_source_of(const pyb::handle& obj, const std::string& key);
+// Marks a World object with the source it was made from (what world_source_of reads).
+pyb::object with_source(World world, const WorldSpec& source);
 
 // Runs `work(stop)` on a worker of core/parallel.hpp's pool with the GIL released, and wakes every
 // 100 ms to let Python run its signal handlers: Ctrl-C (KeyboardInterrupt) sets `stop` — which the
@@ -131,13 +164,14 @@ void apply_args(S& s, const params::Table<S>& table, const pyb::args& args, cons
     apply_kwargs(s, table, kwargs);
 }
 
-// "key=default  description" lines for docstrings, from the table and a default struct.
+// "key=default  description" lines for docstrings, from the table and a default struct (the keys in `skip` aside).
 template <class S>
-std::string describe(const params::Table<S>& table, const S& defaults) {
+std::string describe(const params::Table<S>& table, const S& defaults, const std::vector<std::string>& skip = {}) {
     std::string out;
     for (const auto& f : table.fields())
-        out += "  " + f.key + "=" + params::to_text(f.get(defaults)) + "  " + f.doc + (f.radians ? " (radians)" : "") +
-               "\n";
+        if (std::find(skip.begin(), skip.end(), f.key) == skip.end())
+            out += "  " + f.key + "=" + params::to_text(f.get(defaults)) + "  " + f.doc +
+                   (f.radians ? " (radians)" : "") + "\n";
     return out;
 }
 

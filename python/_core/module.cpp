@@ -81,6 +81,42 @@ std::uint64_t seed_of(const pyb::handle& obj, const std::string& name) {
     return value.cast<std::uint64_t>();
 }
 
+int count_of(const pyb::handle& obj, const std::string& name) {
+    const auto v = std::get<long long>(to_value(obj, params::Kind::integer, name));
+    if (v < 0 || v > std::numeric_limits<int>::max())
+        throw InputError("'" + name + "' must be from 0 to " + std::to_string(std::numeric_limits<int>::max()) +
+                         ", got " + std::to_string(v));
+    return static_cast<int>(v);
+}
+
+bool flag_of(const pyb::handle& obj, const std::string& name) {
+    if (pyb::isinstance<pyb::bool_>(obj)) return obj.cast<bool>();
+    if (pyb::hasattr(obj, "dtype") && pyb::hasattr(obj, "ndim") && obj.attr("ndim").cast<int>() == 0 &&
+        pyb::str(obj.attr("dtype").attr("kind")).cast<std::string>() == "b")
+        return obj.attr("item")().cast<bool>();
+    throw InputError(name + " must be True or False, not " + type_name(obj));
+}
+
+std::string type_name(const pyb::handle& obj) {
+    return pyb::str(pyb::type::of(obj).attr("__name__")).cast<std::string>();
+}
+
+pyb::kwargs named_arguments(const std::string& what, const pyb::args& args, const pyb::kwargs& kwargs,
+                            const std::vector<std::string>& names, const std::vector<std::string>& required) {
+    if (args.size() > names.size())
+        throw InputError(what + ": too many positional arguments (" + std::to_string(args.size()) + "; it takes " +
+                         std::to_string(names.size()) + ")");
+    pyb::kwargs out;
+    for (std::size_t i = 0; i < args.size(); ++i) out[pyb::str(names[i])] = args[i];
+    for (const auto& [k, v] : kwargs) {
+        if (out.contains(k)) throw InputError(what + ": '" + pyb::str(k).cast<std::string>() + "' given twice");
+        out[k] = v;
+    }
+    for (const auto& r : required)
+        if (!out.contains(r.c_str())) throw InputError(what + ": '" + r + "' is required");
+    return out;
+}
+
 pyb::object from_value(const params::Value& v) {
     return std::visit([](const auto& x) -> pyb::object { return pyb::cast(x); }, v);
 }

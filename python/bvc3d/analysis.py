@@ -147,6 +147,8 @@ def _centers_maps(centers, maps):
         m = m.reshape(-1, 1)
     if m.ndim != 2 or m.shape[0] != c.shape[0]:
         raise ValueError(f"maps must be (N,) or (N, n_cells) with N = {c.shape[0]} bins, got shape {np.shape(maps)}")
+    if m.shape[1] == 0:
+        raise ValueError(f"maps have no cells (shape {np.shape(maps)}): give (N,) or (N, n_cells) with n_cells >= 1")
     return c, m, was_1d
 
 

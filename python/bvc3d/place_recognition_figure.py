@@ -25,7 +25,8 @@ def _pct(v):
     return "n/a" if math.isnan(v) else f"{100 * v:.1f}%"
 
 
-def figure(directory, out=None):
+def draw(directory):
+    """The figure of a folder as a matplotlib Figure (figure() writes it)."""
     details = read_csv(os.path.join(directory, "details.csv"))
     pr = read_csv(os.path.join(directory, "pr.csv"))
     scans = read_csv(os.path.join(directory, "scans.csv"))
@@ -41,11 +42,17 @@ def figure(directory, out=None):
                  f"AUC {num(row['auc']):.2f}")
         left.plot(recall, precision, "-", lw=1.2, label=label, drawstyle="steps-post")
     protocol = details[0]["protocol"] if details else ""
+    if details and all(int(row["revisits"]) == 0 for row in details):
+        left.text(0.5, 0.5, "no query has a revisit\n(no older scan outside the exclusion window within the\n"
+                  "revisit radius): recall, F1max and AUC are undefined", ha="center", va="center", fontsize=9,
+                  transform=left.transAxes)
+    untimed = details and details[0].get("timed") == "0"
     left.set_xlim(0, 1.02)
     left.set_ylim(0, 1.02)
     left.set_xlabel("recall (right matches / queries with a revisit)")
     left.set_ylabel("precision")
-    left.set_title(f"precision-recall, {protocol} protocol", fontsize=10)
+    left.set_title(f"precision-recall, {protocol} protocol" + (" (scans without times)" if untimed else ""),
+                   fontsize=10)
     left.legend(fontsize=7, loc="lower left")
     x = [num(s["x"]) for s in scans]
     y = [num(s["y"]) for s in scans]
@@ -61,6 +68,11 @@ def figure(directory, out=None):
     right.set_ylabel("y (m)")
     right.legend(fontsize=7, loc="best")
     fig.tight_layout()
+    return fig
+
+
+def figure(directory, out=None):
+    fig = draw(directory)
     path = out or os.path.join(directory, "place-recognition.png")
     fig.savefig(path, dpi=DPI)
     plt.close(fig)

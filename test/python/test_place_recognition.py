@@ -364,7 +364,7 @@ def test_the_command_and_the_function_give_the_same_tables(tmp_path):
     with open(out / "queries.csv") as f:
         assert f.readline().strip() == "descriptor,query,match,distance,match_m,has_revisit,correct"
     with open(out / "summary.csv") as f:
-        assert f.readline().strip() == "descriptor,protocol,recall_at_1,f1_max,auc,queries,revisits"
+        assert f.readline().strip() == "descriptor,protocol,recall_at_1,f1_max,auc,queries,revisits,timed"
     assert (out / "place-recognition.png").stat().st_size > 10000
     r = bvc3d.place_recognition(world="cross", route=route, sensor="horizontal", descriptors=descriptors,
                                 exclude_seconds=10)

@@ -14,10 +14,15 @@ from conftest import run_cli
 SHORT = dict(explore_hours=0.01, sample_hours=0.02)
 
 
-def test_a_world_object_is_refused_by_name():
-    with pytest.raises(ValueError, match=r"world= takes a world preset name or a world YAML path, not a World"):
-        bvc3d.run_trial(world=bvc3d.World.cross())
-    with pytest.raises(ValueError, match=r"world= must be .* not int"):
+def test_a_world_built_in_python_is_refused_by_name():
+    """A trial records where its world came from: a World made from a preset or a file is that source (issue
+    43); one built in Python has none, and the message says what to give instead."""
+    built = bvc3d.World.from_dict({"objects": [{"box": {"center": [0, 3, 1], "size": [6, 0.2, 2]}}],
+                                   "walkable": {"rect": [-3, -3, 3, 3]}})
+    with pytest.raises(ValueError, match=r"run_trial: world: this World was built in Python .* a preset name or a "
+                                         r"world file"):
+        bvc3d.run_trial(world=built)
+    with pytest.raises(ValueError, match=r"world must be a World, a preset name or a world file's path, not int"):
         bvc3d.run_trial(world=3)
     with pytest.raises(ValueError, match=r"'tilt_deg' must be a number"):
         bvc3d.run_trial(tilt_deg="45")

@@ -196,7 +196,8 @@ def test_a_broken_checkpoint_is_named_before_the_trial_restarts(tmp_path, damage
         pathlib.Path(f"{ckpt}.seg0").unlink()
     proc = run_cli(*args)
     assert proc.returncode == 0, proc.stderr
-    warning = [l for l in proc.stderr.splitlines() if l.startswith("bvc3d: warning:")]
+    # The analysis may warn too (a 0.3 h walk's decoded half lies mostly away from the first half's places).
+    warning = [l for l in proc.stderr.splitlines() if l.startswith("bvc3d: warning:") and ": decoding:" not in l]
     assert (len(warning) == 1 and f"checkpoint '{ckpt}'" in warning[0]
             and "starts again from the beginning" in warning[0])
     if damage == "missing segment":

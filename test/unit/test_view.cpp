@@ -145,5 +145,15 @@ TEST(ViewData, ErrorsAreRepliesWithAStatus) {
     EXPECT_EQ(data.get("nothing", {}).status, 404);
     const auto error = nlohmann::json::parse(data.get("trial", {{"path", "broken.h5"}}).body);
     EXPECT_NE(error["error"].get<std::string>().find("broken.h5"), std::string::npos);
+    // A trial or world file that is a folder is said to be one (issue 43), not "does not exist".
+    fs::create_directory(dir / "folder.h5");
+    fs::create_directory(dir / "folder.yaml");
+    for (const auto& [endpoint, query] : {std::pair{"trial", view::Query{{"path", "folder.h5"}}},
+                                          std::pair{"world", view::Query{{"source", "folder.yaml"}}}}) {
+        const auto reply = data.get(endpoint, query);
+        EXPECT_EQ(reply.status, 422) << endpoint;
+        EXPECT_NE(nlohmann::json::parse(reply.body)["error"].get<std::string>().find("is a folder"), std::string::npos)
+            << reply.body;
+    }
     fs::remove_all(dir);
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/format.hpp"
 
 namespace bvc3d::analysis {
 
@@ -65,6 +66,16 @@ LocalizationResult localize(const Eigen::Ref<const RowMatrixXf>& templates,
                          std::to_string(queries.cols()) + ": they must come from the same model");
     if (template_xyz.rows() != T || query_xyz.rows() != Q || template_xyz.cols() != 3 || query_xyz.cols() != 3)
         throw InputError("localization: one x, y, z row per template and per query");
+    // A position that is not a number has no error to measure: refused, naming the row, not carried into the means.
+    for (const auto& [xyz, what] : {std::pair{&template_xyz, "template"}, std::pair{&query_xyz, "query"}})
+        for (Eigen::Index i = 0; i < xyz->rows(); ++i)
+            if (!xyz->row(i).allFinite())
+                throw InputError(std::string("localization: ") + what + " " + std::to_string(i) +
+                                 "'s position is not finite (" + format_number((*xyz)(i, 0)) + ", " +
+                                 format_number((*xyz)(i, 1)) + ", " + format_number((*xyz)(i, 2)) + ")");
+    for (const auto& [rates, what] : {std::pair{&templates, "templates"}, std::pair{&queries, "queries"}})
+        if (!rates->allFinite())
+            throw InputError(std::string("localization: the ") + what + " hold values that are not finite");
 
     const RowMatrixXd t = unit_rows(templates), q = unit_rows(queries);
     LocalizationResult r;

@@ -70,6 +70,15 @@ struct TrialMetrics {
 // so when the visited bins' span (the diagonal of their bounding box) is below d_th (every pair of
 // bins is excluded) or below 2·eps (DBSCAN cannot separate two fields); empty otherwise.
 std::vector<std::string> scale_warnings(const Points& centers, const AnalysisParams& params);
+// DBSCAN finds a field only around a bin with min_samples visited bins within eps (a cell's active bins are
+// visited ones). Says so, with the settings to change, when fewer than half of the visited bins have that many:
+// bins large for eps (a building binned with the arena's gridsize), or a path that covers lines, not areas.
+std::vector<std::string> field_warnings(const Eigen::Ref<const Points>& positions, const RateMaps& maps,
+                                        const AnalysisParams& params);
+// Decoding reads the first half's maps at the second half's places (n samples): says so when most of the second
+// half lies farther than `radius` from every bin the first half visited (a path that does not come back: the error
+// measures the path).
+std::vector<std::string> decoding_warnings(const RateMaps& maps, std::size_t n, double radius);
 
 // The grid a trial's positions are binned on: hexagons for 2-D positions (gridsize, extent), voxels
 // for 3-D ones (voxel, volume); InputError for other dimensions.

@@ -173,6 +173,12 @@ Descriptions descriptions_for(const std::vector<DescriptorSpec>& descriptors) {
 
 }  // namespace
 
+bool has_times(const ScanSequence& seq) {
+    for (std::size_t i = 0; i < seq.size(); ++i)
+        if (!seq.time(i)) return false;
+    return true;
+}
+
 std::vector<double> scan_times(const ScanSequence& seq) {
     std::vector<double> times(seq.size());
     for (std::size_t i = 0; i < seq.size(); ++i) {
@@ -191,9 +197,7 @@ analysis::QueryPlan query_plan(const ScanSequence& seq, const PlaceRecognitionOp
     if (o.database.has_value() != o.queries.has_value())
         throw InputError("a database/query split needs both --database and --queries");
     if (o.database) return analysis::split_plan(seq.size(), *o.database, *o.queries);
-    bool timed = true;
-    for (std::size_t i = 0; i < seq.size() && timed; ++i) timed = seq.time(i).has_value();
-    const std::vector<double> times = timed ? scan_times(seq) : std::vector<double>{};
+    const std::vector<double> times = has_times(seq) ? scan_times(seq) : std::vector<double>{};
     return analysis::sequential_plan(seq.size(), times, o.loop);
 }
 
@@ -289,6 +293,7 @@ PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std
     const analysis::QueryPlan plan = query_plan(seq, o);
     out.protocol = plan.protocol;
     out.times = scan_times(seq);
+    out.timed = has_times(seq);
     out.positions.resize(static_cast<Eigen::Index>(n), 3);
     out.heading.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -301,7 +306,8 @@ PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std
     Descriptions d = descriptions_for(descriptors);
     const std::size_t cores = thread_count(o.threads);
     const auto start = Clock::now();
-    describe_scans(seq, out.heading, out.drift, o, std::max<std::size_t>(1, std::min(n, cores)), d);
+    out.threads = std::max<std::size_t>(1, std::min(n, cores));
+    describe_scans(seq, out.heading, out.drift, o, out.threads, d);
     out.describe_wall_seconds = since(start);
     out.read_seconds = total(d.read_seconds);
 

@@ -74,14 +74,18 @@ struct PlaceRecognitionOutcome {
     analysis::Points positions;   // x, y, z of every scan
     std::vector<double> heading;  // the pose's heading of every scan, rad
     std::vector<double> times;    // every scan's time, s (scan_times)
+    bool timed = true;            // every scan has a time of its own (else `times` counts one scan a second)
     std::vector<double> drift;    // the drifting descriptors' heading error of every scan, rad
     std::vector<DescriptorOutcome> descriptors;
-    double read_seconds = 0;  // thread time spent reading (or simulating) the scans
+    double read_seconds = 0;  // thread time spent reading (or simulating) the scans, summed over the threads
     double describe_wall_seconds = 0;
+    std::size_t threads = 1;  // the threads that read and described the scans
 };
 
 // Each scan's time: the sequence's when every scan has one, else one scan a second (as replays count).
 std::vector<double> scan_times(const ScanSequence& sequence);
+// Whether every scan of the sequence has a time.
+bool has_times(const ScanSequence& sequence);
 // Which scans query which (the split when options name one, else the sequential windows, on the
 // scans' own times when they all have one): InputError for bad spans and windows, before any scan is read.
 analysis::QueryPlan query_plan(const ScanSequence& sequence, const PlaceRecognitionOptions& options);

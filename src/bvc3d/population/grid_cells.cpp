@@ -107,31 +107,32 @@ void GridCells::rates(double x, double y, std::span<double> out) const {
     for (std::size_t c = 0; c < cells_.size(); ++c) out[c] = grid::rate_at(cells_[c], p_.spacing, x, y);
 }
 
+std::array<double, 2> GridCells::read_position(double x, double y, std::uint64_t index) {
+    if (p_.input == GridInput::pose) return {x, y};
+    if (!started_) {
+        est_x_ = x;
+        est_y_ = y;
+    } else {
+        const auto normal = [&](std::uint64_t axis) {  // Box-Muller on two counter-based uniforms
+            const double u1 = 1.0 - hash_uniform(seed_ ^ noise_tag, index, 2 * axis);
+            const double u2 = hash_uniform(seed_ ^ noise_tag, index, 2 * axis + 1);
+            return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * pi * u2);
+        };
+        est_x_ += (x - last_x_) + p_.path_noise * normal(0);
+        est_y_ += (y - last_y_) + p_.path_noise * normal(1);
+    }
+    started_ = true;
+    last_x_ = x;
+    last_y_ = y;
+    return {est_x_, est_y_};
+}
+
 void GridCells::step(const StepBlock& block, std::span<const std::span<const double>>, std::span<double> out) {
     const std::size_t n = size();
     for (std::size_t s = 0; s < block.size(); ++s) {
         const Pose& pose = block.steps[s].pose;
-        double x = pose.x, y = pose.y;
-        if (p_.input == GridInput::path) {
-            if (!started_) {
-                est_x_ = x;
-                est_y_ = y;
-            } else {
-                const auto index = static_cast<std::uint64_t>(block.first_index + static_cast<std::int64_t>(s));
-                const auto normal = [&](std::uint64_t axis) {  // Box-Muller on two counter-based uniforms
-                    const double u1 = 1.0 - hash_uniform(seed_ ^ noise_tag, index, 2 * axis);
-                    const double u2 = hash_uniform(seed_ ^ noise_tag, index, 2 * axis + 1);
-                    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * pi * u2);
-                };
-                est_x_ += (x - last_x_) + p_.path_noise * normal(0);
-                est_y_ += (y - last_y_) + p_.path_noise * normal(1);
-            }
-            started_ = true;
-            last_x_ = x;
-            last_y_ = y;
-            x = est_x_;
-            y = est_y_;
-        }
+        const auto index = static_cast<std::uint64_t>(block.first_index + static_cast<std::int64_t>(s));
+        const auto [x, y] = read_position(pose.x, pose.y, index);
         rates(x, y, out.subspan(s * n, n));
     }
 }

@@ -20,6 +20,7 @@
 // step's true displacement plus Gaussian noise of sd path_noise (m, per axis, per model step) drawn from the seed
 // and the step's index (counter-based: the same at every block size, and across a checkpoint). Its error is a
 // random walk: sd path_noise·√steps.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -69,6 +70,9 @@ public:
     const std::vector<grid::Cell>& cells() const { return cells_; }
     // Rates at (x, y) into out (n values).
     void rates(double x, double y, std::span<double> out) const;
+    // The position the cells read at model step `index` (0, 1, ... of a trial) with the agent at (x, y): that
+    // position (input: pose), or the estimate integrated to it (input: path; each call is one step along the path).
+    std::array<double, 2> read_position(double x, double y, std::uint64_t index);
 
     std::size_t size() const override { return cells_.size(); }
     void step(const StepBlock& block, std::span<const std::span<const double>> inputs, std::span<double> out) override;

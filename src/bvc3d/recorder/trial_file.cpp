@@ -472,6 +472,14 @@ TrialWeights read_trial_weights(const std::filesystem::path& path) {
             r.fail(std::string(": attribute '/weights/") + name + "' is not text");
         *text = h5::read_attr_string(weights, name);
     }
+    // Files written before /weights named its model: the root's `model` and `config` do (the configuration
+    // holds the model's canonical text, which weights_model_mismatch reads the same).
+    for (auto [name, text] : {std::pair{"model", &w.model}, std::pair{"config", &w.model_config}}) {
+        if (!w.model_config.empty() || !text->empty() || !h5::exists_attr(r.file(), name)) continue;
+        if (h5::attr_class(r.file(), name) != H5T_STRING)
+            r.fail(std::string(": attribute '/") + name + "' is not text");
+        *text = h5::read_attr_string(r.file(), name);
+    }
     return w;
 }
 

@@ -105,8 +105,8 @@ struct TrialRates {
 TrialRates read_trial_rates(const std::filesystem::path& path, bool bvc);
 
 // The trained weights (n_place × n_bvc, row-major) of a trial file, and the model that trained them
-// (its name and canonical text, attributes `model` and `model_config` of /weights; empty in files
-// written before bvc3d recorded them).
+// (its name and canonical text, attributes `model` and `model_config` of /weights; in files written
+// before bvc3d recorded them there, the root's `model` and its whole `config`, which holds the model's text).
 struct TrialWeights {
     std::vector<float> values;
     std::size_t n_place = 0, n_bvc = 0;

@@ -17,6 +17,10 @@ namespace {
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
+std::vector<ScanEntry> scans_in_list(const fs::path& list);
+
+// A folder's scans in name order; with its own scans.txt (as write_recording and the KITTI conversion write it)
+// the list's entries, which carry the scans' times, once they are checked to be the same scans.
 std::vector<ScanEntry> scans_in_folder(const fs::path& folder) {
     std::vector<ScanEntry> scans;
     std::error_code ec;
@@ -29,7 +33,24 @@ std::vector<ScanEntry> scans_in_folder(const fs::path& folder) {
     std::sort(scans.begin(), scans.end(), [](const ScanEntry& a, const ScanEntry& b) {
         return natural_less(a.path.filename().string(), b.path.filename().string());
     });
-    return scans;
+    const fs::path list = folder / "scans.txt";
+    if (!fs::is_regular_file(list, ec)) return scans;
+    std::vector<ScanEntry> listed = scans_in_list(list);
+    for (std::size_t i = 0; i < std::max(listed.size(), scans.size()); ++i) {
+        std::error_code same_ec;
+        if (i < listed.size() && i < scans.size() && fs::equivalent(listed[i].path, scans[i].path, same_ec)) continue;
+        const std::string differs =
+            i >= listed.size() ? "it lists " + std::to_string(listed.size()) + " scans, the folder holds " +
+                                     std::to_string(scans.size())
+            : i >= scans.size() ? "it lists " + std::to_string(listed.size()) + " scans, the folder holds only " +
+                                      std::to_string(scans.size())
+                                : "its scan " + std::to_string(i) + " is '" + listed[i].path.filename().string() +
+                                      "', the folder's (in name order) '" + scans[i].path.filename().string() + "'";
+        throw input_error(list, "lists other scans than its folder holds (" + differs +
+                                    "): give the list itself to read the scans it names, or move it away to read "
+                                    "every scan of the folder without times");
+    }
+    return listed;
 }
 
 // A list line: a path, optionally followed by a time after the last whitespace or comma.

@@ -2,7 +2,8 @@
 // Which scans make up a recording. Takes: a folder, a list file, or one scan file. Gives: the
 // scan paths in recording order, each with its time when the list gives one.
 //  - A folder: its files with a scan extension (.pcd, .ply, .bin) in natural name order
-//    (digit runs compare as numbers: 2.pcd < 10.pcd); no times.
+//    (digit runs compare as numbers: 2.pcd < 10.pcd); no times, unless the folder holds its own list,
+//    scans.txt (as bvc3d writes recordings): then the list's times, which must name the same scans.
 //  - A scan file: just that scan.
 //  - Any other file: a list, one scan path per line (relative paths are relative to the list
 //    file's folder), optionally followed by its time in seconds after whitespace or a comma.

@@ -99,7 +99,7 @@ async function main() {
   } else if (recordingMode) {
     viewer.panes.push(new RecordingPane(container));
   } else if (world) {
-    viewer.panes.push(new WorldPane(container, world));
+    viewer.panes.push(new WorldPane(container, world, params.get('world') ? '' : index.trajectory));
   }
   setStatus(isExport() ? 'exported page (static files)' : 'served by bvc3d view');
   await Promise.all(viewer.panes.map((p) => p.open()));

@@ -312,9 +312,11 @@ export class TrialPane extends Pane {
 // A world on its own, with a probe: the default model's scanner and BVCs at a pose on the floor.
 // Click the floor (without dragging) to move the probe there; the heading field turns it.
 export class WorldPane extends Pane {
-  constructor(container, source) {
+  // `trajectory`: the name of a path to draw over the world (bvc3d view WORLD --trajectory FILE), or ''.
+  constructor(container, source, trajectory = '') {
     super(container, source);
     this.source = source;
+    this.trajectoryName = trajectory;
   }
 
   async open() {
@@ -332,6 +334,19 @@ export class WorldPane extends Pane {
       (w.header.tilt_deg !== undefined ? ` · tilt ${w.header.tilt_deg}°` : '') + ' · click the floor to probe there';
     this.readout.dataset.triangles = w.header.triangles;
     this.readout.textContent = 'orbit: drag · zoom: wheel · pan: right-drag';
+    if (this.trajectoryName) {
+      try {
+        this.path = await get('trajectory');
+      } catch (e) {
+        this.error(`cannot open trajectory ${this.trajectoryName}: ${e.message}`);
+        return false;
+      }
+      const a = this.path.arrays;
+      this.length = this.path.header.steps;
+      this.view.setTrajectory(a.x, a.y, a.z);
+      this.sub.textContent += ` · trajectory ${this.trajectoryName}: ${this.length} steps over ${fmt(a.t[this.length - 1] - a.t[0], 1)} s`;
+      this.steps = exportedSteps('#trajectory');
+    }
     if (!w.header.probe) return true;
     const headingInput = el('input', { type: 'number', value: '0', step: '15', className: 'probe-heading', title: 'heading, degrees' });
     const bvcBox = el('div', { className: 'box' }, el('h3', { textContent: 'boundary vector cells (BVCs) at the probe: how strongly each responds to the walls around, one disc per layer' }),
@@ -348,8 +363,13 @@ export class WorldPane extends Pane {
       this.pose = { x: x.toFixed(3), y: y.toFixed(3), heading: this.pose.heading };
       this.loader.request(this.pose);
     };
-    this.loader.request(this.pose);
+    if (!this.path) this.loader.request(this.pose);
     return true;
+  }
+
+  // Seconds since the trajectory's first row.
+  timeAt(i) {
+    return this.path ? this.path.arrays.t[i] - this.path.arrays.t[0] : null;
   }
 
   applyProbe(probe, error) {
@@ -374,12 +394,22 @@ export class WorldPane extends Pane {
     this.readout.dataset.x = h.x;
     this.readout.dataset.y = h.y;
     this.readout.dataset.returns = h.returns;
-    this.readout.textContent = `probe at x ${h.x.toFixed(3)} m  y ${h.y.toFixed(3)} m  heading ${h.heading.toFixed(4)} rad ` +
+    const along = h.step !== undefined ? `step ${h.step} of trajectory ${this.trajectoryName}: ` : '';
+    this.readout.dataset.step = h.step !== undefined ? h.step : '';
+    this.readout.textContent = `${along}probe at x ${h.x.toFixed(3)} m  y ${h.y.toFixed(3)} m  heading ${h.heading.toFixed(4)} rad ` +
       `(${degrees(h.heading)}): ${h.returns} LiDAR returns drawn, ${kept} of them in the rows the model's BVCs read ` +
       `(drawn large); the model's own scanner gets ${h.model_returns}`;
   }
 
-  moveTo() {}
+  // Along the trajectory: the agent at step i, the probe there (in an export, at the nearest exported step).
+  moveTo(i) {
+    if (!this.path || !this.loader) return;
+    i = Math.max(0, Math.min(this.length - 1, i));
+    const a = this.path.arrays;
+    this.view.moving();
+    this.view.setAgent(a.x[i], a.y[i], a.z[i], a.heading[i]);
+    this.loader.request({ step: this.steps ? nearest(this.steps, i) : i });
+  }
 }
 
 export class RecordingPane extends Pane {
