@@ -106,7 +106,11 @@ void add_route_command(CLI::App& app) {
                       << tenths(steps.back().t) << " s\n";
         }
         write_trajectory_file(o->out, steps);
-        const std::vector<std::string> args{"--world", o->world.world, "--trajectory", o->out, "--out", o->figure};
+        // The figure's world is the route's: its source with the world options that were given.
+        std::vector<std::string> args{"--world", o->world.world, "--trajectory", o->out, "--out", o->figure};
+        if (o->world.tilt) args.insert(args.end(), {"--tilt", num(*o->world.tilt)});
+        if (o->world.lean) args.insert(args.end(), {"--lean", *o->world.lean});
+        if (o->world.missing_models) args.insert(args.end(), {"--missing-models", *o->world.missing_models});
         if (!o->figure.empty() && run_python_module("bvc3d.route_figure", args).status != 0)
             throw InputError("the figure failed; the route is in '" + o->out + "'; rerun it with:\n  " +
                              python_command().shell_line("bvc3d.route_figure", args));

@@ -5,6 +5,7 @@
 #include "bvc3d/agent/flying_walk.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
+#include "bvc3d/config/building.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/world/gazebo_world.hpp"
 
@@ -111,13 +112,22 @@ void bind_world(pyb::module_& m) {
             "A world from the text of a world YAML (docs/worlds.md); errors name `name` and the key")
         .def_static(
             "preset",
-            [](const std::filesystem::path& name, std::optional<double> tilt_deg) {
-                return with_source(World(config::resolve_world(name.string(), tilt_deg)),
-                                   WorldSpec{name.string(), tilt_deg, "+x+y"});
+            [](const std::filesystem::path& name, std::optional<double> tilt_deg, const std::string& lean,
+               const std::string& missing_models) {
+                config::MissingModels missing{};
+                try {
+                    missing = config::parse_missing_models(missing_models);
+                } catch (const InputError& e) {
+                    throw InputError(std::string("missing_models ") + e.what());
+                }
+                return with_source(World(config::resolve_world(name.string(), tilt_deg, lean, missing)),
+                                   WorldSpec{name.string(), tilt_deg, lean, missing});
             },
-            pyb::arg("name"), pyb::arg("tilt_deg") = pyb::none(),
+            pyb::arg("name"), pyb::arg("tilt_deg") = pyb::none(), pyb::arg("lean") = CrossArenaParams{}.lean,
+            pyb::arg("missing_models") = "error",
             "A preset name (cross, cross-30, ..., cross-webots, flight-room, atrium) or a world file (YAML, Gazebo "
-            ".world or .sdf); tilt_deg for cross and cross-webots")
+            ".world or .sdf); tilt_deg and lean for cross and cross-webots; missing_models 'skip' builds a Gazebo "
+            "world without the included models that are not found (World.left_out names them), 'error' refuses it")
         .def_property_readonly("name", &World::name)
         .def(
             "floor_plan",

@@ -1,6 +1,7 @@
 """A route or a tour over the floor plan of its world: what `bvc3d route --figure FILE` draws.
 
-    /usr/bin/python3 -m bvc3d.route_figure --world WORLD --trajectory FILE --out FILE.png
+    /usr/bin/python3 -m bvc3d.route_figure --world WORLD [--tilt DEG --lean CORNER --missing-models skip] \
+        --trajectory FILE --out FILE.png
 
 The floor plan is the world cut at the ground robot's body, as its collision sees it: the outline of
 every surface between the floor (or the world's step height) and the body's top (0.1 m, the paper's
@@ -52,8 +53,9 @@ def draw_path(ax, fig, t, x, y, heading):
             label="start")
 
 
-def figure(world_source, trajectory, out, body_height=BODY_HEIGHT):
-    world = _core.World.preset(str(world_source))
+def figure(world_source, trajectory, out, body_height=BODY_HEIGHT, tilt_deg=None, lean="+x+y",
+           missing_models="error"):
+    world = _core.World.preset(str(world_source), tilt_deg, lean, missing_models)
     path = _core.read_trajectory(str(trajectory))
     t, x, y, heading = path["t"], path["x"], path["y"], path["heading"]
     if len(t) < 2:
@@ -85,12 +87,17 @@ def figure(world_source, trajectory, out, body_height=BODY_HEIGHT):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--world", required=True, help="a world preset, world YAML or Gazebo world")
+    parser.add_argument("--tilt", type=float, default=None, help="degrees the cross arena's central walls lean")
+    parser.add_argument("--lean", default="+x+y", help="the corner they lean toward (default +x+y)")
+    parser.add_argument("--missing-models", default="error",
+                        help="a Gazebo world's models that are not found: 'skip' or 'error' (default)")
     parser.add_argument("--trajectory", required=True, help="the route: a trajectory file (t, x, y, [z], heading)")
     parser.add_argument("--out", required=True, help="the figure to write (.png)")
     parser.add_argument("--body-height", type=float, default=BODY_HEIGHT, help="m: the plan's cut (default 0.1)")
     args = parser.parse_args(argv)
     try:
-        print("figure:", figure(args.world, args.trajectory, args.out, args.body_height))
+        print("figure:", figure(args.world, args.trajectory, args.out, args.body_height, args.tilt, args.lean,
+                                       args.missing_models))
     except (OSError, ValueError) as e:
         print(f"bvc3d.route_figure: error: {e}", file=sys.stderr)
         return 2

@@ -9,8 +9,10 @@ import os
 import pathlib
 import re
 
+import numpy as np
 import pytest
 
+import bvc3d
 from conftest import SOURCE_DIR, run_cli
 
 # Commands that take a world other than by --world, and how: each must still exist and say so in its help.
@@ -230,6 +232,7 @@ def test_missing_models_skip_loads_a_gazebo_world_with_a_missing_model(room, tmp
 @pytest.mark.parametrize("argv", [
     ["walk", "--hours", "0.001"],
     ["route", "--tour", "--out", "{tmp}/tour.csv"],
+    ["route", "--tour", "--out", "{tmp}/tour.csv", "--figure", "{tmp}/tour.png"],  # the figure's world is the same
     ["run", "--hours", "0.002", "--model", "2d", "--out", "{tmp}/trial.h5"],
     ["export-scans", "--hours", "0.001", "--sensor", "horizontal", "--out", "{tmp}/scans"],
 ])
@@ -238,6 +241,18 @@ def test_missing_models_skip_reaches_every_kind_of_command(room, tmp_path, argv)
     refused = run_cli(*argv, "--world", room)
     assert refused.returncode == 2 and "no_such_chair" in refused.stderr, refused.stderr
     run_cli(*argv, "--world", room, "--missing-models", "skip", check=True)
+
+
+def test_python_world_preset_takes_the_world_groups_options(room):
+    """World.preset builds what --world, --tilt, --lean and --missing-models build (route --figure draws it)."""
+    leaning = bvc3d.World.preset("cross", 30, lean="-x+y")
+    assert np.array_equal(leaning.triangles, bvc3d.World.cross(tilt_deg=30, lean="-x+y").triangles)
+    assert not np.array_equal(leaning.triangles, bvc3d.World.preset("cross", 30).triangles)
+    with pytest.raises(ValueError, match="no_such_chair"):
+        bvc3d.World.preset(str(room))
+    assert bvc3d.World.preset(str(room), missing_models="skip").left_out[0].startswith("no_such_chair")
+    with pytest.raises(ValueError, match="missing_models must be 'error' or 'skip', got 'maybe'"):
+        bvc3d.World.preset(str(room), missing_models="maybe")
 
 
 def test_missing_models_is_refused_where_it_means_nothing():

@@ -52,7 +52,7 @@ def exported(tmp_path_factory):
 
 def place_recognition_cli(out, *source):
     proc = run_cli("place-recognition", *source, "--descriptors", "bvc:2d,scan-context", "--out", out,
-                   "--no-figure", check=True)
+                   "--no-figures", check=True)
     return proc.stdout, read_table(out / "summary.csv"), read_table(out / "queries.csv")
 
 
