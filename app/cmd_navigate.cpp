@@ -216,8 +216,10 @@ void add_navigate_command(CLI::App& app) {
     for (CLI::Option* g : given) config->excludes(g);
     cmd->add_flag("--dry-run", o->dry_run, "Read and check everything, say what would run, and exit");
     o->run.add_out(*cmd,
-                   "Output folder: a trial file per model and seed (a run started again resumes there), the "
-                   "tables and figures",
+                   "Output folder: a trial file per model and seed, WORLD_MODEL_seedN.h5 (a run started again "
+                   "resumes there); the tables starts.csv, paths.csv, learning.csv, reward_map.csv, summary.csv, "
+                   "summary.md; the figures paths.png, reward_map.png (goals on the floor) and "
+                   "path_ratio_learning.png",
                    OutputKind::results_folder);
     o->run.add_jobs(*cmd, "Learning runs", " (the files are the same)");
     o->run.add_checkpoint_minutes(*cmd);

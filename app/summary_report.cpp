@@ -80,8 +80,12 @@ void summarize_navigation(const std::filesystem::path& out, const std::vector<st
     std::vector<NavigationTrial> trials;
     for (const auto& f : files) trials.push_back(read_navigation_trial(f));
     write_navigation_report(out, trials);
-    std::printf("wrote %s (starts.csv, paths.csv, learning.csv, reward_map.csv, summary.csv, summary.md)\n",
-                out.string().c_str());
+    std::string sources;
+    for (const auto& f : files) sources += (sources.empty() ? "" : ", ") + f.filename().string();
+    std::printf(
+        "wrote starts.csv, paths.csv, learning.csv, reward_map.csv, summary.csv, summary.md in %s from its trial "
+        "files (%s)\n",
+        out.string().c_str(), sources.c_str());
     if (!report) return;
     const ModuleRun fig = run_python_module("bvc3d.navigation_figures", {out.string(), trials.front().world}, true);
     if (fig.status != 0) std::fprintf(stderr, "bvc3d: warning: no figures (%s)\n", fig.last_error_line().c_str());

@@ -39,7 +39,9 @@ def reward_background(ax, maps, seed, goal):
 
 
 def main(folder, world=""):
+    """Draws the figures; prints (and returns) the names of those it wrote."""
     folder = pathlib.Path(folder)
+    drawn = []
     starts, paths, maps, learning = (read(folder / n) for n in ("starts.csv", "paths.csv", "reward_map.csv",
                                                                  "learning.csv"))
     model = starts["model"][0]  # the figures show the first model of the folder
@@ -70,6 +72,7 @@ def main(folder, world=""):
         ax.set_ylabel("y (m)")
     fig.suptitle(f"{world}, model {model}, seed {seed:g}")
     save(fig, folder / "paths.png")
+    drawn.append("paths.png")
     # The reward maps of the first seed.
     if maps:
         fig, axes = plt.subplots(1, len(goals), figsize=(5 * len(goals), 4.4), squeeze=False)
@@ -80,6 +83,7 @@ def main(folder, world=""):
             ax.set_aspect("equal")
             ax.set_title(f"reward cell of goal ({gx:g}, {gy:g}) after replay")
         save(fig, folder / "reward_map.png")
+        drawn.append("reward_map.png")
     # Path ratio against learning time: each learning run's median over its reached starts.
     fig, ax = plt.subplots(figsize=(5.5, 4))
     learn = {float(s): float(t) / 3600 for s, t in zip(learning["seed"], learning["learn_s"])}
@@ -91,6 +95,9 @@ def main(folder, world=""):
     ax.set_ylabel("path ratio (median of reached starts)")
     ax.set_title(f"path ratio against learning time ({model})")
     save(fig, folder / "path_ratio_learning.png")
+    drawn.append("path_ratio_learning.png")
+    print(f"drew {', '.join(drawn)} in {folder}")
+    return drawn
 
 
 if __name__ == "__main__":

@@ -521,6 +521,33 @@ def test_the_pages_agree_on_the_hospitals_floor():
     assert all(sizes.values()) and len({s for v in sizes.values() for s in v}) == 1, sizes
 
 
+def test_navigate_lists_the_files_it_writes(tmp_path):
+    """Finding 12: navigate's output, its --out help and docs/navigation.md each name every file the run wrote:
+    the trial file, the tables and the figures, no more and no fewer (compared with the folder itself)."""
+    out = tmp_path / "nav"
+    proc = run_cli("navigate", "--world", "cross", "--goals", "3.5,3.5", "--max-learn-hours", "0.05", "--starts", 1,
+                   "--out", out, check=True)
+    written = {p.name for p in out.rglob("*") if p.is_file()}
+    trial_files = {n for n in written if n.endswith(".h5")}
+    assert trial_files == {"cross_2d_seed0.h5"} and len(written - trial_files) == 9, written
+    # The output's lines: the tables from the trial files, then the figures.
+    listed = set()
+    for line in proc.stdout.splitlines():
+        tables = re.fullmatch(r"wrote (.*) in (.*) from its trial files \((.*)\)", line)
+        figures = re.fullmatch(r"drew (.*) in (.*)", line)
+        for m, groups in ((tables, (1, 3)), (figures, (1,))):
+            if m:
+                assert m.group(2) == str(out), line
+                listed |= {n for g in groups for n in m.group(g).split(", ")}
+    assert listed == written, proc.stdout
+    # The help of --out and the page: every table and figure by its name, the trial file by its pattern.
+    help_text = " ".join(run_cli("navigate", "--help", check=True).stdout.split())
+    page = (SOURCE_DIR / "docs" / "navigation.md").read_text()
+    for name in sorted(written - trial_files):
+        assert name in help_text, name
+        assert f"`{name}`" in page, name
+    assert "WORLD_MODEL_seedN.h5" in help_text and "`<world>_<model>_seed<N>.h5`" in page
+
 # ---- 13: the corpus's classes ----------------------------------------------------------------------
 
 def test_replayed_weights_of_an_old_trial_file_for_another_model_are_refused(exported, tmp_path):
