@@ -57,9 +57,11 @@ def test_files_without_a_recorded_model_are_checked_by_shape_only(trained, tmp_p
     out, track = trained
     old = tmp_path / "old.h5"
     old.write_bytes(out.read_bytes())
-    with h5py.File(old, "r+") as f:
+    with h5py.File(old, "r+") as f:  # no model recorded anywhere: not on /weights, not on the root (issue 43, 13)
         del f["weights"].attrs["model"]
         del f["weights"].attrs["model_config"]
+        del f.attrs["model"]
+        del f.attrs["config"]
     r = bvc3d.replay_simulated("cross", str(track), "spherical", model="3d-0.2", weights=str(old))
     assert r["rates"].shape[1] == 250
 
