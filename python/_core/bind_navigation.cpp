@@ -7,6 +7,7 @@
 #include "bvc3d/agent/body_collider.hpp"
 #include "bvc3d/agent/shortest_path.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/experiment/navigation.hpp"
 #include "bvc3d/navigation/replay.hpp"
 #include "bvc3d/navigation/rollouts.hpp"
@@ -36,15 +37,31 @@ RewardParams reward_of(const pyb::kwargs& kwargs) {
     return p;
 }
 
-// Keywords to whichever table names them: navigation, reward, adjacency.
+// A dict keyword (a YAML file's section: navigation=, adjacency=, reward=, flight=) as the keywords of its table.
+pyb::kwargs section_of(const std::string& key, const pyb::handle& v) {
+    if (!pyb::isinstance<pyb::dict>(v))
+        throw InputError(key + " must be a dict of the parameters of a navigation YAML's `" + key + ":` section");
+    return pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v));
+}
+
+// Keywords as a navigation YAML has them (docs/navigation.md#a-yaml-file): its sections as dicts (navigation=,
+// adjacency=, reward=, flight=), policy= and the policy's own section (e.g. authors=dict(...)); and, flat, the keys
+// of the navigation, reward and adjacency tables, each to whichever table names it.
 void apply_navigation(NavigationSpec& s, const pyb::kwargs& kwargs) {
     pyb::kwargs a, b, c;
+    std::string policy = default_policy_kind().name;
+    std::optional<std::pair<std::string, std::string>> policy_section;  // its key and the dict as JSON (YAML)
+    const auto sections = config::policy_yaml_keys();
     for (const auto& [k, v] : kwargs) {
         const std::string key = pyb::str(k);
-        if (key == "flight") {  // the flying agent's parameters, as a YAML file's `flight:` section
-            if (!pyb::isinstance<pyb::dict>(v))
-                throw InputError("flight must be a dict of the flying agent's parameters");
-            apply_kwargs(s.space.flight, FlightParams::table(), pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v)));
+        if (key == "flight") apply_kwargs(s.space.flight, FlightParams::table(), section_of(key, v));
+        else if (key == "navigation") apply_kwargs(s.space.nav, NavigationParams::table(), section_of(key, v));
+        else if (key == "adjacency") apply_kwargs(s.adjacency, AdjacencyParams::table(), section_of(key, v));
+        else if (key == "reward") apply_kwargs(s.reward, RewardParams::table(), section_of(key, v));
+        else if (key == "policy") policy = pyb::str(v);
+        else if (std::find(sections.begin(), sections.end(), key) != sections.end()) {
+            section_of(key, v);
+            policy_section = {key, pyb::str(pyb::module_::import("json").attr("dumps")(v))};
         } else if (RewardParams::table().find(key)) b[k] = v;
         else if (AdjacencyParams::table().find(key) && !NavigationParams::table().find(key)) c[k] = v;
         else a[k] = v;
@@ -53,6 +70,23 @@ void apply_navigation(NavigationSpec& s, const pyb::kwargs& kwargs) {
     apply_kwargs(s.reward, RewardParams::table(), b);
     apply_kwargs(s.adjacency, AdjacencyParams::table(), c);
     s.space.n_hd = s.adjacency.n_hd;
+    if (policy_section) {
+        const auto& [key, json] = *policy_section;
+        if (policy_kind(policy).section != key)
+            throw InputError(key + "= gives the parameters of another policy than policy='" + policy + "'");
+        const auto view = config::YamlView::load_string(json, key + "=");
+        s.policy = config::policy_named(policy, &view);
+    } else {
+        s.policy = config::policy_named(policy);
+    }
+}
+
+// A world given as a World, or as what navigate's --world takes: a preset name or a world file.
+World world_of(const pyb::handle& obj) {
+    if (pyb::isinstance<World>(obj)) return obj.cast<World>();
+    if (pyb::isinstance<pyb::str>(obj) || pyb::hasattr(obj, "__fspath__"))
+        return World(config::resolve_world(pyb::str(pyb::module_::import("os").attr("fspath")(obj))));
+    throw InputError("world must be a bvc3d.World, or a preset name or world file (a str or a path)");
 }
 
 }  // namespace
@@ -170,10 +204,11 @@ HdAdjacency(n_place, **params); params and their defaults:
         "(m), points (N, 2)");
     m.def(
         "navigate",
-        [](const World& w, const pyb::object& goals, const std::string& model, const pyb::object& seed,
+        [](const pyb::object& world, const pyb::object& goals, const std::string& model, const pyb::object& seed,
            const pyb::kwargs& kwargs) {
+            const World w = world_of(world);
             NavigationSpec s;
-            const ModelSpec m = config::resolve_model(model);
+            const ModelSpec base = config::resolve_model(model);
             const auto g = real_array(goals, "goals");
             if (g.ndim() != 2 || (g.shape(1) != 2 && g.shape(1) != 3))
                 throw InputError("goals must be an (N, 2) array of x, y (on the floor) or (N, 3) of x, y, z (flying)");
@@ -183,7 +218,7 @@ HdAdjacency(n_place, **params); params and their defaults:
             apply_navigation(s, kwargs);
             const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
             const NavigationRecord run =
-                interruptible([&](const std::atomic<bool>& stop) { return navigate(w, m, s, seed_value, &stop); });
+                interruptible([&](const std::atomic<bool>& stop) { return navigate(w, base, s, seed_value, &stop); });
             const int dims = run.dims;
             const auto n = pyb::ssize_t(run.n_starts());
             std::vector<double> gx, gy, gz, sx, sy, sz;
@@ -222,11 +257,15 @@ HdAdjacency(n_place, **params); params and their defaults:
             return d;
         },
         pyb::arg("world"), pyb::arg("goals"), pyb::arg("model") = "2d", pyb::arg("seed") = 0,
-        ("One navigation run (docs/navigation.md): learning, then starts per goal. goals: (N, 2) on the floor or "
-         "(N, 3) for the flying agent (docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per "
-         "start (goal, goal_x, goal_y, start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, "
-         "time_s, paths of (M, 2) or (M, 3)), and learn_s, coverage, visits, goal_cells. Keywords (navigation, reward "
-         "and adjacency parameters; flight=dict of the flying agent's, below them):\n" +
+        ("One navigation run (docs/navigation.md): learning, then starts per goal. world: a bvc3d.World, or a preset "
+         "name or world file as navigate's --world. goals: (N, 2) on the floor or (N, 3) for the flying agent "
+         "(docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per start (goal, goal_x, goal_y, "
+         "start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, time_s, paths of (M, 2) or "
+         "(M, 3)), and learn_s, coverage, visits, goal_cells. Keywords as a navigation YAML's keys: the sections "
+         "navigation=, adjacency=, reward=, flight= as dicts; policy= (" +
+         policy_names_text() +
+         ") and the policy's own section as a dict (e.g. authors=dict(...)); or flat, the navigation, reward and "
+         "adjacency parameters (below; flight's after them):\n" +
          describe(NavigationParams::table(), NavigationParams{}) + describe(RewardParams::table(), RewardParams{}) +
          "flight:\n" + describe(FlightParams::table(), FlightParams{}))
             .c_str());

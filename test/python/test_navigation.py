@@ -201,6 +201,16 @@ def test_navigate_refuses_bad_goals(tmp_path, goals, named):
     assert not (tmp_path / "out").exists()
 
 
+def test_navigate_refuses_an_unknown_policy_naming_the_list(tmp_path):
+    r = run("navigate", "--world", "cross", "--goals", "3,3", "--policy", "nonesuch", "--out", str(tmp_path / "out"))
+    assert r.returncode == 2 and "policy 'nonesuch' is not one of rollout8" in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+    config = tmp_path / "nav.yaml"
+    config.write_text("world: cross\ngoals: [[3, 3]]\npolicy: nonesuch\n")
+    r = run("navigate", "--config", str(config), "--out", str(tmp_path / "out"))
+    assert r.returncode == 2 and "nav.yaml" in r.stderr and "policy" in r.stderr, r.stderr
+
+
 def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path():
     world = bvc3d.World.cross()
     kw = dict(max_learn_hours=0.2, starts=2, min_start_distance=3.0, goal_visits=1, reward_map_cell=0)
@@ -217,6 +227,20 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
     with pytest.raises(ValueError, match="goal 1"):
         bvc3d.navigate(world, [[30.0, 0.0]])
+    # The world by name (as navigate's --world), the YAML's sections as dicts, the policy by name: the same run.
+    c = bvc3d.navigate("cross", [[3.5, 3.5]], seed=1, policy="rollout8", navigation=kw)
+    for key in ("start_x", "path_m", "time_s"):
+        np.testing.assert_array_equal(a[key], c[key])
+    pruned = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, adjacency=dict(prune=0.01), reward=dict(rollout_steps=3),
+                            **kw)
+    flat = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, prune=0.01, **kw)
+    np.testing.assert_array_equal(pruned["path_m"], flat["path_m"])
+    with pytest.raises(ValueError, match="policy 'nonesuch' is not one of rollout8"):
+        bvc3d.navigate(world, [[3.5, 3.5]], policy="nonesuch", **kw)
+    with pytest.raises(ValueError, match="adjacency must be a dict"):
+        bvc3d.navigate(world, [[3.5, 3.5]], adjacency=0.01, **kw)
+    with pytest.raises(ValueError, match="unknown argument 'prun'"):
+        bvc3d.navigate(world, [[3.5, 3.5]], adjacency=dict(prun=0.01), **kw)
 
 
 def six_digits(text):
