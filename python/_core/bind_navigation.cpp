@@ -81,6 +81,8 @@ void apply_navigation(NavigationSpec& s, const pyb::kwargs& kwargs) {
     }
 }
 
+}  // namespace
+
 // A world given as a World, or as what navigate's --world takes: a preset name or a world file.
 World world_of(const pyb::handle& obj) {
     if (pyb::isinstance<World>(obj)) return obj.cast<World>();
@@ -88,8 +90,6 @@ World world_of(const pyb::handle& obj) {
         return World(config::resolve_world(pyb::str(pyb::module_::import("os").attr("fspath")(obj))));
     throw InputError("world must be a bvc3d.World, or a preset name or world file (a str or a path)");
 }
-
-}  // namespace
 
 void bind_navigation(pyb::module_& m) {
     auto cls = pyb::class_<HdAdjacency>(m, "HdAdjacency",

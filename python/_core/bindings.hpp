@@ -159,6 +159,9 @@ void def_fields(C& cls) {
             f.key.c_str(), [get = f.get](const S& s) { return from_value(get(s)); }, f.doc.c_str());
 }
 
+// A world given as a World, or as what navigate's --world takes: a preset name or a world file (str or path).
+World world_of(const pyb::handle& obj);
+
 void bind_simulator(pyb::module_& m);
 void bind_model(pyb::module_& m);
 void bind_experiment(pyb::module_& m);
@@ -167,6 +170,7 @@ void bind_recording(pyb::module_& m);
 void bind_place_recognition(pyb::module_& m);
 void bind_buildings(pyb::module_& m);  // after bind_simulator: it adds to World
 void bind_navigation(pyb::module_& m);
+void bind_authors(pyb::module_& m);
 void bind_populations(pyb::module_& m);
 void bind_growing(pyb::module_& m);
 

@@ -18,6 +18,9 @@ void NavigationSpec::validate() const {
     space.check_goals_shape();
     policy->validate();
     policy->check_dims(space.dims());
+    if (space.nav.protocol == NavigationProtocol::authors && space.dims() != 2)
+        NavigationParams::table().fail("protocol", "authors poses and scores starts on the floor; goals of " +
+                                                       std::to_string(space.dims()) + " coordinates fly");
 }
 
 std::string NavigationSpec::adjacency_name(const ModelSpec& model, std::size_t scale) {

@@ -1,6 +1,7 @@
 #include "bvc3d/config/policy_kinds.hpp"
 
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/navigation/authors_policy.hpp"
 #include "bvc3d/navigation/rollout_policy.hpp"
 
 namespace bvc3d {
@@ -10,9 +11,17 @@ const std::vector<PolicyKind>& policy_kinds() {
         {RolloutPolicySpec::kind,
          "bvc3d's first controller: every 0.25 m one of the HD directions, drawn from one straight 3-step rollout per "
          "direction (docs/navigation.md#the-model)",
-         "",
-         [] { return std::make_shared<RolloutPolicySpec>(); },
-         nullptr},
+         "", [] { return std::make_shared<RolloutPolicySpec>(); }, nullptr},
+        {AuthorsPolicySpec::kind,
+         "the authors' controller (SPEC §17.2): 1.43 m blocks along a continuous heading from 10 turning rollouts per "
+         "direction, the scales mixed by entropy and reliability, LiDAR safety, exploration and loop recovery "
+         "(docs/navigation.md#the-authors-controller)",
+         "authors", [] { return std::make_shared<AuthorsPolicySpec>(); },
+         [](const config::YamlView& v) {
+             AuthorsParams p;
+             config::read_table(v, p, AuthorsParams::table());
+             return std::make_shared<AuthorsPolicySpec>(p);
+         }},
     };
     return kinds;
 }

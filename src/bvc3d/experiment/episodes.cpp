@@ -1,7 +1,9 @@
 #include "bvc3d/experiment/episodes.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bvc3d/agent/navigation_space.hpp"
@@ -81,6 +83,50 @@ private:
     std::vector<std::vector<StateArray>> learned_;
 };
 
+// FNV-1a of a text: a seed from a world's name.
+std::uint64_t text_seed(const std::string& text) {
+    std::uint64_t h = 14695981039346656037ULL;
+    for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+    return h;
+}
+
+std::uint64_t bits_of(double v) {
+    std::uint64_t b = 0;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+}
+
+// The streams of a goal's starts. bvc3d's protocol: one stream per learning run and goal draws the starts, their
+// poses and every choice of the starts in turn. The authors' (SPEC §17.3): the starts and their poses from a stream
+// of the world's name and the goal's coordinates alone (the same starts for every learning run), each start's
+// choices from a stream of the learning run's seed, the goal and the start.
+class StartStreams {
+public:
+    StartStreams(const NavigationParams& p, const std::string& world, std::uint64_t seed, std::size_t g,
+                 const NavigationGoal& goal)
+        : own_(p.protocol == NavigationProtocol::authors),
+          seed_(seed),
+          g_(g),
+          starts_(own_ ? hash_u64(text_seed(world), bits_of(goal.x()), bits_of(goal.y()) ^ bits_of(goal.z()))
+                       : hash_u64(seed, 0x6e617669676174ULL, g),
+                  Stream::walk) {}
+    Rng& starts() { return starts_; }
+    // The stream of start i's choices.
+    Rng& choices(int i) {
+        if (!own_) return starts_;
+        choices_.emplace(hash_u64(seed_, 0x63686f69636573ULL, (std::uint64_t(g_) << 32) | std::uint64_t(i)),
+                         Stream::walk);
+        return *choices_;
+    }
+
+private:
+    bool own_;
+    std::uint64_t seed_;
+    std::size_t g_;
+    Rng starts_;
+    std::optional<Rng> choices_;
+};
+
 const StateArray& array_named(const std::vector<StateArray>& arrays, const std::string& name) {
     for (const StateArray& a : arrays)
         if (a.name == name) return a;
@@ -155,19 +201,21 @@ EpisodeOutcome run_episodes(const World& world, const TrialConfig& trial, std::v
             rec.map_reward[g * points.size() + m] = reward_readout(memory.front().rewards[g], senses.rates().front());
     }
 
-    const auto controller = policy.make(PolicyContext{world, *space, nav.space, senses, memory, nav.reward});
+    const auto controller =
+        policy.make(PolicyContext{world, *space, nav.space, senses, memory, nav.reward, model.sensor});
     const std::size_t total = n_goals * std::size_t(p.starts);
     rec.path_start.push_back(0);
     for (std::size_t g = 0; g < n_goals; ++g) {
         const NavigationGoal& goal = nav.space.goals[g];
-        Rng rng(hash_u64(trial.seed, 0x6e617669676174ULL, g), Stream::walk);
+        StartStreams streams(p, world.name(), trial.seed, g, goal);
         for (int i = 0; i < p.starts; ++i) {
             if (control.stop && control.stop->load()) throw Interrupted();
-            const Vec3 start = space->draw_start(rng, g, goal, p.min_start_distance);
+            const Vec3 start = space->draw_start(streams.starts(), g, goal, p.min_start_distance);
             const double shortest = space->shortest(start, goal.p);
-            const Pose pose = space->start_pose(start, rng);
+            const Pose pose = space->start_pose(start, streams.starts());
             const StartRun run = controller->run(
-                pose, StartTask{g, goal.p, p.success_radius, p.max_path_ratio * shortest, p.max_hours * 3600}, rng);
+                pose, StartTask{g, goal.p, p.success_radius, p.max_path_ratio * shortest, p.max_hours * 3600},
+                streams.choices(i));
             for (const Vec3& at : run.path)
                 for (int d = 0; d < rec.dims; ++d) rec.path.push_back(at[d]);
             rec.start_goal.push_back(static_cast<int>(g));

@@ -17,6 +17,7 @@
 #include "bvc3d/agent/navigation_space.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/navigation/scale_memory.hpp"
+#include "bvc3d/sensor/lidar.hpp"
 #include "bvc3d/world/world.hpp"
 
 namespace bvc3d {
@@ -42,11 +43,11 @@ public:
 
 // One start's goal and limits.
 struct StartTask {
-    std::size_t goal = 0;           // its index among the goals (each scale's reward weights)
-    Vec3 at = Vec3::Zero();         // where it is
-    double success_radius = 1.0;    // m: reached within this (NavigationSpace::distance)
-    double max_path_m = 0.0;        // m: fails when the path reaches this
-    double max_s = 0.0;             // s of agent time: fails after this
+    std::size_t goal = 0;         // its index among the goals (each scale's reward weights)
+    Vec3 at = Vec3::Zero();       // where it is
+    double success_radius = 1.0;  // m: reached within this (NavigationSpace::distance)
+    double max_path_m = 0.0;      // m: fails when the path reaches this
+    double max_s = 0.0;           // s of agent time: fails after this
 };
 
 // Why a start ended.
@@ -55,8 +56,8 @@ enum class StartEnd { reached, path_cap, time_cap, wedged };
 struct StartRun {
     StartEnd end = StartEnd::time_cap;
     double path_m = 0.0, time_s = 0.0;
-    std::vector<Vec3> path;     // positions: the start, then one per move of the agent
-    std::vector<char> bumped;   // per position after the start: the move touched geometry
+    std::vector<Vec3> path;    // positions: the start, then one per move of the agent
+    std::vector<char> bumped;  // per position after the start: the move touched geometry
     bool success() const { return end == StartEnd::reached; }
 };
 
@@ -75,6 +76,7 @@ struct PolicyContext {
     NavigationSenses& senses;
     const std::vector<ScaleMemory>& memory;  // per scale
     const RewardParams& reward;              // navigation's reward: table (the first scale's)
+    const LidarSpec& sensor;                 // the model's sensor (its height and range: a policy's own scans)
 };
 
 class PolicySpec {

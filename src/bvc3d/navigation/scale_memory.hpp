@@ -15,11 +15,15 @@ namespace bvc3d {
 struct ScaleMemory {
     std::shared_ptr<const SparseAdjacency> sparse;
     std::shared_ptr<const AdjacencyProduct> rollouts;
+    std::vector<double> column_sums;  // the sparse copy's (SparseAdjacency::column_sums): a turning rollout's logits
+    AdjacencyParams adjacency;        // how the copies keep the adjacency (prune, rollout_weights)
     RewardParams reward;
     std::vector<std::vector<double>> rewards;  // per goal
 };
 
 // The scale's frozen copies of a learned adjacency under `params` (prune, rollout_weights).
 ScaleMemory scale_memory(const HdAdjacency& adj, const AdjacencyParams& params, const RewardParams& reward);
+// The copies made again from `adj` as it is now (a policy that learns while it exploits), the rest kept.
+void refresh_copies(ScaleMemory& memory, const HdAdjacency& adj);
 
 }  // namespace bvc3d
