@@ -9,6 +9,7 @@
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/experiment/navigation.hpp"
+#include "bvc3d/navigation/failure_class.hpp"
 #include "bvc3d/navigation/replay.hpp"
 #include "bvc3d/navigation/rollouts.hpp"
 #include "bvc3d/navigation/scale_mix.hpp"
@@ -248,6 +249,9 @@ HdAdjacency(n_place, **params); params and their defaults:
             d["path_m"] = to_numpy(run.path_m.data(), {n});
             d["shortest_m"] = to_numpy(run.shortest_m.data(), {n});
             d["time_s"] = to_numpy(run.time_s.data(), {n});
+            pyb::list failure;  // why each start failed: "" when it arrived (docs/navigation.md#why-a-start-fails)
+            for (const int c : run.failure) failure.append(to_string(FailureClass(c)));
+            d["failure"] = failure;
             d["paths"] = paths;
             d["learn_s"] = run.learn_s;
             d["coverage"] = run.coverage;
@@ -260,7 +264,8 @@ HdAdjacency(n_place, **params); params and their defaults:
         ("One navigation run (docs/navigation.md): learning, then starts per goal. world: a bvc3d.World, or a preset "
          "name or world file as navigate's --world. goals: (N, 2) on the floor or (N, 3) for the flying agent "
          "(docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per start (goal, goal_x, goal_y, "
-         "start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, time_s, paths of (M, 2) or "
+         "start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, time_s, failure (why it failed, "
+         "\"\" when it arrived), paths of (M, 2) or "
          "(M, 3)), and learn_s, coverage, visits, goal_cells. Keywords as a navigation YAML's keys: the sections "
          "navigation=, adjacency=, reward=, flight= as dicts; policy= (" +
          policy_names_text() +

@@ -7,6 +7,7 @@ import signal
 import subprocess
 import time
 
+import h5py
 import numpy as np
 import pytest
 
@@ -254,6 +255,19 @@ def six_digits(text):
     return "".join(",".join(field(f) for f in line.split(",")) + "\n" for line in text.splitlines())
 
 
+FAILURE_CLASSES = {"", "blocked", "closing-in", "plateau", "wrong-basin", "loop", "wander"}
+
+
+def without_failure_column(text):
+    """starts.csv without its last column, `failure`, and each row's failure class with the row (a dict)."""
+    lines = text.splitlines()
+    header = lines[0].split(",")
+    assert header[-1] == "failure", header
+    rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
+    assert {row["failure"] for row in rows} <= FAILURE_CLASSES, rows
+    return "".join(line.rsplit(",", 1)[0] + "\n" for line in lines), [(row["failure"], row) for row in rows]
+
+
 def test_navigate_on_the_floor_keeps_the_numbers_it_wrote_before(tmp_path):
     """A small run's starts.csv and paths.csv: the digests the code wrote before navigation became trials of the
     engine (issue 41; before that, the digests of the code before goals in 3-D, issue 30), from today's exact numbers
@@ -263,6 +277,17 @@ def test_navigate_on_the_floor_keeps_the_numbers_it_wrote_before(tmp_path):
             "0.2", "--starts", "3", "--seeds", "2", "--out", str(out), "--no-report")
     assert r.returncode == 0, r.stderr
     texts = {name: (out / name).read_text() for name in ("starts.csv", "paths.csv")}
+    # The failure class (issue 46) is a column after the ones pinned: the pinned bytes are those before it.
+    texts["starts.csv"], failures = without_failure_column(texts["starts.csv"])
+    assert all((f == "") == (row["success"] == "1") for f, row in failures), failures
+    # ... written from the trial files' /navigation/failure (0: reached, then the classes in the order above).
+    names = ["", "blocked", "closing-in", "plateau", "wrong-basin", "loop", "wander"]
+    written = []
+    for seed in (0, 1):
+        with h5py.File(next(out.glob(f"*seed{seed}.h5")), "r") as f:
+            written += [names[c] for c in f["navigation/failure"][()]]
+            assert f["navigation/walls"].shape[1] == 4 and len(f["navigation/walls"]) > 4  # the cross and the room
+    assert written == [f for f, _ in failures]
     digest = lambda text: hashlib.sha256(text.encode()).hexdigest()
     assert {name: digest(six_digits(t)) for name, t in texts.items()} == {
         "starts.csv": "e600565f279eff431d74855ac1dffb396389c3d8aeb0576f6799413a55a27b71",
@@ -317,7 +342,7 @@ def test_navigate_in_3d_writes_z_and_resumes_its_runs_to_the_same_bytes(tmp_path
     starts, paths = ((out / n).read_text() for n in ("starts.csv", "paths.csv"))
     header = starts.splitlines()[0].split(",")
     assert header == ("world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s,"
-                      "goal_z,start_z").split(",")
+                      "goal_z,start_z,failure").split(",")
     assert paths.splitlines()[0] == "model,seed,start,x,y,z"
     row = dict(zip(header, starts.splitlines()[1].split(",")))
     assert float(row["goal_z"]) == 0.8 and 0.4 < float(row["start_z"]) < 5.6

@@ -134,6 +134,9 @@ public:
             const auto path = authors_->shortest(xy(from), xy(to), s_.nav.success_radius);
             return path ? path->length : 0.0;
         }
+        return geodesic(from, to);
+    }
+    double geodesic(const Vec3& from, const Vec3& to) const override {
         return shortest_path(path_grid_, xy(from), xy(to), s_.nav.path_inflate).length;
     }
     std::vector<std::array<Vec2, 2>> walls() const override {
@@ -228,7 +231,8 @@ public:
     Pose start_pose(const Vec3& p, Rng& rng) const override {
         return Pose{p.x(), p.y(), p.z(), rng.uniform(-pi, pi), 0.0, 0.0};
     }
-    double shortest(const Vec3& from, const Vec3& to) const override {
+    double shortest(const Vec3& from, const Vec3& to) const override { return geodesic(from, to); }
+    double geodesic(const Vec3& from, const Vec3& to) const override {
         return voxel_path_between(occupancy_, from, to).value_or(0.0);
     }
     std::unique_ptr<GoalSeeker> seeker(DirectionPolicy& policy, const Pose& start) const override {

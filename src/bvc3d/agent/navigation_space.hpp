@@ -102,6 +102,9 @@ public:
     // The yardstick: the shortest path from `from` to the goal `to` (protocol authors: their optimal path to the
     // goal's disc of the success radius).
     virtual double shortest(const Vec3& from, const Vec3& to) const = 0;
+    // The distance to walk from `from` to `to` round the geometry (bvc3d's shortest path, whatever the protocol):
+    // how far a failed start still was from its goal.
+    virtual double geodesic(const Vec3& from, const Vec3& to) const = 0;
     // The geometry the agent meets, as segments of the floor plane (the walls a figure draws); none in flight.
     virtual std::vector<std::array<Vec2, 2>> walls() const = 0;
     virtual std::unique_ptr<GoalSeeker> seeker(DirectionPolicy& policy, const Pose& start) const = 0;

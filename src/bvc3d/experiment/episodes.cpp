@@ -12,6 +12,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/experiment/model_network.hpp"
+#include "bvc3d/navigation/failure_class.hpp"
 #include "bvc3d/navigation/policy.hpp"
 #include "bvc3d/navigation/replay.hpp"
 #include "bvc3d/population/reward_cells.hpp"
@@ -127,6 +128,25 @@ private:
     std::optional<Rng> choices_;
 };
 
+// Why a start failed (navigation/failure_class.hpp): its path and end, the yardstick's distances to the goal where
+// its last quarter began and at its end (bvc3d's shortest path, whatever the protocol), goal g's reward map.
+FailureClass failure_of(const StartRun& run, const NavigationSpace& space, const NavigationGoal& goal,
+                        const std::vector<Vec2>& points, const std::vector<double>& map_reward, std::size_t g,
+                        const NavigationParams& p) {
+    if (run.success()) return FailureClass::none;
+    FailedStart f;
+    f.end = run.end;
+    f.path = run.path;
+    f.bumped = run.bumped;
+    f.goal = goal.p.head<2>();
+    f.distance_at_last_quarter = space.geodesic(run.path[tail_start(run.path, 0.25)], goal.p);
+    f.distance_at_end = space.geodesic(run.path.back(), goal.p);
+    f.map_points = points;
+    f.map_values = std::span<const double>(map_reward).subspan(g * points.size(), points.size());
+    f.map_cell = p.reward_map_cell;
+    return classify_failure(f);
+}
+
 const StateArray& array_named(const std::vector<StateArray>& arrays, const std::string& name) {
     for (const StateArray& a : arrays)
         if (a.name == name) return a;
@@ -190,6 +210,9 @@ EpisodeOutcome run_episodes(const World& world, const TrialConfig& trial, std::v
     senses.restore(learned, policy.learns());
     if (policy.learns()) senses.keep(learned);
 
+    for (const auto& wall : space->walls())
+        for (const Vec2& end : wall) rec.walls.push_back(end.x()), rec.walls.push_back(end.y());
+
     // The first scale's reward map: the model settled at each point, read out for every goal.
     const auto points = space->map_points(p.reward_map_cell);
     rec.map_reward.assign(n_goals * points.size(), 0.0);
@@ -225,6 +248,7 @@ EpisodeOutcome run_episodes(const World& world, const TrialConfig& trial, std::v
             rec.shortest_m.push_back(shortest);
             rec.time_s.push_back(run.time_s);
             rec.path_start.push_back(rec.path_start.back() + run.path.size());
+            rec.failure.push_back(static_cast<int>(failure_of(run, *space, goal, points, rec.map_reward, g, p)));
             if (control.progress) control.progress(rec.n_starts(), total);
         }
     }

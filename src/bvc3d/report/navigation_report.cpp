@@ -7,6 +7,7 @@
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/navigation/failure_class.hpp"
 
 namespace bvc3d {
 
@@ -61,7 +62,7 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
     AtomicFile starts(folder / "starts.csv"), paths(folder / "paths.csv"), maps(folder / "reward_map.csv"),
         learning(folder / "learning.csv");
     starts.stream() << "world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s"
-                    << (flying ? ",goal_z,start_z\n" : "\n");
+                    << (flying ? ",goal_z,start_z" : "") << ",failure\n";
     paths.stream() << "model,seed,start,x,y" << (flying ? ",z\n" : "\n");
     maps.stream() << "model,seed,goal,x,y,reward\n";
     learning.stream() << "model,seed,learn_s,coverage,goal,visits,goal_cell\n";
@@ -103,7 +104,8 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
                             << ',' << r.success[i] << ',' << num(r.path_m[i]) << ',' << num(r.shortest_m[i]) << ','
                             << num(ratio) << ',' << num(r.time_s[i]);
             if (flying) starts.stream() << ',' << num(goal[2]) << ',' << num(r.start[i * 3 + 2]);
-            starts.stream() << '\n';
+            // Why it failed: empty when it arrived, and in files written before the classes existed.
+            starts.stream() << ',' << (i < r.failure.size() ? to_string(FailureClass(r.failure[i])) : "") << '\n';
             for (std::uint64_t k = r.path_start[i]; k < r.path_start[i + 1]; ++k)
                 paths.stream() << who << ',' << i << ',' << point(r.path, k, dims) << '\n';
             Cell& c = cell_of(t, g);
