@@ -2,8 +2,9 @@
 
 setuptools packages the pure-Python modules (python/bvc3d) and the launcher of the program
 (python/program, the module bvc3d.program). CMake builds the extension bvc3d._core and the `bvc3d`
-program, without tests, benchmarks or examples, in build-pip/ and installs both into the package
-(component python_package, python/CMakeLists.txt).
+program (only these two targets) in build-pip/ and installs both into the package (component
+python_package, python/CMakeLists.txt). The CMake build folder sits beside ./build, one level below the
+source tree: with ccache and CCACHE_BASEDIR set to the tree, its compiles are the same as ./build's.
 """
 import os
 import re
@@ -40,7 +41,7 @@ class BuildWithCMake(build_ext):
     def build_extension(self, ext):
         # The folder that holds the package folder bvc3d/ in the wheel being assembled.
         package_root = Path(self.get_ext_fullpath(ext.name)).resolve().parent.parent
-        build_dir = Path(self.build_temp).resolve() / "cmake"
+        build_dir = SOURCE_DIR / CMAKE_BUILD_DIR
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
         configure = [
             "cmake", "-S", str(SOURCE_DIR), "-B", str(build_dir), "-G", "Ninja",
@@ -50,15 +51,17 @@ class BuildWithCMake(build_ext):
             "-DBVC3D_BUILD_TESTS=OFF", "-DBVC3D_BUILD_BENCHMARKS=OFF", "-DBVC3D_BUILD_EXAMPLES=OFF",
         ]
         subprocess.run(configure, check=True)
-        subprocess.run(["cmake", "--build", str(build_dir), "-j", jobs], check=True)
+        subprocess.run(["cmake", "--build", str(build_dir), "-j", jobs, "--target", "_core", "bvc3d_cli"], check=True)
         subprocess.run(["cmake", "--install", str(build_dir), "--component", "python_package",
                         "--prefix", str(package_root)], check=True)
 
 
-# Everything the build writes goes to build-pip/ (ignored by git): not ./build, which is the CMake
-# build folder of README and scripts/build, and no bvc3d.egg-info beside the sources.
-BUILD_BASE = "build-pip"
-(SOURCE_DIR / BUILD_BASE).mkdir(exist_ok=True)
+# Everything the build writes goes to build-pip/ (ignored by git), setuptools' part to build-pip/setuptools:
+# not ./build, which is the CMake build folder of README and scripts/build, and no bvc3d.egg-info beside
+# the sources.
+CMAKE_BUILD_DIR = "build-pip"
+BUILD_BASE = CMAKE_BUILD_DIR + "/setuptools"
+(SOURCE_DIR / BUILD_BASE).mkdir(parents=True, exist_ok=True)
 setup(
     version=project_version(),
     # In setup.py rather than pyproject.toml, where Debian 12's setuptools calls [tool.setuptools] beta.

@@ -17,20 +17,23 @@
 #include "bvc3d/experiment/elevation_chooser.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 #include "recording_options.hpp"
-#include "run_options.hpp"
+#include "table_options.hpp"
 
 namespace bvc3d::cli {
 
 namespace {
 
 struct ChooseOptions {
-    std::string world, lean = "+x+y", sensor, agent, layers = "1-4", sets, out, scans, poses;
-    std::optional<double> tilt, elevation_min;
-    ChooserParams params;
+    WorldOptions world;
+    std::string sensor, agent, layers = "1-4", sets, out, scans, poses;
+    TableOptions<ChooserParams> chooser{ChooserParams::table()};
+    std::uint64_t seed = ChooserParams{}.seed;
+    int jobs = 0;
     RecordingOptions recording;
     PreprocessOptions preprocess;
-    RunOptions run;  // --jobs
+    Outputs outputs;
 };
 
 std::shared_ptr<const AgentSpec> named_agent(const std::string& name) {
@@ -85,13 +88,14 @@ struct Exploration {
 Exploration exploration_of(const ChooseOptions& o) {
     if (o.scans.empty() && o.poses.empty() && !o.recording.has_bag()) {
         const auto agent = named_agent(o.agent.empty() ? "ground" : o.agent);
-        const std::string world = o.world.empty() ? "cross" : o.world;
+        const WorldSpec world = o.world.spec();
         return {agent, std::nullopt,
-                "world " + world + (o.tilt ? " tilt " + format_number(*o.tilt) + " lean " + o.lean : "") + ", agent " +
-                    (o.agent.empty() ? "ground" : o.agent)};
+                "world " + world.source +
+                    (world.tilt_deg ? " tilt " + format_number(*world.tilt_deg) + " lean " + world.lean : "") +
+                    ", agent " + (o.agent.empty() ? "ground" : o.agent)};
     }
     if (o.scans.empty() && !o.recording.has_bag()) throw InputError("--poses needs --scans");
-    if (!o.world.empty() || o.tilt || !o.agent.empty())
+    if (o.world.given() || !o.agent.empty())
         throw InputError(
             "a recording is its own walk: give --scans and --poses (or --bag), or --world (and --agent), not both");
     const ReplaySource source = recorded_source(o.recording.open_any(o.scans, o.poses), o.preprocess.get());
@@ -104,16 +108,19 @@ void choose(const ChooseOptions& o) {
     const Exploration exploration = exploration_of(o);
     const auto& agent = exploration.agent;
     const ChooserDefaults defaults = chooser_defaults(*agent);
-    o.run.check();
-    ChooserParams p = o.params;
-    p.jobs = o.run.jobs;
+    check_jobs(o.jobs);
+    ChooserParams p;
+    o.chooser.apply(p);
+    p.seed = o.seed;
+    p.jobs = o.jobs;
     std::tie(p.min_layers, p.max_layers) = parse_layers(o.layers);
-    p.elevation_min = o.elevation_min.value_or(defaults.symmetric_range ? -p.elevation_max : p.elevation_min);
+    if (!o.chooser.given("elevation_min") && defaults.symmetric_range) p.elevation_min = -p.elevation_max;
     ModelSpec base = model_preset(defaults.model);
     const std::string sensor = o.sensor.empty() ? defaults.sensor : o.sensor;
     base.sensor = config::resolve_sensor(sensor);
     p.validate(base.bvc.n_dir);
     if (o.out.empty()) throw InputError("--out: give the model YAML file to write");
+    o.outputs.check();
     // Fail before minutes of work, not after.
     const auto folder = std::filesystem::path(o.out).parent_path();
     const EmptyFolderCleanup cleanup{folder, folder.empty() ? folder : ensure_writable_directory(folder)};
@@ -129,12 +136,11 @@ void choose(const ChooseOptions& o) {
                         elevations_text(p.candidate_elevations()).c_str());
             c = choose_elevations_on(*exploration.recorded, base, p, analysis, sets);
         } else {
-            const std::string name = o.world.empty() ? "cross" : o.world;
-            const World world(config::resolve_world(name, o.tilt, o.lean));
+            const World world(o.world.resolve());
             agent->check_world(world.description());
             std::printf("exploring %s for %s simulated minutes (seed %llu); candidate elevations %s rad\n",
-                        name.c_str(), format_number(p.explore_minutes).c_str(), static_cast<unsigned long long>(p.seed),
-                        elevations_text(p.candidate_elevations()).c_str());
+                        o.world.spec().source.c_str(), format_number(p.explore_minutes).c_str(),
+                        static_cast<unsigned long long>(p.seed), elevations_text(p.candidate_elevations()).c_str());
             c = sets.empty() ? choose_elevations(world, base, *agent, p, analysis)
                              : choose_from_sets(world, base, *agent, sets, p, analysis);
         }
@@ -167,11 +173,9 @@ void add_adaptive_command(CLI::App& app) {
     auto o = std::make_shared<ChooseOptions>();
     auto* cmd = app.add_subcommand(
         "choose-elevations", "Choose the BVC layers' elevations from a short exploratory walk; write the model YAML");
-    cmd->add_option("--world", o->world, "World preset or YAML file (default: cross)");
-    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
-    cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
-    cmd->add_option("--sensor", o->sensor,
-                    "Sensor preset or YAML file (default: spherical on the ground, spherical-full when flying)");
+    o->world.add_to(*cmd);
+    auto* sensor = add_sensor_option(*cmd, o->sensor);
+    sensor->description(sensor->get_description() + " [spherical on the ground, spherical-full when flying]");
     const std::string who = "; default ground (a flying agent's world needs a flight volume)";
     cmd->add_option("--agent", o->agent, "Who explores: " + agent_names_text() + who);
     cmd->add_option("--scans", o->scans,
@@ -180,20 +184,17 @@ void add_adaptive_command(CLI::App& app) {
     cmd->add_option("--poses", o->poses, "With --scans: the recording's pose file (KITTI, TUM or 4x4 rows)");
     o->recording.add_to(*cmd);
     o->preprocess.add_to(*cmd);
-    cmd->add_option("--budget", o->params.budget, "BVCs shared by the layers")->capture_default_str();
+    static const ChooserParams defaults;
+    o->chooser.add_to(*cmd, {"budget"}, &defaults);
     cmd->add_option("--layers", o->layers, "Number of layers: N or MIN-MAX")->capture_default_str();
-    cmd->add_option("--min-elevation", o->elevation_min,
-                    "Lowest candidate elevation, rad (default: 0 on the ground, -(max elevation) when flying)");
-    cmd->add_option("--max-elevation", o->params.elevation_max, "Highest candidate elevation, rad")
-        ->capture_default_str();
-    cmd->add_option("--elevation-step", o->params.elevation_step, "Spacing of the candidate elevations, rad")
-        ->capture_default_str();
-    cmd->add_option("--explore-minutes", o->params.explore_minutes, "Simulated minutes of the exploratory walk")
-        ->capture_default_str();
-    cmd->add_option("--seed", o->params.seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
+    auto* lowest = o->chooser.add_to(*cmd, {"elevation_min"}, nullptr, {{"elevation_min", "--min-elevation"}}).front();
+    lowest->description(lowest->get_description() + " [0 on the ground, -(--max-elevation) when flying]");
+    o->chooser.add_to(*cmd, {"elevation_max", "elevation_step", "explore_minutes"}, &defaults,
+                      {{"elevation_max", "--max-elevation"}});
+    cmd->add_option("--seed", o->seed, "Seed of the exploratory walk")->check(seed_check)->capture_default_str();
     cmd->add_option("--sets", o->sets, "Score these elevation sets instead of searching, e.g. '0,0.2;0,0.1,0.2' (rad)");
-    o->run.add_jobs(*cmd, "Threads sharing the candidates; 0 (the default): one per core");
-    cmd->add_option("--out", o->out, "Model YAML file to write")->required()->transform(output_path);
+    add_jobs_option(*cmd, o->jobs, "Candidates");
+    o->outputs.add(*cmd, "--out", o->out, OutputKind::file, "Model YAML file to write")->required();
     cmd->callback([o] { choose(*o); });
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/agent/trajectory.hpp"
@@ -17,6 +18,7 @@
 #include "bvc3d/config/sweep_yaml.hpp"
 #include "bvc3d/config/trial_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/output_lock.hpp"
@@ -25,16 +27,19 @@
 #include "bvc3d/report/summary.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 #include "run_options.hpp"
 #include "summary_report.hpp"
+#include "table_options.hpp"
 
 namespace bvc3d::cli {
 
 namespace {
 
 struct TrialOptions {
-    std::string config, world, lean, model, protocol, extent, trajectory, agent;
-    std::optional<double> tilt, explore_hours, sample_hours, hours;
+    std::string config, model, protocol, extent, trajectory, agent;
+    WorldOptions world;
+    std::optional<double> explore_hours, sample_hours, hours;
     std::optional<std::uint64_t> seed;
     bool record_bvc = false, step_per_row = false;
     RunOptions run;  // --out: the trial file; --checkpoint-minutes; --no-memory-check
@@ -43,9 +48,7 @@ struct TrialOptions {
 // The trial `bvc3d run` runs: the YAML file's, with the flags on top.
 TrialConfig run_config(const TrialOptions& o) {
     TrialConfig t = o.config.empty() ? TrialConfig{} : config::load_trial_file(o.config);
-    if (!o.world.empty()) t.world = WorldSpec{o.world, std::nullopt, "+x+y"};
-    if (o.tilt) t.world.tilt_deg = o.tilt;
-    if (!o.lean.empty()) t.world.lean = o.lean;
+    t.world = o.world.over(t.world);
     if (!o.model.empty()) t.model = config::resolve_model(o.model);
     if (!o.agent.empty()) {
         t.set_agent(agent_by_name(o.agent));
@@ -125,10 +128,10 @@ void add_run(CLI::App& app) {
     auto o = std::make_shared<TrialOptions>();
     o->run.checkpoint_minutes = 10;
     cmd->add_option("--config", o->config, "Trial YAML file (docs/experiments.md); flags below override it");
-    cmd->add_option("--world", o->world, "World preset or YAML file (default cross)");
-    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
-    cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward (default +x+y)");
-    cmd->add_option("--model", o->model, "Model preset or model YAML (default 3d-0.2)");
+    auto* world = o->world.add_to(*cmd, "", "").front();
+    world->description(world->get_description() + " [cross, or the --config file's]");
+    auto* model = add_model_option(*cmd, o->model, ModelCount::one);
+    model->description(model->get_description() + " [3d-0.2, or the --config file's]");
     cmd->add_option("--trajectory", o->trajectory,
                     "Follow this path instead of the random walk: a text file of t, x, y, [z], heading rows, "
                     "resampled to the model step (" +
@@ -144,7 +147,7 @@ void add_run(CLI::App& app) {
     cmd->add_option("--hours", o->hours, "Shorten both phases to this many simulated hours");
     cmd->add_flag("--record-bvc", o->record_bvc, "Also record the BVC rates");
     cmd->add_option("--extent", o->extent, extent_help);
-    o->run.add_out(*cmd, "Trial file to write (default results/<trial name>.h5)");
+    o->run.add_out(*cmd, "Trial file to write (default results/<trial name>.h5)", OutputKind::trial_file);
     o->run.add_checkpoint_minutes(*cmd);
     o->run.add_no_memory_check(*cmd);
     cmd->footer("Ctrl-C checkpoints and stops; running the same command again resumes and gives the same file.");
@@ -152,6 +155,7 @@ void add_run(CLI::App& app) {
         const TrialConfig t = run_config(*o);
         const std::filesystem::path out = o->run.out.empty() ? std::filesystem::path("results") / (t.name() + ".h5")
                                                              : std::filesystem::path(o->run.out);
+        check_output("--out", out, OutputKind::trial_file, o->run.outputs.force);  // the default's too
         const OutputLock lock = lock_output_file(out);
         if (trial_file_complete(out, t)) {
             std::cerr << "bvc3d: " << out.string() << " is complete with this configuration; nothing to do\n";
@@ -173,8 +177,7 @@ struct PaperOptions {
 // Models × tilts × seeds, seeds slowest.
 std::vector<TrialConfig> paper_trials(const PaperOptions& o) {
     std::vector<ModelSpec> models;
-    for (const auto& m : split_commas(o.models)) models.push_back(config::resolve_model(m));
-    if (models.empty()) throw InputError("--models lists no model");
+    for (const auto& m : model_list(o.models, "--models")) models.push_back(config::resolve_model(m));
     std::vector<double> tilts;
     for (const auto& t : split_commas(o.tilts)) tilts.push_back(parse_number(t, "--tilts: a tilt"));
     if (tilts.empty()) throw InputError("--tilts lists no tilt");
@@ -211,8 +214,10 @@ void add_paper(CLI::App& app) {
     cmd->add_option("--hours", o->hours,
                     "Shorten both phases to H simulated hours (default: the paper's " +
                         protocol_hours_text(protocol_preset("paper")) + ")");
-    cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
-    cmd->add_option("--tilts", o->tilts, "Comma-separated tilts of the cross arena, degrees")->capture_default_str();
+    add_model_option(*cmd, o->models, ModelCount::list, "--models");
+    cmd->add_option("--tilts", o->tilts,
+                    "Comma-separated tilts of the cross arena, degrees (its world is the paper's: the cross arena)")
+        ->capture_default_str();
     cmd->add_option("--protocol", o->protocol, "explore_then_sample (default) or online");
     std::string presets, choice_names;
     for (const auto& p : paper_presets()) presets += "\n  " + p.name + ": " + p.description;
@@ -231,80 +236,53 @@ void add_paper(CLI::App& app) {
         o->run.check();
         run_experiment_in_folder(paper_trials(*o), o->run);
         std::printf("summary: %s/summary.md%s\n", o->run.out.c_str(),
-                    o->run.no_report ? "" : (", report: " + o->run.out + "/report.md").c_str());
+                    o->run.no_figures ? "" : (", report: " + o->run.out + "/report.md").c_str());
     });
-}
-
-// A CSV field: quoted when it holds a comma, a quote or a line break.
-std::string csv_field(const std::string& text) {
-    if (text.find_first_of(",\"\n") == std::string::npos) return text;
-    std::string out = "\"";
-    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return out + "\"";
 }
 
 void add_analyze(CLI::App& app) {
     auto* cmd = app.add_subcommand("analyze", "Recompute the metrics of trial files, optionally with other parameters");
     struct Options {
         std::vector<std::string> files;
-        std::optional<int> gridsize, min_samples, skip_samples, msai_bins;
-        std::optional<double> quantile, eps, d_th, mi_quantile;
-        std::string extent, cells, templates, out;
+        TableOptions<analysis::AnalysisParams> analysis{analysis::AnalysisParams::table()};
+        std::string extent, cells, out;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("files", o->files, "Trial files (.h5)")->required();
-    cmd->add_option("--out", o->out,
-                    "Write the recomputed metrics to this CSV: one row per file (file, trial, every metric, the "
-                    "analysis parameters used)")
-        ->transform(output_path);
-    cmd->add_option("--gridsize", o->gridsize, "Hexagons across x");
-    cmd->add_option("--quantile", o->quantile, "Rate-map threshold quantile");
-    cmd->add_option("--eps", o->eps, "DBSCAN radius, m");
-    cmd->add_option("--min-samples", o->min_samples, "DBSCAN min_samples");
-    cmd->add_option("--d-th", o->d_th, "SAI exclusion distance, m");
-    cmd->add_option("--mi-quantile", o->mi_quantile,
-                    "Rate-map threshold quantile of the modality index (-1: --quantile's)");
-    cmd->add_option("--skip-samples", o->skip_samples, "Recorded samples to leave out at the start");
-    cmd->add_option("--msai-bins", o->msai_bins,
-                    "Divide SAI and MSAI by this fixed number of bins (0: each trial's own)");
+    o->outputs.add(*cmd, "--out", o->out, OutputKind::file,
+                   "Write the recomputed metrics to this CSV: one row per file (file, trial, every metric, the "
+                   "analysis parameters used)");
+    o->analysis.add_to(*cmd);  // every key of the analysis table
     cmd->add_option("--extent", o->extent, extent_help);
-    cmd->add_option(
-        "--decoding-templates", o->templates,
-        "Decoder templates: rate_maps (thresholded, normalized maps; the default) or means (raw mean rates)");
-    cmd->add_option("--cells", o->cells, "Write per-cell metrics of the first file to this CSV")
-        ->transform(output_path);
-    cmd->footer(
+    o->outputs.add(*cmd, "--cells", o->cells, OutputKind::file, "Write per-cell metrics of the first file to this CSV");
+    const analysis::AnalysisParams flat = analysis::AnalysisParams::defaults(2),
+                                   flying = analysis::AnalysisParams::defaults(3);
+    std::string footer =
         "Each file is analyzed with the parameters its metrics were computed with; the options change only\n"
-        "what they name (defaults: gridsize 50, quantile 0.1, eps 1, min-samples 20 (10 for flying agents'\n"
-        "3-D files), d-th 2, decoding templates rate_maps, mi-quantile -1, skip-samples 0, msai-bins 0;\n"
-        "docs/analysis.md, docs/flying.md).");
+        "what they name (defaults:";
+    std::size_t line = footer.size() - footer.rfind('\n');
+    const auto& fields = analysis::AnalysisParams::table().fields();
+    for (std::size_t i = 0; i < fields.size(); ++i) {  // the table's defaults, wrapped at 100 columns
+        const auto& f = fields[i];
+        std::string item = " " + option_name(f.key).substr(2) + " " + params::to_text(f.get(flat));
+        if (f.get(flying) != f.get(flat))
+            item += " (" + params::to_text(f.get(flying)) + " for flying agents' 3-D files)";
+        item += i + 1 < fields.size() ? "," : ";";
+        if (line + item.size() > 100) footer += "\n", item.erase(0, 1), line = 0;
+        footer += item, line += item.size();
+    }
+    cmd->footer(footer + " docs/analysis.md, docs/flying.md).");
     cmd->callback([o] {
         const bool new_extent = !o->extent.empty();
         const ExtentOption extent = parse_extent(new_extent ? o->extent : "data");
-        if (!o->cells.empty()) require_not_directory(o->cells, "--cells");
-        if (!o->out.empty()) require_not_directory(o->out, "--out");
+        o->outputs.check();
         std::vector<TrialFileData> trials;
         std::vector<analysis::AnalysisParams> params;
         for (const auto& f : o->files) {  // all readable and their parameters valid before any output
             trials.push_back(read_trial_samples(f));
             analysis::AnalysisParams p = stored_analysis_params(trials.back(), f);
-            const auto& table = analysis::AnalysisParams::table();
-            const auto set = [&](const char* key, const params::Value& v) {
-                try {
-                    table.set(p, *table.find(key), v);
-                } catch (const params::ParamError& e) {
-                    throw InputError("--" + std::string(key) + ": " + e.reason());
-                }
-            };
-            if (o->gridsize) set("gridsize", static_cast<long long>(*o->gridsize));
-            if (o->quantile) set("quantile", *o->quantile);
-            if (o->eps) set("eps", *o->eps);
-            if (o->min_samples) set("min_samples", static_cast<long long>(*o->min_samples));
-            if (o->d_th) set("d_th", *o->d_th);
-            if (o->mi_quantile) set("mi_quantile", *o->mi_quantile);
-            if (o->skip_samples) set("skip_samples", static_cast<long long>(*o->skip_samples));
-            if (o->msai_bins) set("msai_bins", static_cast<long long>(*o->msai_bins));
-            if (!o->templates.empty()) p.decoding_templates = analysis::parse_decoding_templates(o->templates);
+            o->analysis.apply(p);
             if (new_extent) {
                 p.extent.reset();
                 if (extent.kind == ExtentOption::Kind::bounds) p.extent = extent.bounds;
@@ -317,16 +295,12 @@ void add_analyze(CLI::App& app) {
         for (const auto& d : trials) dims = std::max(dims, d.dims);
         const auto columns = analysis::metric_names(dims);
         const auto& table = analysis::AnalysisParams::table();
-        std::string csv = "file,trial";
-        for (const auto& c : columns) {
-            csv += ',';
-            csv += c;
-        }
-        for (const auto& f : table.fields()) {
-            csv += ',';
-            csv += f.key;
-        }
-        csv += "\n";
+        std::ostringstream text;
+        CsvWriter csv(text);
+        csv.field("file").field("trial");
+        for (const auto& c : columns) csv.field(c);
+        for (const auto& f : table.fields()) csv.field(f.key);
+        csv.end_row();
         for (std::size_t i = 0; i < trials.size(); ++i) {
             const auto& d = trials[i];
             const Eigen::Map<const analysis::RowMatrixXf> rates(d.rates.data(), static_cast<Eigen::Index>(d.x.size()),
@@ -345,9 +319,7 @@ void add_analyze(CLI::App& app) {
                 std::printf("  no place-cell metrics: its place cells never learned (place_weights untrained)\n");
             const auto m = analysis::analyze_trial<float>(positions, rates, params[i]);
             const auto values = untrained ? std::vector<std::pair<std::string, double>>{} : analysis::scalar_metrics(m);
-            csv += csv_field(o->files[i]);
-            csv += ',';
-            csv += csv_field(d.name);
+            csv.field(o->files[i]).field(d.name);
             for (std::size_t c = 0; c < columns.size(); ++c) {
                 const auto it =
                     std::find_if(values.begin(), values.end(), [&](const auto& v) { return v.first == columns[c]; });
@@ -357,32 +329,30 @@ void add_analyze(CLI::App& app) {
                     else std::printf("  %-22s %12s", columns[c].c_str(), "-");
                     std::printf("%s", c % 2 == 1 || c + 1 == columns.size() ? "\n" : "  ");
                 }
-                csv += ',';
-                if (has) csv += num(it->second);
+                csv.field(has ? std::optional<double>(it->second) : std::nullopt);
             }
-            for (const auto& f : table.fields()) {
-                csv += ',';
-                csv += csv_field(params::to_text(f.get(params[i])));
-            }
-            csv += "\n";
+            for (const auto& f : table.fields()) csv.field(params::to_text(f.get(params[i])));
+            csv.end_row();
             if (i == 0 && !o->cells.empty()) {
                 AtomicFile f(o->cells);
+                CsvWriter cells(f.stream());
                 // field_area is m² of hexagons in 2-D, m³ of voxels in 3-D; isotropy only for 3-D files.
                 const bool three = m.dims == 3;
-                f.stream() << "cell,modality,peak_rate,mean_rate,field_area,spatial_info"
-                           << (three ? ",isotropy\n" : "\n");
+                for (const char* name : {"cell", "modality", "peak_rate", "mean_rate", "field_area", "spatial_info"})
+                    cells.field(name);
+                if (three) cells.field("isotropy");
+                cells.end_row();
                 for (std::size_t c = 0; c < m.modality.size(); ++c) {
-                    f.stream() << c << ',' << m.modality[c] << ',' << num(m.cells.peak_rate[c]) << ','
-                               << num(m.cells.mean_rate[c]) << ',' << num(m.cells.field_area[c]) << ','
-                               << num(m.cells.spatial_info[c]);
-                    if (three) f.stream() << ',' << num(m.isotropy[c]);
-                    f.stream() << '\n';
+                    cells.field(c).field(m.modality[c]).field(m.cells.peak_rate[c]).field(m.cells.mean_rate[c]);
+                    cells.field(m.cells.field_area[c]).field(m.cells.spatial_info[c]);
+                    if (three) cells.field(m.isotropy[c]);
+                    cells.end_row();
                 }
                 f.commit();
             }
         }
         if (!o->out.empty()) {
-            write_file_atomically(o->out, csv);
+            write_file_atomically(o->out, text.str());
             std::printf("wrote %s\n", o->out.c_str());
         }
     });
@@ -393,11 +363,11 @@ void add_summarize(CLI::App& app) {
                                    "Write trials.csv, summary.csv/.md and the figures for a folder of trial files");
     struct Options {
         std::string dir;
-        bool no_report = false, skip_unreadable = false, allow_mixed = false;
+        bool no_figures = false, skip_unreadable = false, allow_mixed = false;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("folder", o->dir, "Folder of trial files")->required();
-    cmd->add_flag("--no-report", o->no_report, "Skip the figures");
+    add_no_figures_option(*cmd, o->no_figures, "the figures and report.md");
     cmd->add_flag(
         "--skip-unreadable", o->skip_unreadable,
         "Leave out .h5 files that are not readable trial files (each named on standard error) instead of stopping");
@@ -424,7 +394,7 @@ void add_summarize(CLI::App& app) {
             }
         }
         if (files.empty()) throw InputError("'" + o->dir + "' holds no readable trial files (*.h5)");
-        summarize(o->dir, files, !o->no_report, o->allow_mixed);
+        summarize(o->dir, files, !o->no_figures, o->allow_mixed);
         std::printf("%zu trials summarized in %s/summary.md\n", files.size(), o->dir.c_str());
     });
 }

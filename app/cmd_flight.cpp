@@ -34,8 +34,7 @@ std::vector<TrialConfig> flight_trials(const FlightOptions& o) {
         if (h && !(*h > 0 || (*h == 0 && std::string(name) == "--explore-hours")))
             throw InputError(std::string(name) + " must be a positive number of hours");
     std::vector<ModelSpec> models;
-    for (const auto& m : split_commas(o.models)) models.push_back(config::resolve_model(m));
-    if (models.empty()) throw InputError("--models lists no model");
+    for (const auto& m : model_list(o.models, "--models")) models.push_back(config::resolve_model(m));
     const auto worlds = split_commas(o.worlds);
     if (worlds.empty()) throw InputError("--worlds lists no world");
     check_seed_count(o.seeds, {{models.size(), "models"}, {worlds.size(), "worlds"}});
@@ -67,7 +66,7 @@ void add_flight_command(CLI::App& app) {
         "flight", "Run the flying agents' experiment: models x worlds x seeds, 3-D place fields, summary, figures");
     auto o = std::make_shared<FlightOptions>();
     o->run.add_experiment_options(*cmd);
-    cmd->add_option("--models", o->models, "Comma-separated model presets or model YAML files")->capture_default_str();
+    add_model_option(*cmd, o->models, ModelCount::list, "--models");
     cmd->add_option("--worlds", o->worlds, "Comma-separated worlds with a flight volume (presets or YAML files)")
         ->capture_default_str();
     cmd->add_option("--seeds", o->seeds, "Seeds per condition (0 .. N-1)")->capture_default_str();
@@ -86,7 +85,7 @@ void add_flight_command(CLI::App& app) {
         o->run.check();
         run_experiment_in_folder(flight_trials(*o), o->run);
         std::printf("summary: %s/summary.md%s\n", o->run.out.c_str(),
-                    o->run.no_report ? "" : (", report: " + o->run.out + "/report.md").c_str());
+                    o->run.no_figures ? "" : (", report: " + o->run.out + "/report.md").c_str());
     });
 }
 

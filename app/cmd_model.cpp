@@ -9,8 +9,10 @@
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 
 namespace bvc3d::cli {
 
@@ -28,33 +30,26 @@ std::string sparkline(const double* v, int n, int width) {
     return s;
 }
 
-std::string preset_list() {
-    std::string s;
-    for (const auto& n : model_preset_names()) s += (s.empty() ? "" : ", ") + n;
-    return s;
-}
-
 void add_bvc(CLI::App& app) {
     auto* cmd = app.add_subcommand("bvc", "Show the boundary vector cell rates of a model at one pose");
     struct Options {
-        std::string model = "3d-0.2", world = "cross", lean = "+x+y", pose, csv;
-        std::optional<double> tilt;
+        std::string model = "3d-0.2", pose, csv;
+        WorldOptions world;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--model", o->model, "Model preset (" + preset_list() + ") or model YAML")->capture_default_str();
-    cmd->add_option("--world", o->world, "World preset or YAML file")->capture_default_str();
-    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's central walls in degrees");
-    cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str();
+    add_model_option(*cmd, o->model, ModelCount::one);
+    o->world.add_to(*cmd);
     cmd->add_option("--pose", o->pose, "Robot pose X,Y,HEADING (m, m, rad; or e.g. 90deg)")->required();
-    cmd->add_option("--csv", o->csv, "Also write every cell: index, elevation, azimuth, distance, rate")
-        ->transform(output_path);
+    o->outputs.add(*cmd, "--csv", o->csv, OutputKind::file,
+                   "Also write every cell to this CSV file: index, elevation, azimuth, distance, rate");
     cmd->footer(
         "One line per (layer, direction): the largest rate, the preferred distance where it peaks, and the\n"
         "rates over preferred distance 0..max_dist as a bar (a full block is the step's maximum, 0.5).");
     cmd->callback([o] {
-        if (!o->csv.empty()) require_not_directory(o->csv, "--csv");
+        o->outputs.check();
         const ModelSpec model = config::resolve_model(o->model);
-        const World world(config::resolve_world(o->world, o->tilt, o->lean));
+        const World world(o->world.resolve());
         const Pose pose = parse_pose(o->pose);
         warn_if_blocked(world, pose);
         const Scan scan = Lidar(model.sensor).scan(world, pose);
@@ -78,12 +73,13 @@ void add_bvc(CLI::App& app) {
             }
         if (!o->csv.empty()) {
             AtomicFile f(o->csv);
-            f.stream() << "index,elevation,azimuth,distance,rate\n";
+            CsvWriter csv(f.stream());
+            csv.row("index", "elevation", "azimuth", "distance", "rate");
             for (std::size_t i = 0; i < rates.size(); ++i) {
                 const int m = static_cast<int>(i % p.n_per_axis), k = static_cast<int>(i / p.n_per_axis % p.n_dir);
                 const int l = static_cast<int>(i / (p.n_per_axis * p.n_dir));
-                f.stream() << i << ',' << num(p.elevations.empty() ? 0.0 : p.elevations[l]) << ','
-                           << num(k * two_pi / p.n_dir) << ',' << num(m * p.spacing()) << ',' << num(rates[i]) << '\n';
+                csv.row(i, p.elevations.empty() ? 0.0 : p.elevations[l], k * two_pi / p.n_dir, m * p.spacing(),
+                        rates[i]);
             }
             f.commit();
         }
@@ -99,8 +95,8 @@ void add_config(CLI::App& app) {
     auto o = std::make_shared<Options>();
     auto* trial =
         cmd->add_option("--trial", o->trial, "A trial YAML file, every key filled in (default: the default trial)");
-    auto* model = cmd->add_option("--model", o->model, "A model preset (" + preset_list() + ") or model YAML file");
-    auto* sensor = cmd->add_option("--sensor", o->sensor, "A sensor: horizontal, spherical or a sensor YAML file");
+    auto* model = add_model_option(*cmd, o->model, ModelCount::one);
+    auto* sensor = add_sensor_option(*cmd, o->sensor);
     trial->excludes(model)->excludes(sensor);
     model->excludes(sensor);
     cmd->footer(

@@ -21,27 +21,30 @@
 #include "bvc3d/experiment/navigation.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 #include "python_module.hpp"
 #include "run_options.hpp"
+#include "table_options.hpp"
 
 namespace bvc3d::cli {
 
 namespace {
 
 struct NavigateOptions {
-    std::string config, world, lean = "+x+y", goals, model = "2d", policy = default_policy_kind().name;
-    std::optional<double> tilt;
+    std::string config, goals, model = "2d", policy = default_policy_kind().name;
+    WorldOptions world;
     int seeds = 1;
     std::uint64_t first_seed = 0;
-    NavigationParams nav;
+    TableOptions<NavigationParams> nav{NavigationParams::table()};
     bool dry_run = false;
-    RunOptions run;  // --out, --jobs, --no-report
+    RunOptions run;  // --out (with --force), --jobs, --checkpoint-minutes, --no-memory-check, --no-figures
 };
 
 // What one command runs: models × seeds in a world with its goals, and every parameter.
 struct NavigatePlan {
     std::string world, lean = "+x+y";
     std::optional<double> tilt;
+    config::MissingModels missing_models = config::MissingModels::error;
     std::vector<NavigationGoal> goals;
     std::vector<std::string> models;  // as given: a preset name or a model file
     int seeds = 1;
@@ -79,33 +82,41 @@ std::vector<NavigationGoal> parse_goals(const std::string& text) {
 }
 
 NavigatePlan plan_of_options(const NavigateOptions& o) {
-    if (o.world.empty()) throw InputError("navigate: give --world and --goals, or --config");
+    if (o.world.world.empty()) throw InputError("navigate: give --world and --goals, or --config");
     if (o.seeds < 1) throw InputError("--seeds: must be at least 1");
     NavigatePlan p;
-    p.world = o.world, p.tilt = o.tilt, p.lean = o.lean;
+    const WorldSpec world = o.world.spec();
+    p.world = world.source, p.tilt = world.tilt_deg, p.lean = world.lean, p.missing_models = world.missing_models;
     p.goals = parse_goals(o.goals);
-    p.models = {o.model};
+    p.models = model_list(o.model);
     p.seeds = o.seeds, p.first_seed = o.first_seed;
-    p.nav = o.nav;
+    o.nav.apply(p.nav);
     p.nav.validate();
     p.policy = config::policy_named(o.policy);
     return p;
 }
 
 // The sweep-friendly YAML (docs/navigation.md#a-yaml-file): world (a preset or a file, relative to the YAML's
-// folder), tilt, lean, goals ([[x, y], ...]), models (a name or a list), seeds, first_seed, and the parameter
-// tables navigation:, adjacency:, reward:, and policy: with its parameters' section (config/policy_kinds.hpp). Any
-// other key: InputError naming it.
+// folder), tilt, lean, missing_models, goals ([[x, y], ...]), models (a name or a list), seeds, first_seed, the
+// parameter tables navigation:, adjacency:, reward:, flight:, and policy: with its parameters' section
+// (config/policy_kinds.hpp). Any other key: InputError naming it.
 NavigatePlan plan_of_yaml(const std::string& file) {
     const auto v = config::YamlView::load_file(file);
-    std::vector<std::string> keys{"world",      "tilt",       "lean",      "goals",  "models", "seeds",
-                                  "first_seed", "navigation", "adjacency", "reward", "flight"};
+    std::vector<std::string> keys{"world", "tilt",       "lean",       "missing_models", "goals",  "models",
+                                  "seeds", "first_seed", "navigation", "adjacency",      "reward", "flight"};
     for (const auto& key : config::policy_yaml_keys()) keys.push_back(key);
     v.expect_map(keys);
     NavigatePlan p;
     p.world = config::path_in_file(v, v["world"].as_string());
     if (v.has("tilt")) p.tilt = v["tilt"].as_double();
     p.lean = v.get("lean", p.lean);
+    if (v.has("missing_models")) try {
+            p.missing_models = config::parse_missing_models(v["missing_models"].as_string());
+        } catch (const ConfigError&) {
+            throw;
+        } catch (const InputError& e) {
+            v["missing_models"].fail(e.what());
+        }
     const auto goals = v["goals"];
     if (!goals.is_sequence()) goals.fail("must be a list of [x, y] or of [x, y, z]");
     for (std::size_t i = 0; i < goals.size(); ++i) {
@@ -161,12 +172,13 @@ void navigate_command(const NavigateOptions& o) {
             models.push_back(config::resolve_model(m));
             nav->check_model(models.back());
         }
-        const World world(config::resolve_world(plan.world, plan.tilt, plan.lean));
+        const WorldSpec world_spec{plan.world, plan.tilt, plan.lean, plan.missing_models};
+        const World world(world_spec.resolve());
+        warn_left_out(world.description());
         check_goals(world, *nav);
         for (std::size_t m = 0; m < models.size(); ++m)
             for (int k = 0; k < plan.seeds; ++k) {
-                TrialConfig t = navigation_trial(WorldSpec{plan.world, plan.tilt, plan.lean}, models[m], nav,
-                                                 plan.first_seed + std::uint64_t(k));
+                TrialConfig t = navigation_trial(world_spec, models[m], nav, plan.first_seed + std::uint64_t(k));
                 t.condition = world_name + "_" + label_of(plan.models[m]);
                 t.swept = {{"world", world_name}, {"model", plan.models[m]}};
                 t.origin = o.config.empty() ? "bvc3d navigate" : o.config;
@@ -176,6 +188,7 @@ void navigate_command(const NavigateOptions& o) {
         if (o.config.empty()) throw;
         throw InputError(o.config + ": " + e.what());
     }
+    check_folder_holds_one_kind(o.run.out, trials);
     if (o.dry_run) {
         std::printf("%s: %zu goal(s), %zu model(s) × %d seed(s) = %zu learning runs, %d starts per goal each\n",
                     world_name.c_str(), plan.goals.size(), plan.models.size(), plan.seeds, trials.size(),
@@ -195,38 +208,29 @@ void add_navigate_command(CLI::App& app) {
                                    "from random starts (docs/navigation.md)");
     auto* config = cmd->add_option("--config", o->config,
                                    "A YAML file: world, goals, models, seeds and parameters (docs/navigation.md)");
-    std::vector<CLI::Option*> given;
-    given.push_back(cmd->add_option("--world", o->world, "World preset or YAML file (configs/worlds/nav-*.yaml)"));
-    given.push_back(cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees"));
-    given.push_back(cmd->add_option("--lean", o->lean, "Corner the cross walls lean toward")->capture_default_str());
+    std::vector<CLI::Option*> given = o->world.add_to(*cmd, "", "");
     given.push_back(cmd->add_option("--goals", o->goals,
                                     "Goals on the floor, x,y[;x,y...], or in the air for the flying agent, "
                                     "x,y,z[;x,y,z...] (m)"));
-    given.push_back(cmd->add_option("--model", o->model, "Model preset or YAML file")->capture_default_str());
-    given.push_back(cmd->add_option("--policy", o->policy, "The controller of the starts: " + policy_names_text())
-                        ->capture_default_str());
+    given.push_back(add_model_option(*cmd, o->model, ModelCount::list));
+    given.push_back(add_policy_option(*cmd, o->policy));
     given.push_back(cmd->add_option("--seeds", o->seeds, "Learning runs (seeds first-seed, first-seed+1, ...)")
                         ->capture_default_str());
     given.push_back(
         cmd->add_option("--first-seed", o->first_seed, "The first seed")->check(seed_check)->capture_default_str());
-    given.push_back(cmd->add_option("--starts", o->nav.starts, "Starts per goal")->capture_default_str());
-    given.push_back(
-        cmd->add_option("--max-learn-hours", o->nav.max_learn_hours, "Longest learning walk, simulated hours")
-            ->capture_default_str());
-    given.push_back(
-        cmd->add_option("--coverage", o->nav.coverage, "Learning ends at this fraction of free 0.5 m cells visited")
-            ->capture_default_str());
-    given.push_back(cmd->add_option("--goal-visits", o->nav.goal_visits, "... and this many visits of each goal")
-                        ->capture_default_str());
+    static const NavigationParams defaults;
+    for (CLI::Option* g : o->nav.add_to(*cmd, {"starts", "max_learn_hours", "coverage", "goal_visits"}, &defaults))
+        given.push_back(g);
     for (CLI::Option* g : given) config->excludes(g);
     cmd->add_flag("--dry-run", o->dry_run, "Read and check everything, say what would run, and exit");
     o->run.add_out(*cmd,
                    "Output folder: a trial file per model and seed (a run started again resumes there), the "
-                   "tables and figures");
-    o->run.add_jobs(*cmd, "Learning runs in parallel; 0 (the default): one per core (the files are the same)");
+                   "tables and figures",
+                   OutputKind::results_folder);
+    o->run.add_jobs(*cmd, "Learning runs", " (the files are the same)");
     o->run.add_checkpoint_minutes(*cmd);
     o->run.add_no_memory_check(*cmd);
-    o->run.add_no_report(*cmd);
+    o->run.add_no_figures(*cmd);
     cmd->callback([o] { navigate_command(*o); });
 }
 

@@ -11,13 +11,15 @@
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/experiment/place_recognition.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 #include "python_module.hpp"
 #include "recording_options.hpp"
-#include "run_options.hpp"
+#include "table_options.hpp"
 
 namespace bvc3d::cli {
 
@@ -25,45 +27,35 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string flag(bool b) { return b ? "1" : "0"; }
-
 void write_tables(const fs::path& dir, const PlaceRecognitionOutcome& r) {
-    std::string queries = "descriptor,query,match,distance,match_m,has_revisit,correct\n";
-    std::string summary = "descriptor,protocol,recall_at_1,f1_max,auc,queries,revisits\n";
-    std::string pr = "descriptor,protocol,threshold,precision,recall\n";
-    std::string details =
-        "descriptor,protocol,uses_heading,recall_at_1,f1_max,auc,queries,revisits,correct,median_match_m,"
-        "describe_s,search_s\n";
+    AtomicFile queries_file(dir / "queries.csv"), summary_file(dir / "summary.csv"), details_file(dir / "details.csv"),
+        pr_file(dir / "pr.csv"), scans_file(dir / "scans.csv");
+    CsvWriter queries(queries_file.stream()), summary(summary_file.stream()), details(details_file.stream()),
+        pr(pr_file.stream()), scans(scans_file.stream());
+    queries.row("descriptor", "query", "match", "distance", "match_m", "has_revisit", "correct");
+    summary.row("descriptor", "protocol", "recall_at_1", "f1_max", "auc", "queries", "revisits");
+    pr.row("descriptor", "protocol", "threshold", "precision", "recall");
+    details.row("descriptor", "protocol", "uses_heading", "recall_at_1", "f1_max", "auc", "queries", "revisits",
+                "correct", "median_match_m", "describe_s", "search_s");
     for (const auto& d : r.descriptors) {
         const auto& rows = d.result.rows;
         for (std::size_t i = 0; i < rows.query.size(); ++i)
-            queries += d.spec.label + "," + std::to_string(rows.query[i]) + "," + std::to_string(rows.match[i]) + "," +
-                       num(rows.distance[i]) + "," + num(rows.match_m[i]) + "," + flag(rows.has_revisit[i]) + "," +
-                       flag(rows.correct[i]) + "\n";
+            queries.row(d.spec.label, rows.query[i], rows.match[i], rows.distance[i], rows.match_m[i],
+                        bool(rows.has_revisit[i]), bool(rows.correct[i]));
         const auto& s = d.result.summary;
-        summary += d.spec.label + "," + r.protocol + "," + num(s.recall_at_1) + "," + num(s.f1_max) + "," + num(s.auc) +
-                   "," + std::to_string(s.queries) + "," + std::to_string(s.revisits) + "\n";
-        details += d.spec.label + "," + r.protocol + "," + flag(d.spec.uses_heading()) + "," + num(s.recall_at_1) +
-                   "," + num(s.f1_max) + "," + num(s.auc) + "," + std::to_string(s.queries) + "," +
-                   std::to_string(s.revisits) + "," + std::to_string(s.correct) + "," + num(s.median_match_m) + "," +
-                   num(d.describe_seconds) + "," + num(d.search_seconds) + "\n";
+        summary.row(d.spec.label, r.protocol, s.recall_at_1, s.f1_max, s.auc, s.queries, s.revisits);
+        details.row(d.spec.label, r.protocol, d.spec.uses_heading(), s.recall_at_1, s.f1_max, s.auc, s.queries,
+                    s.revisits, s.correct, s.median_match_m, d.describe_seconds, d.search_seconds);
         const auto& c = d.result.curve;
         for (std::size_t k = 0; k < c.threshold.size(); ++k)
-            pr += d.spec.label + "," + r.protocol + "," + num(c.threshold[k]) + "," + num(c.precision[k]) + "," +
-                  num(c.recall[k]) + "\n";
+            pr.row(d.spec.label, r.protocol, c.threshold[k], c.precision[k], c.recall[k]);
     }
-    std::string scans = "scan,t,x,y,z,heading,drift\n";
+    scans.row("scan", "t", "x", "y", "z", "heading", "drift");
     for (Eigen::Index i = 0; i < r.positions.rows(); ++i) {
         const auto k = static_cast<std::size_t>(i);
-        scans += std::to_string(i) + "," + num(r.times[k]) + "," + num(r.positions(i, 0)) + "," +
-                 num(r.positions(i, 1)) + "," + num(r.positions(i, 2)) + "," + num(r.heading[k]) + "," +
-                 num(r.drift[k]) + "\n";
+        scans.row(i, r.times[k], r.positions(i, 0), r.positions(i, 1), r.positions(i, 2), r.heading[k], r.drift[k]);
     }
-    write_file_atomically(dir / "queries.csv", queries);
-    write_file_atomically(dir / "summary.csv", summary);
-    write_file_atomically(dir / "details.csv", details);
-    write_file_atomically(dir / "pr.csv", pr);
-    write_file_atomically(dir / "scans.csv", scans);
+    for (AtomicFile* f : {&queries_file, &summary_file, &details_file, &pr_file, &scans_file}) f->commit();
 }
 
 std::string descriptor_help() {
@@ -82,44 +74,40 @@ void add_place_recognition_command(CLI::App& app) {
         "place-recognition",
         "Recognise revisited places from scans alone: BVC rates, place cells and Scan Context, the field's protocol");
     struct Options {
-        std::string scans, poses, world, route, sensor, descriptors, database, queries;
+        std::string scans, poses, route, sensor, descriptors, database, queries;
         std::string out = "results/place-recognition";
+        WorldOptions world;
         RecordingOptions recording;
         PreprocessOptions preprocess;
+        TableOptions<analysis::LoopClosureParams> loop{analysis::LoopClosureParams::table()};
         PlaceRecognitionOptions run;
-        bool no_figure = false;
+        bool no_figures = false;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--scans", o->scans, "Scan folder, scan list file (PCD, PLY, KITTI .bin) of a recording");
     cmd->add_option("--poses", o->poses, "Pose file of the scans (KITTI, TUM or 4x4 rows): the ground truth");
     o->recording.add_to(*cmd);
-    cmd->add_option("--world", o->world, "Instead of a recording: a world (preset or YAML) to drive a sensor through");
+    o->world.add_to(*cmd, "Instead of a recording, to drive a sensor through: ", "");
     cmd->add_option("--route", o->route,
                     "With --world: the route, a trajectory file (rows t, x, y, [z], heading[, pitch, roll])");
-    cmd->add_option("--sensor", o->sensor, "With --world: the sensor (horizontal, spherical or a sensor YAML)");
+    add_sensor_option(*cmd, o->sensor, "With --world: ");
     cmd->add_option("--descriptors", o->descriptors, "Comma-separated descriptors (below)")->required();
     cmd->add_option("--database", o->database, "Split protocol: the database scans A:B (both included)");
     cmd->add_option("--queries", o->queries, "Split protocol: the query scans C:D (both included)");
-    cmd->add_option("--exclude-scans", o->run.loop.exclude_scans,
-                    "Sequential protocol: scan i matches only scans j with i - j > this")
-        ->capture_default_str();
-    cmd->add_option("--exclude-seconds", o->run.loop.exclude_seconds,
-                    "Sequential protocol: and, when the scans carry times, t_i - t_j > this (s)")
-        ->capture_default_str();
-    cmd->add_option("--revisit-m", o->run.loop.revisit_m, "A match this close (horizontally, m) is right")
-        ->capture_default_str();
+    static const analysis::LoopClosureParams loop_defaults;
+    o->loop.add_to(*cmd, {}, &loop_defaults);
     cmd->add_option("--drift-deg-per-sqrt-min", o->run.drift_deg_per_sqrt_min,
                     "bvc-drift: the heading's random-walk drift, degrees after one minute (SD)")
         ->capture_default_str();
     cmd->add_option("--seed", o->run.seed, "Seed of the drift, the place cells' initial weights and sensor noise")
         ->capture_default_str()
         ->check(seed_check);
-    cmd->add_option("--threads", o->run.threads, "Threads (0: every core)")->capture_default_str();
+    add_jobs_option(*cmd, o->run.threads, "Scans described");
     o->preprocess.add_to(*cmd);
-    cmd->add_option("--out", o->out,
-                    "Folder for queries.csv, summary.csv, details.csv, pr.csv, scans.csv, place-recognition.png")
-        ->capture_default_str();
-    cmd->add_flag("--no-figure", o->no_figure, "Skip the figure");
+    o->outputs.add(*cmd, "--out", o->out, OutputKind::folder,
+                   "Folder for queries.csv, summary.csv, details.csv, pr.csv, scans.csv, place-recognition.png");
+    add_no_figures_option(*cmd, o->no_figures, "the figure");
     cmd->footer(
         descriptor_help() +
         "Sequential protocol (default): each scan queries the scans older than the exclusion window; it has a\n"
@@ -130,15 +118,14 @@ void add_place_recognition_command(CLI::App& app) {
         "models read a scan (as replay reads it); Scan Context reads every point within 80 m\n"
         "(docs/place-recognition.md).");
     cmd->callback([o] {
-        RunOptions jobs;  // --jobs checked as every command that runs trials checks it
-        jobs.jobs = o->run.threads;
-        jobs.check();
+        check_jobs(o->run.threads);
+        o->loop.apply(o->run.loop);
         const auto descriptors = parse_descriptors(o->descriptors);
         if (!o->database.empty()) o->run.database = analysis::parse_scan_span(o->database, "--database");
         if (!o->queries.empty()) o->run.queries = analysis::parse_scan_span(o->queries, "--queries");
         o->run.preprocess = o->preprocess.get();
         const bool recorded = !o->scans.empty() || !o->poses.empty();
-        const bool simulated = !o->world.empty() || !o->route.empty() || !o->sensor.empty();
+        const bool simulated = o->world.given() || !o->route.empty() || !o->sensor.empty();
         if (recorded == simulated)
             throw InputError("give either a recording (--scans and --poses) or a route (--world, --route, --sensor)");
         std::unique_ptr<ScanSequence> seq;
@@ -146,13 +133,14 @@ void add_place_recognition_command(CLI::App& app) {
             if (o->scans.empty()) throw InputError("--poses needs --scans");
             seq = std::make_unique<RecordingSequence>(o->recording.open(o->scans, o->poses));
         } else {
-            if (o->world.empty() || o->route.empty() || o->sensor.empty())
+            if (o->world.world.empty() || o->route.empty() || o->sensor.empty())
                 throw InputError("a simulated route needs --world, --route and --sensor");
-            auto world = std::make_shared<const World>(config::resolve_world(o->world));
+            auto world = std::make_shared<const World>(o->world.resolve());
             seq = std::make_unique<SimulatedSequence>(world, read_trajectory_file(o->route), o->route,
                                                       config::resolve_sensor(o->sensor), o->run.seed);
         }
         query_plan(*seq, o->run);  // bad spans and windows fail before anything is written
+        o->outputs.check();
         ensure_writable_directory(o->out);
         const bool tty = ::isatty(STDERR_FILENO);
         o->run.progress = [tty](std::size_t done, std::size_t n) {
@@ -174,11 +162,11 @@ void add_place_recognition_command(CLI::App& app) {
                         s.revisits, s.recall_at_1, s.f1_max, s.auc, d.spec.uses_heading() ? "uses" : "no",
                         d.describe_seconds, d.search_seconds);
         }
-        if (!o->no_figure && run_python_module("bvc3d.place_recognition_figure", {o->out}).status != 0)
+        if (!o->no_figures && run_python_module("bvc3d.place_recognition_figure", {o->out}).status != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
                              python_command().shell_line("bvc3d.place_recognition_figure", {o->out}));
         std::printf("tables: %s/summary.csv, queries.csv, details.csv, pr.csv, scans.csv%s\n", o->out.c_str(),
-                    o->no_figure ? "" : ", figure: place-recognition.png");
+                    o->no_figures ? "" : ", figure: place-recognition.png");
     });
 }
 

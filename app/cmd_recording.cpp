@@ -1,6 +1,7 @@
 // bvc3d replay / localize / map / export-scans: real LiDAR recordings (docs/recordings.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
@@ -27,6 +29,7 @@
 #include "bvc3d/recording/voxel_map.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 #include "python_module.hpp"
 #include "recording_options.hpp"
 #include "run_options.hpp"
@@ -63,7 +66,8 @@ private:
 
 // Scans to replay: a recording (--scans, --poses), or a simulated sensor along a path in a world.
 struct SourceOptions {
-    std::string scans, poses, world, trajectory, sensor;
+    std::string scans, poses, trajectory, sensor;
+    WorldOptions world;
     bool step_per_row = false;
     RecordingOptions recording;
     PreprocessOptions preprocess;
@@ -72,20 +76,19 @@ struct SourceOptions {
         cmd.add_option("--scans", scans, "Scan folder, scan list file or one scan (PCD, PLY, KITTI .bin)");
         cmd.add_option("--poses", poses, "Pose file of the scans (KITTI, TUM or 4x4 rows)");
         recording.add_to(cmd);
-        cmd.add_option("--world", world, "Instead of a recording: a world (preset or YAML) to simulate a sensor in");
+        world.add_to(cmd, "Instead of a recording, to simulate a sensor in: ", "");
         cmd.add_option(
             "--trajectory", trajectory,
             "With --world: the sensor's path, rows t, x, y, [z], heading[, pitch, roll] (a header names them), "
             "resampled to the model step unless they are at it");
         cmd.add_flag("--step-per-row", step_per_row,
                      "With --trajectory: one model step (one scan) per row, whatever their interval");
-        cmd.add_option("--sensor", sensor,
-                       "With --world: the simulated sensor (horizontal, spherical or a sensor YAML)");
+        add_sensor_option(cmd, sensor, "With --world: ");
         preprocess.add_to(cmd);
     }
     ReplaySource get() const {
         const bool recorded = !scans.empty() || !poses.empty() || recording.has_bag();
-        const bool simulated = !world.empty() || !trajectory.empty() || !sensor.empty() || step_per_row;
+        const bool simulated = world.given() || !trajectory.empty() || !sensor.empty() || step_per_row;
         if (recorded == simulated)
             throw InputError(
                 "give either a recording (--scans and --poses, or --bag) or a simulation (--world, --trajectory, "
@@ -94,10 +97,10 @@ struct SourceOptions {
             if (scans.empty() && !recording.has_bag()) throw InputError("--poses needs --scans");
             return recorded_source(recording.open_any(scans, poses), preprocess.get());
         }
-        if (world.empty() || trajectory.empty() || sensor.empty())
+        if (world.world.empty() || trajectory.empty() || sensor.empty())
             throw InputError("a simulated replay needs --world, --trajectory and --sensor");
-        WorldSpec w{world, std::nullopt, "+x+y"};
-        w.resolve();  // fail early on bad worlds
+        const WorldSpec w = world.spec();
+        warn_left_out(w.resolve());  // fail early on bad worlds
         TrajectoryParams params;
         params.step_per_row = step_per_row;
         auto path = std::make_shared<const TrajectorySpec>(TrajectorySpec::from_file(trajectory, params));
@@ -122,17 +125,18 @@ void add_replay(CLI::App& app) {
         std::string model, weights, out;
         bool learn = false;
         std::uint64_t seed = 0;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
     o->source.add_to(*cmd);
-    cmd->add_option("--model", o->model, "Model preset or model YAML")->required();
+    add_model_option(*cmd, o->model, ModelCount::one)->required();
     cmd->add_flag("--learn", o->learn, "Place cells learn while replaying (Oja's rule); default: frozen");
     cmd->add_option("--weights", o->weights, "Start from the trained weights of this trial file (same model)");
     cmd->add_option("--seed", o->seed, "Seed of the initial weights when no --weights is given")
         ->capture_default_str()
         ->check(seed_check);
-    cmd->add_option("--out", o->out, "Trial file to write (default results/<recording>_<model>.h5)")
-        ->transform(output_path);
+    o->outputs.add(*cmd, "--out", o->out, OutputKind::trial_file,
+                   "Trial file to write (default results/<recording>_<model>.h5)");
     cmd->footer(
         "Each scan is one model step at its pose: its points are rotated into the world frame (gravity-aligned),\n"
         "kept within the range limits, and each model reads the upper half (3-D presets) or the horizontal slice\n"
@@ -144,6 +148,7 @@ void add_replay(CLI::App& app) {
             replay_trial(source, config::resolve_model(o->model), o->learn, weights_from(o->weights), o->seed);
         const fs::path out =
             o->out.empty() ? fs::path("results") / (t.world_label() + "_" + t.model.name + ".h5") : fs::path(o->out);
+        check_output("--out", out, OutputKind::trial_file, o->outputs.force);
         const OutputLock lock = lock_output_file(out);
         const std::size_t n = source.path->steps().size();
         ProgressLine line;
@@ -236,13 +241,15 @@ std::string f3(double v) {
 
 void write_localization(const fs::path& dir, const std::vector<LocalizeRow>& rows, bool bvc) {
     const std::string rates = bvc ? "bvc" : "place";
-    std::string summary =
-        "model,rates,queries,templates,undecoded,median_m,mean_m,within_1m,within_2m,vertical_median_m,vertical_mean_m,"
-        "chance_median_m,chance_mean_m,chance_within_1m,chance_within_2m,nearest_median_m,nearest_mean_m,"
-        "nearest_within_1m,nearest_within_2m\n";
-    std::string queries =
-        "model,query,x,y,z,decoded,decoded_x,decoded_y,decoded_z,similarity,error_m,vertical_error_m,nearest_m\n";
-    std::string templates = "model,template,x,y,z\n";
+    AtomicFile summary_file(dir / "localization.csv"), queries_file(dir / "queries.csv"),
+        templates_file(dir / "templates.csv");
+    CsvWriter summary(summary_file.stream()), queries(queries_file.stream()), templates(templates_file.stream());
+    summary.row("model", "rates", "queries", "templates", "undecoded", "median_m", "mean_m", "within_1m", "within_2m",
+                "vertical_median_m", "vertical_mean_m", "chance_median_m", "chance_mean_m", "chance_within_1m",
+                "chance_within_2m", "nearest_median_m", "nearest_mean_m", "nearest_within_1m", "nearest_within_2m");
+    queries.row("model", "query", "x", "y", "z", "decoded", "decoded_x", "decoded_y", "decoded_z", "similarity",
+                "error_m", "vertical_error_m", "nearest_m");
+    templates.row("model", "template", "x", "y", "z");
     std::string md =
         "| model | rates | queries | templates | median (m) | mean (m) | ≤ 1 m | ≤ 2 m | chance median | chance ≤ 2 m "
         "| "
@@ -250,13 +257,10 @@ void write_localization(const fs::path& dir, const std::vector<LocalizeRow>& row
     for (const auto& row : rows) {
         const auto& r = row.result;
         const auto& s = r.decoded_summary;
-        summary += row.model + "," + rates + "," + std::to_string(row.queries.rates.rows()) + "," +
-                   std::to_string(row.templates.rates.rows()) + "," + std::to_string(r.n_undecoded) + "," +
-                   num(s.median) + "," + num(s.mean) + "," + num(s.within_1m) + "," + num(s.within_2m) + "," +
-                   num(r.vertical_median) + "," + num(r.vertical_mean) + "," + num(r.chance.median) + "," +
-                   num(r.chance.mean) + "," + num(r.chance.within_1m) + "," + num(r.chance.within_2m) + "," +
-                   num(r.nearest.median) + "," + num(r.nearest.mean) + "," + num(r.nearest.within_1m) + "," +
-                   num(r.nearest.within_2m) + "\n";
+        summary.row(row.model, rates, row.queries.rates.rows(), row.templates.rates.rows(), r.n_undecoded, s.median,
+                    s.mean, s.within_1m, s.within_2m, r.vertical_median, r.vertical_mean, r.chance.median,
+                    r.chance.mean, r.chance.within_1m, r.chance.within_2m, r.nearest.median, r.nearest.mean,
+                    r.nearest.within_1m, r.nearest.within_2m);
         md += "| " + row.model + " | " + rates + " | " + std::to_string(row.queries.rates.rows()) + " | " +
               std::to_string(row.templates.rates.rows()) + " | " + f3(s.median) + " | " + f3(s.mean) + " | " +
               f3(s.within_1m) + " | " + f3(s.within_2m) + " | " + f3(r.chance.median) + " | " + f3(r.chance.within_2m) +
@@ -264,24 +268,20 @@ void write_localization(const fs::path& dir, const std::vector<LocalizeRow>& row
         for (std::size_t i = 0; i < r.decoded.size(); ++i) {
             const auto q = static_cast<Eigen::Index>(i);
             const long d = r.decoded[i];
-            queries += row.model + "," + std::to_string(row.queries.index[i]) + "," + num(row.queries.xyz(q, 0)) + "," +
-                       num(row.queries.xyz(q, 1)) + "," + num(row.queries.xyz(q, 2)) + ",";
-            if (d >= 0)
-                queries += std::to_string(row.templates.index[static_cast<std::size_t>(d)]) + "," +
-                           num(row.templates.xyz(d, 0)) + "," + num(row.templates.xyz(d, 1)) + "," +
-                           num(row.templates.xyz(d, 2)) + ",";
-            else queries += ",,,,";
-            queries += num(r.similarity[i]) + "," + num(r.error[i]) + "," + num(r.vertical_error[i]) + "," +
-                       num(r.nearest_error[i]) + "\n";
+            queries.field(row.model).field(row.queries.index[i]);
+            queries.field(row.queries.xyz(q, 0)).field(row.queries.xyz(q, 1)).field(row.queries.xyz(q, 2));
+            const std::optional<Eigen::Index> t = d >= 0 ? std::optional<Eigen::Index>(d) : std::nullopt;
+            queries.field(t ? std::optional<std::size_t>(row.templates.index[static_cast<std::size_t>(d)])
+                            : std::nullopt);
+            for (int axis = 0; axis < 3; ++axis)
+                queries.field(t ? std::optional<double>(row.templates.xyz(*t, axis)) : std::nullopt);
+            queries.row(r.similarity[i], r.error[i], r.vertical_error[i], r.nearest_error[i]);
         }
         for (Eigen::Index j = 0; j < row.templates.xyz.rows(); ++j)
-            templates += row.model + "," + std::to_string(row.templates.index[static_cast<std::size_t>(j)]) + "," +
-                         num(row.templates.xyz(j, 0)) + "," + num(row.templates.xyz(j, 1)) + "," +
-                         num(row.templates.xyz(j, 2)) + "\n";
+            templates.row(row.model, row.templates.index[static_cast<std::size_t>(j)], row.templates.xyz(j, 0),
+                          row.templates.xyz(j, 1), row.templates.xyz(j, 2));
     }
-    write_file_atomically(dir / "localization.csv", summary);
-    write_file_atomically(dir / "queries.csv", queries);
-    write_file_atomically(dir / "templates.csv", templates);
+    for (AtomicFile* f : {&summary_file, &queries_file, &templates_file}) f->commit();
     write_file_atomically(dir / "localization.md", md);
 }
 
@@ -291,9 +291,10 @@ void add_localize(CLI::App& app) {
         std::string templates, template_poses, queries, query_poses, scans, poses, models, rates = "bvc", weights;
         std::string out = "results/localization";
         int split = 0;
-        bool no_figure = false;
+        bool no_figures = false;
         RecordingOptions recording;
         PreprocessOptions preprocess;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--templates", o->templates,
@@ -306,16 +307,15 @@ void add_localize(CLI::App& app) {
     cmd->add_option("--poses", o->poses, "Pose file of --scans");
     cmd->add_option("--split", o->split, "With --scans: scan i is a query when i mod N = 1, else a template")
         ->capture_default_str();
-    cmd->add_option("--model", o->models, "Model presets or YAML files, comma-separated")->required();
+    add_model_option(*cmd, o->models, ModelCount::list)->required();
     cmd->add_option("--rates", o->rates, "Decode on 'bvc' rates (default) or 'place' rates")->capture_default_str();
     cmd->add_option("--weights", o->weights,
                     "With --rates place: trained weights for replayed recordings, a trial file (may contain {model})");
     o->recording.add_to(*cmd);
     o->preprocess.add_to(*cmd);
-    cmd->add_option("--out", o->out, "Folder for localization.csv/.md, queries.csv, templates.csv, localization.png")
-        ->capture_default_str()
-        ->transform(output_path);
-    cmd->add_flag("--no-figure", o->no_figure, "Skip the figure");
+    o->outputs.add(*cmd, "--out", o->out, OutputKind::folder,
+                   "Folder for localization.csv/.md, queries.csv, templates.csv, localization.png");
+    add_no_figures_option(*cmd, o->no_figures, "the figure");
     cmd->footer(
         "Each query is decoded to the template whose population vector is most cosine-similar; the error is the\n"
         "horizontal distance between their positions (and, apart, the vertical one). Chance: a uniformly random\n"
@@ -325,9 +325,9 @@ void add_localize(CLI::App& app) {
     cmd->callback([o] {
         if (o->rates != "bvc" && o->rates != "place") throw InputError("--rates must be 'bvc' or 'place'");
         const bool bvc = o->rates == "bvc";
-        const auto models = split_commas(o->models);
-        if (models.empty()) throw InputError("--model lists no model");
+        const auto models = model_list(o->models);
         const RecordedReturnParams pre = o->preprocess.get();
+        o->outputs.check();
 
         Side templates, queries;
         if (!o->scans.empty() || o->recording.has_bag()) {
@@ -412,11 +412,11 @@ void add_localize(CLI::App& app) {
             if (r.n_undecoded)
                 std::printf("  %s: %zu queries undecoded (no positive similarity)\n", row.model.c_str(), r.n_undecoded);
         }
-        if (!o->no_figure && run_python_module("bvc3d.localization_figure", {o->out}).status != 0)
+        if (!o->no_figures && run_python_module("bvc3d.localization_figure", {o->out}).status != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
                              python_command().shell_line("bvc3d.localization_figure", {o->out}));
         std::printf("tables: %s/localization.md, localization.csv, queries.csv%s\n", o->out.c_str(),
-                    o->no_figure ? "" : ", figure: localization.png");
+                    o->no_figures ? "" : ", figure: localization.png");
     });
 }
 
@@ -430,6 +430,7 @@ void add_map(CLI::App& app) {
         std::string scans, poses, out;
         recording::VoxelMapParams params;
         RecordingOptions recording;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
     o->params.min_range = 0.3;
@@ -444,15 +445,16 @@ void add_map(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--min-points", o->params.min_points, "Voxels with fewer points are left out")
         ->capture_default_str();
-    cmd->add_option("--out", o->out, "Map to write: .ply (binary, float) or .pcd (binary, float)")
-        ->required()
-        ->transform(output_path);
+    o->outputs
+        .add(*cmd, "--out", o->out, OutputKind::file, "Map to write: .ply (binary, float) or .pcd (binary, float)")
+        ->required();
     cmd->footer(
         "The map is a point cloud in the recording's world frame; a world YAML draws it as spheres with a\n"
         "point_cloud object (docs/worlds.md#point-clouds), so that a simulated robot or sensor can use it.");
     cmd->callback([o] {
         const auto ext = fs::path(o->out).extension().string();
         if (ext != ".ply" && ext != ".pcd") throw InputError("--out must end in .ply or .pcd");
+        o->outputs.check();
         if (o->scans.empty() && !o->recording.has_bag()) throw InputError("give --scans and --poses, or --bag");
         const auto rec = o->recording.open_any(o->scans, o->poses);
         recording::VoxelMap map(o->params);
@@ -482,36 +484,78 @@ void add_map(CLI::App& app) {
 // ---------------------------------------------------------------------------------------------
 // export-scans
 
+// The bags export-scans writes, one row each: the format's name and the extension its file's name ends
+// in (none: a ROS 2 bag folder). Every other format is a folder of scan files
+// (recording::parse_scan_write_format).
+struct BagExport {
+    std::string name, extension, what;  // no extension: the bag is a folder
+    recording::BagFormat format;
+    bool is_folder() const { return extension.empty(); }
+    std::string written() const { return is_folder() ? what : what + " (a " + extension + " file)"; }
+};
+const std::vector<BagExport>& bag_exports() {
+    static const std::vector<BagExport> bags{
+        {"ros1", ".bag", "a ROS 1 bag", recording::BagFormat::ros1},
+        {"mcap", ".mcap", "a ROS 2 bag in one MCAP file", recording::BagFormat::mcap},
+        {"ros2", "", "a ROS 2 bag folder (metadata.yaml and an .mcap)", recording::BagFormat::ros2}};
+    return bags;
+}
+
+// The format and the output's name agree: a bag's file ends in its extension, a folder (of scans or a
+// ROS 2 bag) does not end in a bag file's (InputError saying what to give instead). Then the rule for
+// outputs that exist.
+void check_export_out(const std::string& format, const std::string& out, bool force) {
+    const std::string ext = fs::path(out).extension().string();
+    for (const auto& b : bag_exports())
+        if (b.name == format && !b.is_folder()) {
+            if (ext != b.extension)
+                throw InputError("--format " + format + " writes " + b.what + ", one file: --out must end in " +
+                                 b.extension + ", got '" + out + "'");
+            return check_output("--out", out, OutputKind::file, force);
+        }
+    const auto bag_folder = std::find_if(bag_exports().begin(), bag_exports().end(),
+                                         [&](const BagExport& b) { return b.name == format && b.is_folder(); });
+    const std::string writes = bag_folder != bag_exports().end() ? bag_folder->what : "a folder of scans";
+    for (const auto& b : bag_exports())
+        if (!b.is_folder() && ext == b.extension)
+            throw InputError("--format " + format + " writes " + writes + ", but --out '" + out + "' is named as " +
+                             b.what + ": give --format " + b.name + " for a " + b.extension +
+                             " file, or a folder's name");
+    check_output("--out", out, OutputKind::folder, force);
+}
+
 void add_export_scans(CLI::App& app) {
     auto* cmd = app.add_subcommand("export-scans", "Write simulated scans along a path as a recording (scans + poses)");
     struct Options {
-        std::string world = "cross", trajectory, sensor = "spherical", format = "pcd-f8", out;
-        std::optional<double> tilt, hours;
+        WorldOptions world;
+        std::string trajectory, sensor = "spherical", format = "pcd-f8", out;
+        std::optional<double> hours;
         std::uint64_t seed = 0;
         double start_time = recording::BagWriteOptions{}.start;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--world", o->world, "Preset or world YAML")->capture_default_str();
-    cmd->add_option("--tilt", o->tilt, "Tilt of the cross arena's walls, degrees");
+    o->world.add_to(*cmd);
     cmd->add_option("--trajectory", o->trajectory,
                     "Path: rows t, x, y, [z], heading[, pitch, roll] (a header names them)");
     cmd->add_option("--hours", o->hours, "Instead of --trajectory: this many hours of the seeded random walk");
     cmd->add_option("--seed", o->seed, "Seed of the random walk and of the sensor's noise")
         ->capture_default_str()
         ->check(seed_check);
-    cmd->add_option("--sensor", o->sensor, "horizontal, spherical (upper half) or a sensor YAML")
+    add_sensor_option(*cmd, o->sensor);
+    std::string bags, bag_names;
+    for (const auto& b : bag_exports()) {
+        bags += "; " + b.name + ": " + b.written();
+        bag_names += (bag_names.empty() ? "" : " or ") + b.name;
+    }
+    cmd->add_option("--format", o->format,
+                    "pcd (float32), pcd-f8 (float64), ply, kitti (.bin): a folder of scans" + bags)
         ->capture_default_str();
-    cmd->add_option(
-           "--format", o->format,
-           "pcd (float32), pcd-f8 (float64), ply, kitti (.bin); or a bag: ros1 (.bag), mcap (ROS 2, .mcap) or ros2 "
-           "(a ROS 2 bag folder: metadata.yaml and an .mcap)")
-        ->capture_default_str();
-    cmd->add_option(
-           "--out", o->out,
-           "Folder to write: 000000.<ext> ..., poses.txt, scans.txt; with ros1 or mcap, the bag file; with ros2, "
-           "the bag's folder")
-        ->required()
-        ->transform(output_path);
+    o->outputs
+        .add(*cmd, "--out", o->out, OutputKind::file_or_folder,
+             "Folder to write: 000000.<ext> ..., poses.txt, scans.txt; with " + bag_names +
+                 ": the bag (a file whose name ends as the format's; ros2: the bag's folder)")
+        ->required();
     cmd->add_option("--start-time", o->start_time,
                     "ros1, mcap, ros2: seconds added to every stamp (ROS takes a zero stamp for 'no time')")
         ->capture_default_str();
@@ -523,12 +567,22 @@ void add_export_scans(CLI::App& app) {
         "and /tf (the same transform): replay it with --bag OUT --cloud-topic /points --pose-topic /odom\n"
         "(docs/ros.md#export).");
     cmd->callback([o] {
-        const bool bag = o->format == "ros1" || o->format == "mcap" || o->format == "ros2";
-        const auto format = bag ? recording::ScanWriteFormat::pcd_f8 : recording::parse_scan_write_format(o->format);
-        if (bag && !(o->start_time >= 0)) throw InputError("--start-time must be >= 0");
+        const auto bag = std::find_if(bag_exports().begin(), bag_exports().end(),
+                                      [&](const BagExport& b) { return b.name == o->format; });
+        const bool is_bag = bag != bag_exports().end();
+        recording::ScanWriteFormat format = recording::ScanWriteFormat::pcd_f8;
+        if (!is_bag) try {
+                format = recording::parse_scan_write_format(o->format);
+            } catch (const InputError& e) {
+                std::string names;
+                for (const auto& b : bag_exports()) names += ", " + b.name;
+                throw InputError("--format: " + std::string(e.what()) + names);
+            }
+        if (is_bag && !(o->start_time >= 0)) throw InputError("--start-time must be >= 0");
         if (o->trajectory.empty() == !o->hours.has_value()) throw InputError("give --trajectory or --hours, not both");
         if (o->hours && !(*o->hours > 0)) throw InputError("--hours must be positive");
-        const World world(config::resolve_world(o->world, o->tilt, "+x+y"));
+        check_export_out(o->format, o->out, o->outputs.force);
+        const World world(o->world.resolve());
         const Lidar lidar(config::resolve_sensor(o->sensor));
         std::vector<ModelStep> steps;
         if (o->hours) {
@@ -560,11 +614,9 @@ void add_export_scans(CLI::App& app) {
             poses.push_back(pose);
         }
         line.done();
-        if (bag) {
+        if (is_bag) {
             recording::BagWriteOptions b;
-            b.format = o->format == "ros1"   ? recording::BagFormat::ros1
-                       : o->format == "mcap" ? recording::BagFormat::mcap
-                                             : recording::BagFormat::ros2;
+            b.format = bag->format;
             b.start = o->start_time;
             recording::write_bag(o->out, clouds, poses, b);
         } else {

@@ -11,6 +11,8 @@
 #include "bvc3d/core/error.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
+#include "table_options.hpp"
 
 namespace bvc3d::cli {
 
@@ -29,24 +31,24 @@ void add_route_command(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "route", "Drive a route through a world's floor, from waypoints or as a tour; write it as a trajectory file");
     struct Options {
-        std::string world, waypoints, start, out;
+        WorldOptions world;
+        std::string waypoints, start, out;
         bool tour = false;
-        RouteParams route;
+        TableOptions<RouteParams> route{RouteParams::table()};
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
-    cmd->add_option("--world", o->world, "World: a preset, a world YAML or a Gazebo world (.world, .sdf)")->required();
+    o->world.add_to(*cmd, "", "").front()->required();
     auto* waypoints = cmd->add_option("--waypoints", o->waypoints, "Text file of waypoints, one 'x y' per line (m)");
     auto* tour = cmd->add_flag("--tour", o->tour,
                                "A closed tour of the floor instead: near 90 % of it, part of it driven both ways");
     waypoints->excludes(tour);
     cmd->add_option("--start", o->start, "With --tour: where it starts and ends, X,Y (default: the floor's middle)")
         ->needs(tour);
-    cmd->add_option("--speed", o->route.speed, "Cruising speed, m/s")->capture_default_str();
-    cmd->add_option("--lateral-acceleration", o->route.lateral_acceleration, "At most this in turns, m/s^2")
-        ->capture_default_str();
-    cmd->add_option("--out", o->out, "Trajectory file to write (t,x,y,z,heading rows)")
-        ->required()
-        ->transform(output_path);
+    static const RouteParams defaults;
+    o->route.add_to(*cmd, {"speed", "lateral_acceleration"}, &defaults);
+    o->outputs.add(*cmd, "--out", o->out, OutputKind::file, "Trajectory file to write (t,x,y,z,heading rows)")
+        ->required();
     cmd->footer(
         "The path joins the waypoints with circular arcs (speed^2/radius never above the lateral acceleration;\n"
         "tight corners are stops and turns in place), heading along the motion, one row per model step (0.288 s)\n"
@@ -55,18 +57,17 @@ void add_route_command(CLI::App& app) {
         "`localize`, `replay` and Python's TrajectorySpec.");
     cmd->callback([o] {
         if (o->waypoints.empty() == !o->tour) throw InputError("give --waypoints FILE or --tour");
-        o->route.validate();
-        require_not_directory(o->out, "--out");
-        const World world(config::resolve_world(o->world));
-        if (const auto& out = world.description().left_out; !out.empty())
-            std::cerr << "bvc3d: warning: " << out.size()
-                      << " included models were not found and are left out (first: " << out.front() << ")\n";
+        RouteParams route;
+        o->route.apply(route);
+        route.validate();
+        o->outputs.check();
+        const World world(o->world.resolve());
         const RobotParams robot;
         std::vector<ModelStep> steps;
         if (o->tour) {
             std::optional<Vec2> start;
             if (!o->start.empty()) start = parse_point(o->start, "--start");
-            const Tour t = make_tour(world.description(), robot.radius, robot.height, start, {}, o->route);
+            const Tour t = make_tour(world.description(), robot.radius, robot.height, start, {}, route);
             steps = t.steps;
             std::cout << "tour of '" << world.name() << "': " << steps.size() << " model steps, " << num(t.stats.length)
                       << " m in " << num(steps.back().t) << " s; passes within 1 m of "
@@ -75,7 +76,7 @@ void add_route_command(CLI::App& app) {
                       << num(std::round(t.stats.reverse_length)) << " m again in the opposite direction\n";
         } else {
             const BodyCollider body(world.description(), robot.radius, robot.height);
-            steps = route_through(read_waypoints(o->waypoints), body, o->route);
+            steps = route_through(read_waypoints(o->waypoints), body, route);
             std::cout << "route through '" << world.name() << "': " << steps.size() << " model steps in "
                       << num(steps.back().t) << " s\n";
         }

@@ -122,10 +122,10 @@ void add_sweep_command(CLI::App& app) {
     auto* cmd = app.add_subcommand("sweep", "Run a parameter sweep (conditions x seeds) on local cores or over MPI");
     auto o = std::make_shared<SweepOptions>();
     cmd->add_option("sweep", o->file, "Sweep YAML file (docs/sweeps.md)")->required();
-    o->run.add_out(*cmd, "Output folder (default results/<sweep name>)");
-    o->run.add_jobs(*cmd, "Threads (per rank under MPI); 0 (the default): one per core, or 1 per rank under MPI");
+    o->run.add_out(*cmd, "Output folder (default results/<sweep name>)", OutputKind::results_folder);
+    o->run.add_jobs(*cmd, "Trials", " (under mpirun: per rank, and 0 is 1)");
     o->run.add_checkpoint_minutes(*cmd);
-    o->run.add_no_report(*cmd);
+    o->run.add_no_figures(*cmd, "the figures and report.md");
     o->run.add_no_memory_check(*cmd);
     cmd->add_option("--hours", o->hours, "Shorten both phases of every trial to H simulated hours");
     cmd->add_flag("--dry-run", o->dry_run, "List the trials and exit");
@@ -135,9 +135,10 @@ void add_sweep_command(CLI::App& app) {
         "folder must be shared by all ranks. Completed trials are skipped on a rerun. See docs/cluster.md.");
     cmd->callback([o] {
         const auto sweep = checked_sweep(*o);
-        RunOptions run = o->run;
+        RunOptions& run = o->run;
         if (run.out.empty()) run.out = (std::filesystem::path("results") / sweep.name).string();
         const std::filesystem::path out = run.out;
+        if (!o->dry_run) run.outputs.check();  // the default's too
         if (o->dry_run) {
             check_runnable(sweep.trials);
             for (const auto& t : sweep.trials) std::printf("%s\n", t.name().c_str());
@@ -151,7 +152,7 @@ void add_sweep_command(CLI::App& app) {
             ExperimentOutcome outcome;
             if (!run_over_mpi(sweep, *o, out, outcome)) return;
             print_outcome(sweep.trials.size(), out, outcome);  // rank 0; the ranks have finished
-            summarize(out, outcome.files, !run.no_report);
+            summarize(out, outcome.files, !run.no_figures);
             std::printf("summary: %s/summary.md\n", out.c_str());
             return;
         } else

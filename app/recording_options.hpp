@@ -15,6 +15,7 @@
 #include "bvc3d/recording/extrinsics.hpp"
 #include "bvc3d/recording/recording.hpp"
 #include "bvc3d/sensor/recorded_returns.hpp"
+#include "table_options.hpp"
 
 namespace bvc3d::cli {
 
@@ -91,20 +92,17 @@ struct RecordingOptions {
     }
 };
 
-// The preprocessing of recorded scans.
+// The preprocessing of recorded scans: the options of the table RecordedReturnParams.
 struct PreprocessOptions {
-    RecordedReturnParams params;
-    std::optional<double> slice_deg;
+    TableOptions<RecordedReturnParams> table{RecordedReturnParams::table()};
 
     void add_to(CLI::App& cmd) {
-        cmd.add_option("--min-range", params.min_range, "m: nearer points are dropped")->capture_default_str();
-        cmd.add_option("--max-range", params.max_range, "m: farther points are dropped")->capture_default_str();
-        cmd.add_option("--slice-half-width-deg", slice_deg,
-                       "The 2-D models read the returns within this many degrees of the horizontal (default 1)");
+        static const RecordedReturnParams defaults;
+        table.add_to(cmd, {}, &defaults);
     }
     RecordedReturnParams get() const {
-        RecordedReturnParams p = params;
-        if (slice_deg) p.slice_half_width = deg_to_rad(*slice_deg);
+        RecordedReturnParams p;
+        table.apply(p);
         p.validate();
         return p;
     }

@@ -1,31 +1,27 @@
 #include "run_options.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/memory.hpp"
+#include "bvc3d/recorder/trial_file.hpp"
 #include "cli_common.hpp"
 #include "summary_report.hpp"
 
 namespace bvc3d::cli {
 
-const char* const jobs_help = "Trials in parallel; 0 (the default): one per core";
 const char* const no_memory_check_help = "Run even when the estimated memory exceeds what the machine has available";
 
-CLI::Option* RunOptions::add_out(CLI::App& cmd, const std::string& help) {
-    auto* option = cmd.add_option("--out", out, help)->transform(output_path);
-    return out.empty() ? option : option->capture_default_str();
+CLI::Option* RunOptions::add_out(CLI::App& cmd, const std::string& help, OutputKind kind,
+                                 std::vector<std::string> own) {
+    return outputs.add(cmd, "--out", out, kind, help, std::move(own));
 }
 
-CLI::Option* RunOptions::add_jobs(CLI::App& cmd, const std::string& help) {
-    return cmd.add_option("--jobs", jobs, help);
+CLI::Option* RunOptions::add_jobs(CLI::App& cmd, const std::string& what, const std::string& note) {
+    return add_jobs_option(cmd, jobs, what, note);
 }
 
 CLI::Option* RunOptions::add_checkpoint_minutes(CLI::App& cmd) {
@@ -39,23 +35,22 @@ CLI::Option* RunOptions::add_no_memory_check(CLI::App& cmd) {
     return cmd.add_flag("--no-memory-check", no_memory_check, no_memory_check_help);
 }
 
-CLI::Option* RunOptions::add_no_report(CLI::App& cmd) {
-    return cmd.add_flag("--no-report", no_report, "Skip the figures (trial files and summary only)");
+CLI::Option* RunOptions::add_no_figures(CLI::App& cmd, const std::string& what) {
+    return add_no_figures_option(cmd, no_figures, what);
 }
 
 void RunOptions::add_experiment_options(CLI::App& cmd, const std::string& out_help) {
-    add_out(cmd, out_help);
+    add_out(cmd, out_help, OutputKind::results_folder);
     add_jobs(cmd);
     add_checkpoint_minutes(cmd);
-    add_no_report(cmd);
+    add_no_figures(cmd, "the figures and report.md");
     add_no_memory_check(cmd);
 }
 
 void RunOptions::check() const {
-    if (jobs < 0) throw InputError("--jobs must be >= 0 (0: one per core), got " + std::to_string(jobs));
-    if (jobs > max_jobs)
-        throw InputError("--jobs " + std::to_string(jobs) + " is more than the limit of " + std::to_string(max_jobs));
+    check_jobs(jobs);
     if (!(checkpoint_minutes >= 0)) throw InputError("--checkpoint-minutes must be >= 0");
+    outputs.check();
 }
 
 void RunOptions::check_memory(const std::vector<TrialConfig>& trials, int threads) const {
@@ -65,28 +60,6 @@ void RunOptions::check_memory(const std::vector<TrialConfig>& trials, int thread
     bvc3d::check_memory(
         estimate_memory(trials, threads), what,
         "shorten sample_hours, use fewer --jobs or smaller models, or pass --no-memory-check to try anyway");
-}
-
-void run_in_parallel(std::size_t n, int jobs, const std::function<void(std::size_t)>& fn) {
-    const std::size_t threads =
-        std::min(n, jobs > 0 ? std::size_t(jobs) : std::max<std::size_t>(1, std::thread::hardware_concurrency()));
-    std::atomic<std::size_t> next{0};
-    std::mutex failed;
-    std::exception_ptr failure;
-    const auto work = [&] {
-        for (std::size_t t; (t = next++) < n;) try {
-                fn(t);
-            } catch (...) {
-                const std::lock_guard<std::mutex> lock(failed);
-                if (!failure) failure = std::current_exception();
-                next = n;
-            }
-    };
-    std::vector<std::thread> others;
-    for (std::size_t k = 1; k < threads; ++k) others.emplace_back(work);
-    work();
-    for (auto& t : others) t.join();
-    if (failure) std::rethrow_exception(failure);
 }
 
 std::string output_folder_text(const std::filesystem::path& folder) {
@@ -126,9 +99,30 @@ void print_outcome(std::size_t n_trials, const std::filesystem::path& out, const
     std::printf("\n");
 }
 
+void check_folder_holds_one_kind(const std::filesystem::path& out, const std::vector<TrialConfig>& trials) {
+    std::error_code ec;
+    if (trials.empty() || !std::filesystem::is_directory(out, ec)) return;
+    const bool navigating = trials.front().navigation != nullptr;
+    const auto kind = [](bool navigation) {
+        return navigation ? std::string("navigation trials") : std::string("trials that record place cells");
+    };
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(out))
+        if (e.path().extension() == ".h5") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+        const auto stamp = read_trial_stamp(f);
+        if (stamp && stamp->navigation != navigating)
+            throw InputError(output_folder_text(out) + " holds files of another kind (first: '" +
+                             f.filename().string() + "', of " + kind(stamp->navigation) + "): " + kind(navigating) +
+                             " go to another --out (one folder's tables cannot hold both)");
+    }
+}
+
 ExperimentOutcome run_experiment_in_folder(const std::vector<TrialConfig>& trials, const RunOptions& o,
                                            const FolderRunHooks& hooks) {
     o.check();  // before anything is written
+    check_folder_holds_one_kind(o.out, trials);
     check_runnable(trials);
     o.check_memory(trials, o.jobs);
     const OutputLock lock = lock_output_folder(o.out);
@@ -150,7 +144,7 @@ ExperimentOutcome run_experiment_in_folder(const std::vector<TrialConfig>& trial
         }
     }
     print_outcome(trials.size(), o.out, outcome);
-    summarize(o.out, outcome.files, !o.no_report);
+    summarize(o.out, outcome.files, !o.no_figures);
     return outcome;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// What the commands that run trials share, written once: the options --out, --jobs,
-// --checkpoint-minutes, --no-memory-check and --no-report with their help and checks, the output's
+// What the commands that run trials share, written once: the options --out (with --force), --jobs,
+// --checkpoint-minutes, --no-memory-check and --no-figures with their help and checks, the output's
 // lock (one writer per folder or trial file, core/output_lock.hpp), the memory check, and an
 // experiment's whole run into a folder (paper, flight, a local sweep): trials on this machine's
 // threads, the outcome line, the tables and the figures.
@@ -16,12 +16,10 @@
 #include "bvc3d/config/trial_config.hpp"
 #include "bvc3d/core/output_lock.hpp"
 #include "bvc3d/experiment/experiment.hpp"
+#include "option_groups.hpp"
 
 namespace bvc3d::cli {
 
-// `--jobs`: threads; 0 means one per core. Values above this are refused.
-inline constexpr int max_jobs = 4096;
-extern const char* const jobs_help;
 extern const char* const no_memory_check_help;
 
 struct RunOptions {
@@ -29,27 +27,27 @@ struct RunOptions {
     int jobs = 0;
     double checkpoint_minutes = 0;  // simulated minutes between checkpoints; 0: only on Ctrl-C
     bool no_memory_check = false;
-    bool no_report = false;
+    bool no_figures = false;
+    Outputs outputs{};  // --out and --force
 
-    // Each adds its option to `cmd`; a non-empty `out` and checkpoint_minutes show as defaults.
-    CLI::Option* add_out(CLI::App& cmd, const std::string& help);
-    CLI::Option* add_jobs(CLI::App& cmd, const std::string& help = jobs_help);
+    // Each adds its option to `cmd` (from the option groups, option_groups.hpp); a non-empty `out` and
+    // checkpoint_minutes show as defaults. A results folder is resumed when it holds one of `own`.
+    CLI::Option* add_out(CLI::App& cmd, const std::string& help, OutputKind kind,
+                         std::vector<std::string> own = experiment_folder_marks());
+    CLI::Option* add_jobs(CLI::App& cmd, const std::string& what = "Trials", const std::string& note = "");
     CLI::Option* add_checkpoint_minutes(CLI::App& cmd);
     CLI::Option* add_no_memory_check(CLI::App& cmd);
-    CLI::Option* add_no_report(CLI::App& cmd);
-    // The experiments' block (paper, flight, sweep): all five, --out an output folder.
+    CLI::Option* add_no_figures(CLI::App& cmd, const std::string& what = "the figures");
+    // The experiments' block (paper, flight, sweep): all five, --out a results folder.
     void add_experiment_options(CLI::App& cmd, const std::string& out_help = "Output folder");
 
-    // --jobs (0 .. max_jobs) and --checkpoint-minutes (>= 0), or InputError naming the option.
+    // --jobs (0 .. max_jobs), --checkpoint-minutes (>= 0) and the outputs (the rule for existing ones),
+    // or InputError naming the option.
     void check() const;
     // Refuses (InputError) trials whose estimated memory on `jobs` threads (0: one per core)
     // exceeds what the machine has available, unless --no-memory-check.
     void check_memory(const std::vector<TrialConfig>& trials, int jobs) const;
 };
-
-// fn(0) … fn(n − 1) on `jobs` threads (0: one per core); the first exception any of them throws is rethrown once
-// all have stopped (the others take no new task after it).
-void run_in_parallel(std::size_t n, int jobs, const std::function<void(std::size_t)>& fn);
 
 // "output folder 'DIR'": how messages (and the lock's holder message) name an output folder.
 std::string output_folder_text(const std::filesystem::path& folder);
@@ -69,10 +67,15 @@ struct FolderRunHooks {
     std::function<void(const std::string&)> on_trial_done;
 };
 
+// InputError when the folder `out` already holds complete trial files of the other kind than `trials` (navigation
+// trials beside trials that record place cells): one folder's tables cannot hold both, and --force does not change
+// that. Nothing when it does not exist or holds no trial file.
+void check_folder_holds_one_kind(const std::filesystem::path& out, const std::vector<TrialConfig>& trials);
+
 // An experiment's run into the folder `o.out`: the options, the trials and the memory they need checked
 // before anything is written, the folder locked, the trials run on this machine's threads with
 // progress on standard error (Ctrl-C or SIGTERM checkpoints and exits with status 130), the
-// outcome line printed, trials.csv and summary.csv/.md written and, unless --no-report, the figures.
+// outcome line printed, trials.csv and summary.csv/.md written and, unless --no-figures, the figures.
 ExperimentOutcome run_experiment_in_folder(const std::vector<TrialConfig>& trials, const RunOptions& o,
                                            const FolderRunHooks& hooks = {});
 

@@ -11,6 +11,7 @@
 #include "bvc3d/world/gazebo_world.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "option_groups.hpp"
 #include "recording_options.hpp"
 #include "view/export.hpp"
 #include "view/safe_path.hpp"
@@ -148,6 +149,7 @@ void add_view_command(CLI::App& app) {
         std::string export_dir, scans, poses, model = "3d-0.2";
         std::size_t export_steps = 40;
         RecordingOptions recording;
+        Outputs outputs;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("paths", o->paths,
@@ -159,11 +161,11 @@ void add_view_command(CLI::App& app) {
                     "file: the recording it replayed, when it is not found beside it)");
     cmd->add_option("--poses", o->poses, "The recording's sensor poses (KITTI, TUM or 4x4 matrices)");
     o->recording.add_to(*cmd);
-    cmd->add_option("--model", o->model, "Model whose scanner and BVCs the page of a recording or a world shows")
-        ->capture_default_str();
-    cmd->add_option("--export", o->export_dir,
-                    "Write the page as static files into this (new) folder instead of serving it")
-        ->transform(output_path);
+    add_model_option(*cmd, o->model, ModelCount::one, "--model",
+                     "Whose scanner and BVCs the page of a recording or a world shows: ");
+    o->outputs.add(*cmd, "--export", o->export_dir, OutputKind::folder,
+                   "Write the page as static files into this folder instead of serving it (--force replaces only a "
+                   "page exported earlier)");
     cmd->add_option("--export-steps", o->export_steps,
                     "Samples per trial (or scans) whose returns and rates are exported")
         ->capture_default_str()
@@ -175,7 +177,7 @@ void add_view_command(CLI::App& app) {
         view::ViewData data(make_target(o->paths, o->scans, o->poses, o->recording, o->model));
         const fs::path web = web_dir();
         if (!o->export_dir.empty()) {
-            const auto s = view::export_view(data, web, o->export_dir, o->export_steps);
+            const auto s = view::export_view(data, web, o->export_dir, o->export_steps, o->outputs.force);
             std::printf("wrote %s: open %s/index.html (%zu data files, %.1f MB, %zu steps)\n", o->export_dir.c_str(),
                         o->export_dir.c_str(), s.files, s.bytes / 1e6, s.steps);
             return;

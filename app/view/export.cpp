@@ -81,11 +81,17 @@ private:
 
 }  // namespace
 
-ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::path& target, std::size_t steps) {
+ExportSummary export_view(ViewData& data, const fs::path& web_dir, const fs::path& target, std::size_t steps,
+                          bool replace) {
     const fs::path out = without_trailing_slash(target);
     std::error_code ec;
-    if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
-        throw InputError("export folder '" + out.string() + "' exists and is not an empty folder");
+    if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+        throw InputError("export folder '" + out.string() + "' exists and is not a folder");
+    const bool earlier_export = fs::is_regular_file(out / "index.html", ec) && fs::is_directory(out / "data", ec);
+    if (fs::exists(out, ec) && !fs::is_empty(out, ec) && !(replace && earlier_export))
+        throw InputError("export folder '" + out.string() + "' exists and is not empty" +
+                         (replace ? " and holds no page bvc3d exported (index.html and data/): choose another folder"
+                                  : ": choose another folder, or --force to replace a page exported earlier"));
     AtomicFolder folder(out);  // a new folder beside `out`, removed on an error
     const fs::path& temp = folder.temp_path();
     fs::create_directory(temp / "data", ec);

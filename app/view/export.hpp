@@ -17,8 +17,10 @@ struct ExportSummary {
 
 // Steps: the samples whose returns and rates are written, evenly spaced over each trial (the
 // trajectory and metrics are complete; the slider shows the nearest exported step). The folder is
-// written under a temporary name and renamed when complete.
+// written under a temporary name and renamed when complete. An existing folder that is not empty is
+// refused, unless `replace` and it is an earlier export (index.html and data/ in it), which is then
+// replaced whole.
 ExportSummary export_view(ViewData& data, const std::filesystem::path& web_dir, const std::filesystem::path& out,
-                          std::size_t steps);
+                          std::size_t steps, bool replace = false);
 
 }  // namespace bvc3d::view

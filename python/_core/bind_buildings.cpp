@@ -72,11 +72,12 @@ void bind_buildings(pyb::module_& m) {
             "from_sdf",
             [](const std::filesystem::path& path, const std::vector<std::string>& model_path,
                const std::string& geometry, std::optional<double> floor_z, const std::string& missing_models,
-               bool flight_volume, const std::string& name) {
+               bool flight_volume, const std::string& name, const std::vector<std::string>& resource_path) {
                 config::BuildingSpec spec;
                 spec.file = path.string();
                 spec.name = name;
                 spec.gazebo.model_path = model_path;
+                spec.gazebo.resource_path = resource_path;
                 if (geometry != "visual" && geometry != "collision")
                     throw InputError("geometry must be 'visual' or 'collision', got '" + geometry + "'");
                 spec.gazebo.geometry =
@@ -91,9 +92,10 @@ void bind_buildings(pyb::module_& m) {
             },
             pyb::arg("path"), pyb::arg("model_path") = std::vector<std::string>{}, pyb::arg("geometry") = "visual",
             pyb::arg("floor_z") = pyb::none(), pyb::arg("missing_models") = "error", pyb::arg("flight_volume") = false,
-            pyb::arg("name") = "",
+            pyb::arg("name") = "", pyb::arg("resource_path") = std::vector<std::string>{},
             R"doc(A Gazebo (SDF) world (docs/buildings.md): model_path lists folders searched for model://NAME before
-the `models` folder beside the world's folder and GAZEBO_MODEL_PATH; geometry 'visual' or 'collision'; floor_z the
+the `models` folder beside the world's folder and GAZEBO_MODEL_PATH; resource_path folders searched for relative
+file:// meshes before GAZEBO_RESOURCE_PATH; geometry 'visual' or 'collision'; floor_z the
 height of the floor to walk on (default the lowest); missing_models 'error' or 'skip'; flight_volume=True: a
 flight volume filling the storey. The chosen floor is moved to z = 0 (World.floor_z says by how much).)doc")
         .def_property_readonly(

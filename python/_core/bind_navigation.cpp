@@ -209,7 +209,7 @@ HdAdjacency(n_place, **params); params and their defaults:
            const pyb::kwargs& kwargs) {
             const World w = world_of(world);
             NavigationSpec s;
-            const ModelSpec base = config::resolve_model(model);
+            const ModelSpec model_spec = config::resolve_model(model);
             const auto g = real_array(goals, "goals");
             if (g.ndim() != 2 || (g.shape(1) != 2 && g.shape(1) != 3))
                 throw InputError("goals must be an (N, 2) array of x, y (on the floor) or (N, 3) of x, y, z (flying)");
@@ -218,8 +218,8 @@ HdAdjacency(n_place, **params); params and their defaults:
                                                         : NavigationGoal(g.at(i, 0), g.at(i, 1)));
             apply_navigation(s, kwargs);
             const std::uint64_t seed_value = seed_of(seed, "seed");  // with the GIL, before the work lets it go
-            const NavigationRecord run =
-                interruptible([&](const std::atomic<bool>& stop) { return navigate(w, base, s, seed_value, &stop); });
+            const NavigationRecord run = interruptible(
+                [&](const std::atomic<bool>& stop) { return navigate(w, model_spec, s, seed_value, &stop); });
             const int dims = run.dims;
             const auto n = pyb::ssize_t(run.n_starts());
             std::vector<double> gx, gy, gz, sx, sy, sz;

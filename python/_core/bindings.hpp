@@ -9,19 +9,17 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstring>
 #include <exception>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/parallel.hpp"
 #include "bvc3d/core/params.hpp"
 #include "bvc3d/recorder/trial_record.hpp"
 
@@ -59,47 +57,39 @@ pyb::array_t<float, pyb::array::c_style | pyb::array::forcecast> real_array_f32(
 // A seed: a Python integer 0 .. 2^64 - 1 (InputError naming `name` otherwise; no bools, no floats).
 std::uint64_t seed_of(const pyb::handle& obj, const std::string& name);
 
-// Runs `work(stop)` on a worker thread with the GIL released, and wakes every 100 ms to let Python
-// run its signal handlers: Ctrl-C (KeyboardInterrupt) sets `stop` — which the work's loops poll,
-// directly or through poll_cancel() — waits for the work to end (a fraction of a second) and
-// raises the KeyboardInterrupt. Exceptions of the work are rethrown in the caller.
+// Runs `work(stop)` on a worker of core/parallel.hpp's pool with the GIL released, and wakes every
+// 100 ms to let Python run its signal handlers: Ctrl-C (KeyboardInterrupt) sets `stop` — which the
+// work's loops poll, directly or through poll_cancel() — waits for the work to end (a fraction of a
+// second) and raises the KeyboardInterrupt. Exceptions of the work are rethrown in the caller.
 template <class F>
 auto interruptible(F&& work) {
     using R = std::invoke_result_t<F&, const std::atomic<bool>&>;
-    std::atomic<bool> stop{false};
-    std::mutex m;
-    std::condition_variable cv;
-    bool done = false;
-    std::exception_ptr error;
+    std::atomic<bool> interrupt{false};
     std::conditional_t<std::is_void_v<R>, bool, std::optional<R>> result{};
     bool interrupted = false;
+    std::exception_ptr error;
     {
         pyb::gil_scoped_release release;
-        std::thread worker([&] {
-            try {
-                const CancelScope scope(&stop);
-                if constexpr (std::is_void_v<R>) work(stop);
-                else result.emplace(work(stop));
-            } catch (...) {
-                error = std::current_exception();
-            }
-            std::lock_guard lock(m);
-            done = true;
-            cv.notify_one();
-        });
-        std::unique_lock lock(m);
-        while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
-            if (interrupted) continue;
-            lock.unlock();
-            {
-                pyb::gil_scoped_acquire gil;
-                if (PyErr_CheckSignals() != 0) interrupted = true;  // the exception stays set
-            }
-            if (interrupted) stop = true;
-            lock.lock();
+        const CancelScope scope(&interrupt);
+        ParallelOptions options;
+        options.tick_every = std::chrono::milliseconds(100);
+        options.tick = [&] {
+            if (interrupted) return;
+            pyb::gil_scoped_acquire gil;
+            if (PyErr_CheckSignals() != 0) interrupted = interrupt = true;  // the exception stays set
+        };
+        try {
+            run_workers(
+                1,
+                [&](std::size_t) {
+                    const std::atomic<bool>& stop = *cancel_flag();  // the pool's, set once `interrupt` is
+                    if constexpr (std::is_void_v<R>) work(stop);
+                    else result.emplace(work(stop));
+                },
+                options);
+        } catch (...) {
+            error = std::current_exception();
         }
-        lock.unlock();
-        worker.join();
     }
     if (interrupted) throw pyb::error_already_set();
     if (error) std::rethrow_exception(error);

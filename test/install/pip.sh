@@ -18,6 +18,11 @@ mkdir "$scratch/source"
 git -C "$source_dir" ls-files -z --cached --others --exclude-standard \
   | tar -C "$source_dir" --null --ignore-failed-read -T - -cf - | tar -C "$scratch/source" -xf -
 
+# With ccache (scripts/setup installs it), the copy's compiles that ./build made already are cache hits:
+# paths relative to the copy, and setup.py builds one level below it, as ./build is.
+if command -v ccache >/dev/null; then
+  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CMAKE_C_COMPILER_LAUNCHER=ccache CCACHE_BASEDIR="$scratch/source"
+fi
 /usr/bin/python3 -m venv --system-site-packages "$venv"
 (cd "$scratch/source" && "$venv/bin/pip" install --no-build-isolation . >"$scratch/pip.log" 2>&1) \
   || { tail -n 60 "$scratch/pip.log" >&2; echo "pip: install failed" >&2; exit 1; }

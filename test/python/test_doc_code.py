@@ -99,7 +99,7 @@ import re
 import shlex
 
 SH_SETUP = {  # page -> bvc3d command lines run first in the block's folder (what the block reads)
-    "README.md": [["paper", "--models", "2d", "--tilts", "0", "--hours", "0.002", "--no-report",
+    "README.md": [["paper", "--models", "2d", "--tilts", "0", "--hours", "0.002", "--no-figures",
                    "--out", "results/paper"],
                   ["export-scans", "--hours", "0.01", "--format", "pcd", "--out", "run/"],
                   ["export-scans", "--hours", "0.002", "--format", "ros1", "--out", "run.bag"]],
@@ -111,7 +111,7 @@ SH_NEEDS = {
     "hall/": "a LiDAR recording in hall/ (the shared data's hall-lidar, not found)",
     "hall.yaml": "a recording's chosen model (the user's own)",
     "hospital.yaml": "the page's Gazebo hospital world YAML over the shared Gazebo models",
-    "hospital.world": "a Gazebo world file (the user's own)",
+    "worlds/hospital.world": f"the AWS hospital world (not in {GAZEBO})",
     "house.world": "a Gazebo world file (the user's own)",
     "my-building.yaml": "the user's own building",
     "room.yaml": "the user's own world",
@@ -159,7 +159,7 @@ def shortened(argv):
     if cmd in ("paper", "flight", "navigate") and "--seeds" in out:
         out[out.index("--seeds") + 1] = "1"
     if cmd in ("paper", "flight", "sweep"):
-        out.append("--no-report")
+        out.append("--no-figures")
     if cmd == "choose-elevations":
         set_option("--explore-minutes", "0.3")
     if cmd == "navigate":
@@ -221,6 +221,9 @@ def test_shell_block_runs(page, line, text, tmp_path):
     (tmp_path / "configs").symlink_to(SOURCE_DIR / "configs")
     if (SHARED / "hall-lidar").is_dir():  # the docs' hall/: a real recording, 60 scans with poses.csv
         (tmp_path / "hall").symlink_to(SHARED / "hall-lidar")
+    if GAZEBO.is_dir():  # the README's worlds/hospital.world: the AWS hospital's folder, as a user has it
+        (tmp_path / "worlds").symlink_to(GAZEBO / "worlds")
+        (tmp_path / "models").symlink_to(GAZEBO / "models")
     for argv in SH_SETUP.get(page.name, []):
         proc = subprocess.run([CLI, *argv], cwd=tmp_path, capture_output=True, text=True)
         assert proc.returncode == 0, proc.stderr

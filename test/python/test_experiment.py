@@ -119,7 +119,7 @@ def test_analyze_recomputes_the_stored_metrics(paper_dir, tmp_path):
                 assert f" {n} " in proc.stdout
         mi = f["metrics/modality"][:]
     np.testing.assert_array_equal(np.genfromtxt(cells, delimiter=",", names=True)["modality"], mi)
-    run_cli("analyze", path, "--min-samples", 5, "--out", f"{table}/", check=True)  # recomputed, written
+    run_cli("analyze", path, "--min-samples", 5, "--out", f"{table}/", "--force", check=True)  # recomputed, written
     (other,) = list(csv.DictReader(open(table)))
     assert other["min_samples"] == "5" and other != row
 
@@ -269,7 +269,7 @@ def test_analyze_starts_from_the_files_own_parameters(tmp_path):
         assert float(row["frac_active"]) == pytest.approx(f["metrics"].attrs["frac_active"])
         assert float(row["n_bins"]) == f["metrics"].attrs["n_bins"]
         np.testing.assert_array_equal(f["metrics/extent"][:], [-5, 5, -5, 5])
-    run_cli("analyze", out, "--extent", "data", "--out", table, check=True)
+    run_cli("analyze", out, "--extent", "data", "--out", table, "--force", check=True)
     (data,) = list(csv.DictReader(open(table)))
     assert data["n_bins"] != row["n_bins"]  # binned over the trajectory instead: another grid
 

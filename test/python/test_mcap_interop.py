@@ -129,13 +129,22 @@ def test_ros2_export_is_a_bag_folder(tmp_path, cli):
     b = bvc3d.Recording.open_bag(tmp_path / "walk.mcap", "/points", pose_topic="/odom").replay("3d-3l")
     np.testing.assert_array_equal(a["bvc_rates"], b["bvc_rates"])
     assert "ROS 2 bag (mcap)" in cli("bag-info", tmp_path / "walk", check=True).stdout
-    # Written again over itself; never over a folder that holds anything else.
-    cli(*args, "--format", "ros2", "--out", tmp_path / "walk", check=True)
+    # An existing bag folder is refused unless --force (experiments.md#outputs-that-exist), as a bag file is;
+    # with --force it is written again over itself, but never over a folder that holds anything else.
+    again = cli(*args, "--format", "ros2", "--out", tmp_path / "walk")
+    assert again.returncode == 2 and "--force" in again.stderr, again.stderr
+    cli(*args, "--format", "ros2", "--out", tmp_path / "walk", "--force", check=True)
+    assert sorted(p.name for p in (tmp_path / "walk").iterdir()) == ["metadata.yaml", "walk_0.mcap"]
     (tmp_path / "other").mkdir()
     (tmp_path / "other" / "notes.txt").write_text("mine")
-    bad = cli(*args, "--format", "ros2", "--out", tmp_path / "other")
-    assert bad.returncode == 2 and "notes.txt" in bad.stderr
-    assert sorted(p.name for p in (tmp_path / "other").iterdir()) == ["notes.txt"]
+    for force in ([], ["--force"]):
+        bad = cli(*args, "--format", "ros2", "--out", tmp_path / "other", *force)
+        assert bad.returncode == 2 and "notes.txt" in bad.stderr
+        assert sorted(p.name for p in (tmp_path / "other").iterdir()) == ["notes.txt"]
+    # A ROS 2 bag is a folder: a name that ends as a bag file's is refused.
+    bad = cli(*args, "--format", "ros2", "--out", tmp_path / "walk2.mcap")
+    assert bad.returncode == 2 and "--format mcap for a .mcap file" in bad.stderr, bad.stderr
+    assert not (tmp_path / "walk2.mcap").exists()
 
 
 # ---- MCAP and ROS 2 bags as other writers leave them (crafted here) ----

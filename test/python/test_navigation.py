@@ -419,3 +419,36 @@ def test_navigate_config_refuses_unknown_keys_and_options_beside_it(tmp_path):
     assert not (tmp_path / "out").exists()
     r = run("navigate", "--config", str(tmp_path / "nav.yaml"), "--world", "cross", "--out", str(tmp_path / "out"))
     assert r.returncode != 0 and "--world" in r.stderr, r.stderr
+
+
+def test_a_sweep_of_navigation_trials_writes_what_navigate_writes(tmp_path):
+    """A navigation experiment under `bvc3d sweep` (and so under MPI): the trial YAML's navigation: section gives the
+    trials `bvc3d navigate` makes from the same world, goals and parameters, and the same numbers in starts.csv."""
+    nav = run("navigate", "--world", "cross", "--tilt", "60", "--goals", "3.5,3.5", "--model", "2d", "--seeds", "2",
+              "--starts", "2", "--max-learn-hours", "0.1", "--out", str(tmp_path / "nav"), "--no-report")
+    assert nav.returncode == 0, nav.stderr
+    (tmp_path / "sweep.yaml").write_text(
+        "base:\n  world: {source: cross, tilt_deg: 60}\n"
+        "  navigation: {goals: [[3.5, 3.5]], starts: 2, max_learn_hours: 0.1}\n"
+        "grid:\n  model: [2d]\nseeds: 2\n")
+    sweep = run("sweep", str(tmp_path / "sweep.yaml"), "--out", str(tmp_path / "sweep"), "--no-report")
+    assert sweep.returncode == 0, sweep.stderr
+    def columns(folder):  # the numbers of each start (the world and model labels are each command's own)
+        rows = (folder / "starts.csv").read_text().splitlines()
+        return [row.split(",")[2:] for row in rows[1:]]
+    assert columns(tmp_path / "sweep") == columns(tmp_path / "nav") and len(columns(tmp_path / "nav")) == 4
+    with h5py.File(next((tmp_path / "sweep").glob("*seed1.h5"))) as h:
+        g = h["navigation"]
+        assert g.attrs["dims"] == 2 and g["path_start"][-1] == len(g["path"])
+        assert h["populations/reward/reward_weights"].shape == (1, 250)
+    # A navigation trial takes no protocol, and its goals are checked against the world before anything runs.
+    (tmp_path / "bad.yaml").write_text(
+        "base:\n  world: cross\n  protocol: {explore_hours: 1}\n  navigation: {goals: [[3.5, 3.5]]}\n"
+        "grid:\n  model: [2d]\n")
+    bad = run("sweep", str(tmp_path / "bad.yaml"), "--out", str(tmp_path / "bad"))
+    assert bad.returncode == 2 and "protocol" in bad.stderr, bad.stderr
+    (tmp_path / "wall.yaml").write_text(
+        "base:\n  world: cross\n  navigation: {goals: [[30, 0]]}\ngrid:\n  model: [2d]\n")
+    wall = run("sweep", str(tmp_path / "wall.yaml"), "--out", str(tmp_path / "wall"))
+    assert wall.returncode == 2 and "goal 1 (30, 0)" in wall.stderr, wall.stderr
+    assert not list((tmp_path / "wall").glob("*.h5"))

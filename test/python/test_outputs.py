@@ -24,8 +24,11 @@ def test_export_scans_to_a_folder_with_a_trailing_slash_then_replay_and_map_read
     assert [p.name for p in tmp_path.iterdir()] == ["walk"]  # no temporary folder beside it
     scans = sorted(p.name for p in out.glob("*.pcd"))
     assert len(scans) == len((out / "poses.txt").read_text().splitlines()) // 4 >= 2  # 4x4 rows per pose
-    # Again into the same folder (an earlier recording is replaced), and read back by replay and map.
-    assert run_cli("export-scans", "--hours", "0.002", "--out", f"{out}//", cwd=tmp_path).returncode == 0
+    # Again into the same folder: refused, naming it; with --force the earlier recording is replaced. Then read back
+    # by replay and map.
+    again = run_cli("export-scans", "--hours", "0.002", "--out", f"{out}//", cwd=tmp_path)
+    assert again.returncode == 2 and f"--out '{out}' exists" in again.stderr, again.stderr
+    assert run_cli("export-scans", "--hours", "0.002", "--out", f"{out}//", "--force", cwd=tmp_path).returncode == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["walk"]
     replay = run_cli("replay", "--scans", f"{out}/", "--poses", out / "poses.txt", "--model", "2d",
                      "--out", tmp_path / "r" / "replay.h5/", cwd=tmp_path)

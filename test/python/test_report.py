@@ -88,7 +88,9 @@ def test_failed_report_hint_works_as_printed(tmp_path):
     out = tmp_path / "exp"
     out.mkdir()
     (out / "figures").write_text("a file where the figures folder goes: the report fails")
-    proc = run_cli("paper", "--hours", "0.02", "--models", "2d", "--tilts", "0", "--out", "exp", cwd=tmp_path)
+    # --force: the folder holds a file of another kind (the outputs rule would refuse it before any trial runs).
+    proc = run_cli("paper", "--hours", "0.02", "--models", "2d", "--tilts", "0", "--out", "exp", "--force",
+                   cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.splitlines()
     i = next(k for k, line in enumerate(lines) if line.endswith("rerun it with:"))

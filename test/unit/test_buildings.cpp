@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <numbers>
+#include <optional>
 
 #include "../support/temp_dir.hpp"
 #include "bvc3d/agent/grid_path.hpp"
@@ -12,6 +15,7 @@
 #include "bvc3d/agent/tour.hpp"
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/config/building.hpp"
+#include "bvc3d/config/trial_config.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/sensor/lidar_models.hpp"
@@ -402,6 +406,156 @@ TEST(GazeboWorld, SkipsMissingModelsWhenAskedAndListsThem) {
     ASSERT_EQ(s.missing_models.size(), 1u);
     EXPECT_NE(s.missing_models[0].find("nothere"), std::string::npos);
     EXPECT_EQ(s.parts.size(), 3u);  // the crate's box, lid ball and bolt
+}
+
+// An environment variable set (or unset) for one test; restored after.
+class ScopedEnv {
+public:
+    ScopedEnv(const char* name, const std::optional<std::string>& value) : name_(name) {
+        if (const char* old = std::getenv(name)) old_ = old;
+        if (value) ::setenv(name, value->c_str(), 1);
+        else ::unsetenv(name);
+    }
+    ~ScopedEnv() {
+        if (old_) ::setenv(name_, old_->c_str(), 1);
+        else ::unsetenv(name_);
+    }
+    ScopedEnv(const ScopedEnv&) = delete;
+    ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+private:
+    const char* name_;
+    std::optional<std::string> old_;
+};
+
+// A world published as a ROS package (AWS's bookstore): worlds/store.world includes model://desk,
+// whose mesh is named relative to the package's folder, file://models/desk/meshes/desk.obj.
+struct PackagedWorld {
+    TempDir dir{"package"};
+    std::filesystem::path world, mesh;
+    PackagedWorld() {
+        dir.write("models/desk/model.config", model_config("desk"));
+        dir.write("models/desk/model.sdf", R"(<?xml version="1.0"?>
+<sdf version="1.6"><model name="desk"><static>true</static>
+  <link name="l"><visual name="v">
+    <geometry><mesh><uri>file://models/desk/meshes/desk.obj</uri></mesh></geometry></visual></link>
+</model></sdf>
+)");
+        mesh = dir.write("models/desk/meshes/desk.obj", kCubeObj);
+        world = dir.write("worlds/store.world", R"(<?xml version="1.0"?>
+<sdf version="1.6"><world name="store"><include><uri>model://desk</uri></include></world></sdf>
+)");
+    }
+};
+
+bool lists(const std::vector<std::string>& files, const std::filesystem::path& file) {
+    for (const auto& f : files)
+        if (std::filesystem::equivalent(f, file)) return true;
+    return false;
+}
+
+std::string load_error(const std::string& world, const GazeboOptions& options = {}) {
+    try {
+        load_gazebo_world(world, options);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+TEST(GazeboWorld, RelativeFileUrisAreFoundOnTheResourcePath) {
+    const PackagedWorld p;
+    const ScopedEnv no_env("GAZEBO_RESOURCE_PATH", std::nullopt);
+    // Not beside the model's file, not in the current folder: nowhere without a resource path.
+    std::string m = load_error(p.world.string());
+    EXPECT_NE(m.find("mesh 'file://models/desk/meshes/desk.obj'"), std::string::npos) << m;
+    EXPECT_NE(m.find("resource path is empty"), std::string::npos) << m;
+    EXPECT_NE(m.find("GAZEBO_RESOURCE_PATH"), std::string::npos) << m;
+    EXPECT_NE(m.find("store/desk/l/v"), std::string::npos) << m;
+    EXPECT_NE(m.find("model.sdf"), std::string::npos) << m;
+    // Through GAZEBO_RESOURCE_PATH (its first folder holds nothing), as gazebo_ros sets it from the
+    // package's gazebo_media_path.
+    {
+        const ScopedEnv env("GAZEBO_RESOURCE_PATH", "/nonexistent-bvc3d:" + p.dir.path().string());
+        const GazeboScene s = load_gazebo_world(p.world.string());
+        ASSERT_EQ(s.parts.size(), 1u);
+        EXPECT_TRUE(std::filesystem::equivalent(s.parts[0].mesh_file, p.mesh));
+        EXPECT_EQ(s.parts[0].triangle_count, 12u);
+        EXPECT_TRUE(lists(s.files, p.mesh));
+        EXPECT_TRUE(lists(gazebo_world_files(p.world.string()), p.mesh));
+    }
+    // Through the option (a world YAML's resource_path).
+    GazeboOptions o;
+    o.resource_path = {p.dir.path().string()};
+    EXPECT_EQ(load_gazebo_world(p.world.string(), o).parts.at(0).triangle_count, 12u);
+    // Folders that do not hold it are named in the message.
+    o.resource_path = {(p.dir / "worlds").string(), (p.dir / "models").string()};
+    m = load_error(p.world.string(), o);
+    EXPECT_NE(m.find("'models/desk/meshes/desk.obj' was not found in '" + (p.dir / "worlds").string() + "', '" +
+                     (p.dir / "models").string() + "'"),
+              std::string::npos)
+        << m;
+}
+
+TEST(Building, WorldYamlResourcePathFindsFileUris) {
+    const PackagedWorld p;
+    const ScopedEnv no_env("GAZEBO_RESOURCE_PATH", std::nullopt);
+    const auto yaml = p.dir.write("store.yaml", "sdf: worlds/store.world\nresource_path: [.]\n");
+    const WorldDescription w = config::load_world_file(yaml.string());
+    EXPECT_EQ(w.mesh.size(), 12u);
+    EXPECT_TRUE(lists(config::world_file_meshes(yaml.string()), p.mesh));
+    // Without the key the YAML's world is an error naming its key, the URI and where to say where it is.
+    const auto bare = p.dir.write("bare.yaml", "sdf: worlds/store.world\n");
+    try {
+        config::load_world_file(bare.string());
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("bare.yaml"), std::string::npos) << m;
+        EXPECT_NE(m.find("file://models/desk/meshes/desk.obj"), std::string::npos) << m;
+        EXPECT_NE(m.find("resource_path"), std::string::npos) << m;
+    }
+}
+
+TEST(Building, FingerprintChangesWhenAnyMeshTheWorldReadsIsEdited) {
+    // One mesh of each kind of URI: an absolute file://, a relative file:// on the resource path, a plain
+    // path beside the world file, and model://.
+    const TempDir dir("fingerprint");
+    const auto abs = dir.write("elsewhere/a.obj", kCubeObj);
+    const auto on_path = dir.write("media/meshes/b.obj", kCubeObj);
+    const auto plain = dir.write("worlds/meshes/c.obj", kCubeObj);
+    dir.write("models/cube/model.config", model_config("cube"));
+    const auto in_model = dir.write("models/cube/meshes/cube.obj", kCubeObj);
+    dir.write("models/cube/model.sdf", R"(<?xml version="1.0"?>
+<sdf version="1.6"><model name="cube"><static>true</static><link name="l"><visual name="v">
+  <geometry><mesh><uri>model://cube/meshes/cube.obj</uri></mesh></geometry></visual></link></model></sdf>
+)");
+    const auto mesh_model = [](const std::string& name, const std::string& uri, double x) {
+        return "<model name='" + name + "'><static>true</static><pose>" + std::to_string(x) +
+               " 0 0 0 0 0</pose><link name='l'><visual name='v'><geometry><mesh><uri>" + uri +
+               "</uri></mesh></geometry></visual></link></model>\n";
+    };
+    const auto world =
+        dir.write("worlds/w.world", "<?xml version=\"1.0\"?>\n<sdf version=\"1.6\"><world name=\"w\">\n" +
+                                        mesh_model("a", "file://" + abs.string(), 0) +
+                                        mesh_model("b", "file://meshes/b.obj", 2) + mesh_model("c", "meshes/c.obj", 4) +
+                                        "<include><uri>model://cube</uri></include>\n" + "</world></sdf>\n");
+    const ScopedEnv env("GAZEBO_RESOURCE_PATH", (dir / "media").string());
+    const WorldSpec spec{world.string(), std::nullopt, "+x+y"};
+    // The files it reads are all listed (never fewer than the loader reads).
+    const GazeboScene scene = load_gazebo_world(world.string());
+    const auto listed = gazebo_world_files(world.string());
+    for (const auto& f : scene.files) EXPECT_TRUE(lists(listed, f)) << f;
+    for (const auto& mesh : {abs, on_path, plain, in_model}) EXPECT_TRUE(lists(scene.files, mesh)) << mesh;
+    // Editing any of them makes a new world; the same bytes again, the same one.
+    std::string before = spec.fingerprint();
+    EXPECT_EQ(spec.fingerprint(), before);
+    for (const auto& mesh : {abs, on_path, plain, in_model}) {
+        std::ofstream(mesh, std::ios::app) << "v 9 9 9\n";
+        const std::string after = spec.fingerprint();
+        EXPECT_NE(after, before) << mesh;
+        before = after;
+    }
 }
 
 // A two-storey building: slabs at z = 0 and z = 3 with a stairwell hole in the upper one.

@@ -119,11 +119,15 @@ std::unique_ptr<Agent> LearningWalkSpec::make(const World* world, std::uint64_t 
 }
 
 std::string LearningWalkSpec::key() const {
-    std::string k = walk_->key() + "learning until: coverage " + format_number(spec_.nav.coverage) + " of " +
-                    format_number(spec_.nav.coverage_cell) + " m cells, " + std::to_string(spec_.nav.goal_visits) +
-                    " visits within " + format_number(spec_.nav.goal_radius) + " m of goals";
+    std::string k = walk_->key();
+    k += "learning until: coverage " + format_number(spec_.nav.coverage) + " of " +
+         format_number(spec_.nav.coverage_cell) + " m cells, " + std::to_string(spec_.nav.goal_visits) +
+         " visits within " + format_number(spec_.nav.goal_radius) + " m of goals";
     for (const NavigationGoal& g : spec_.goals)
-        k += " " + format_number(g.x()) + "," + format_number(g.y()) + (g.dims == 3 ? "," + format_number(g.z()) : "");
+        for (int d = 0; d < g.dims; ++d) {
+            k += d == 0 ? ' ' : ',';
+            k += format_number(g.p[d]);
+        }
     return k + "\n";
 }
 

@@ -106,14 +106,6 @@ namespace {
     throw ConfigError(world.file, key, reason);
 }
 
-std::string point_text(const Vec2& p) {
-    std::string text = "(";  // appended, not "(" + ...: g++ 12 warns falsely on that (-Wrestrict, GCC bug 105329)
-    text += format_number(p.x());
-    text += ", ";
-    text += format_number(p.y());
-    return text + ")";
-}
-
 }  // namespace
 
 void RandomWalk::check_start(const WorldDescription& world, const BodyCollider& body) {

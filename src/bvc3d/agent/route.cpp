@@ -41,8 +41,6 @@ std::string quoted_field(const std::string& field) {
     return out + "'";
 }
 
-std::string point_text(const Vec2& p) { return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ")"; }
-
 // A node of the path, every centimeter or so: where, which way, how fast at most.
 struct Node {
     Vec2 p;

@@ -29,8 +29,6 @@ const params::Table<TourParams>& TourParams::table() {
 
 namespace {
 
-std::string point_text(const Vec2& p) { return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ")"; }
-
 // The walkable region of a drive: the cells where the body fits, in the part holding `start`.
 std::vector<char> walkable_cells(const FreeSpaceGrid& grid, double radius, const Vec2& start) {
     int count = 0;

@@ -9,6 +9,7 @@
 
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/random.hpp"
@@ -227,13 +228,14 @@ void write_trajectory_file(const std::filesystem::path& path, const std::vector<
     bool tilted = false;
     for (const auto& s : steps) tilted = tilted || !s.pose.level();
     AtomicFile file(path);
-    auto& out = file.stream();
-    out << (tilted ? "t,x,y,z,heading,pitch,roll\n" : "t,x,y,z,heading\n");
+    CsvWriter csv(file.stream());
+    csv.field("t").field("x").field("y").field("z").field("heading");
+    if (tilted) csv.field("pitch").field("roll");
+    csv.end_row();
     for (const auto& s : steps) {
-        out << format_number(s.t) << ',' << format_number(s.pose.x) << ',' << format_number(s.pose.y) << ','
-            << format_number(s.pose.z) << ',' << format_number(s.pose.heading);
-        if (tilted) out << ',' << format_number(s.pose.pitch) << ',' << format_number(s.pose.roll);
-        out << '\n';
+        csv.field(s.t).field(s.pose.x).field(s.pose.y).field(s.pose.z).field(s.pose.heading);
+        if (tilted) csv.field(s.pose.pitch).field(s.pose.roll);
+        csv.end_row();
     }
     file.commit();
 }

@@ -4,10 +4,10 @@
 #include <atomic>
 #include <cmath>
 #include <string>
-#include <thread>
 
 #include "bvc3d/analysis/cosine_kernels.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/parallel.hpp"
 
 #if BVC3D_HAVE_DISPATCH
 #include <immintrin.h>  // the kernels' intrinsics
@@ -175,13 +175,12 @@ std::vector<CosineIndex::Best> CosineIndex::search(const float* unit, const std:
     // of their templates and merged in that order: ties still go to the lowest template.
     const auto v = static_cast<std::size_t>(turns.turns), step = turns.inner, period = v * step;
     const std::size_t n_rows = ranges.size() * v, n_blocks = (n_rows + row_block - 1) / row_block;
-    const std::size_t cores =
-        threads > 0 ? static_cast<std::size_t>(threads) : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+    const std::size_t cores = thread_count(threads);
     const std::size_t chunks = n_blocks == 0 ? 1 : std::max<std::size_t>(1, std::min(cores / n_blocks, n_ / 4096));
     std::vector<Best> chunk_best(chunks * n_rows);
     const simd::Isa isa = simd::isa();
     std::atomic<std::size_t> next{0};
-    auto work = [&] {
+    auto work = [&](std::size_t) {
         std::vector<float, CacheAligned<float>> q(row_block * stride_);
         std::vector<float> scores(row_block * template_block);
         for (std::size_t item; (item = next++) < n_blocks * chunks;) {
@@ -224,10 +223,7 @@ std::vector<CosineIndex::Best> CosineIndex::search(const float* unit, const std:
         }
     };
     const std::size_t n_threads = std::max<std::size_t>(1, std::min(n_blocks * chunks, cores));
-    std::vector<std::thread> pool;
-    for (std::size_t k = 1; k < n_threads; ++k) pool.emplace_back(work);
-    work();
-    for (auto& t : pool) t.join();
+    run_workers(n_threads, work);
 
     // Per query: the best over its chunks (in template order) and turns.
     std::vector<Best> out(ranges.size());

@@ -75,6 +75,18 @@ std::vector<FloorLevel> building_floors(const GazeboScene& scene) {
     return levels.empty() ? floor_levels(scene.mesh, skip, options) : levels;
 }
 
+const std::vector<std::string>& missing_models_names() {
+    static const std::vector<std::string> names{"error", "skip"};
+    return names;
+}
+
+MissingModels parse_missing_models(const std::string& text) {
+    const auto& names = missing_models_names();
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (text == names[i]) return static_cast<MissingModels>(i);
+    throw InputError("must be '" + names[0] + "' or '" + names[1] + "', got '" + text + "'");
+}
+
 WorldDescription building_world(const BuildingSpec& spec) {
     GazeboScene scene = load_gazebo_world(spec.file, spec.gazebo);
     const std::string where = "Gazebo world '" + spec.file + "'";
@@ -148,22 +160,30 @@ GazeboOptions gazebo_options_from_yaml(const YamlView& v, BuildingSpec& spec) {
     };
     spec.file = in_yaml_dir(v["sdf"].as_string());
     if (!is_gazebo_file(spec.file)) v["sdf"].fail("must name a Gazebo world file (.world or .sdf)");
-    if (v.has("model_path")) {
-        const YamlView mp = v["model_path"];
-        if (!mp.is_sequence()) mp.fail("must be a list of folders");
-        for (std::size_t i = 0; i < mp.size(); ++i) {
-            const std::string dir = in_yaml_dir(mp.at(i).as_string());
+    // Lists of folders, relative to the YAML, that must exist.
+    const auto folders = [&](const char* key, std::vector<std::string>& out) {
+        if (!v.has(key)) return;
+        const YamlView list = v[key];
+        if (!list.is_sequence()) list.fail("must be a list of folders");
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            const std::string dir = in_yaml_dir(list.at(i).as_string());
             std::error_code ec;
-            if (!fs::is_directory(dir, ec)) mp.at(i).fail("folder '" + dir + "' does not exist");
-            o.model_path.push_back(dir);
+            if (!fs::is_directory(dir, ec)) list.at(i).fail("folder '" + dir + "' does not exist");
+            out.push_back(dir);
         }
-    }
+    };
+    folders("model_path", o.model_path);
+    folders("resource_path", o.resource_path);
     const std::string geometry = v.get("geometry", "visual");
     if (geometry != "visual" && geometry != "collision") v["geometry"].fail("must be 'visual' or 'collision'");
     o.geometry = geometry == "visual" ? GazeboOptions::Geometry::visual : GazeboOptions::Geometry::collision;
-    const std::string missing = v.get("missing_models", "error");
-    if (missing != "error" && missing != "skip") v["missing_models"].fail("must be 'error' or 'skip'");
-    o.skip_missing_models = missing == "skip";
+    if (v.has("missing_models")) try {
+            o.skip_missing_models = parse_missing_models(v["missing_models"].as_string()) == MissingModels::skip;
+        } catch (const ConfigError&) {
+            throw;
+        } catch (const InputError& e) {
+            v["missing_models"].fail(e.what());
+        }
     const std::string up = v.get("collada_up_axis", "ignored");
     if (up != "ignored" && up != "declared") v["collada_up_axis"].fail("must be 'ignored' (as Gazebo) or 'declared'");
     o.collada_up_axis = up == "ignored" ? ColladaUpAxis::ignored : ColladaUpAxis::to_z_up;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "bvc3d/config/yaml_reader.hpp"
 #include "bvc3d/world/floors.hpp"
@@ -21,6 +22,14 @@ namespace bvc3d::config {
 struct StoreyFlight {
     double clearance = 0.2;  // m
 };
+
+// What becomes of a Gazebo world's included models that are not found on the model path: the world is
+// refused (error, the default) or built without them (skip; WorldDescription::left_out names them).
+// The values of a world YAML's `missing_models:` and of the program's --missing-models.
+enum class MissingModels { error, skip };
+const std::vector<std::string>& missing_models_names();  // "error", "skip": in the enum's order
+// InputError "must be 'error' or 'skip', got '...'" for other text.
+MissingModels parse_missing_models(const std::string& text);
 
 struct BuildingSpec {
     std::string file;  // a .world or .sdf file
@@ -41,7 +50,7 @@ WorldDescription building_world(const BuildingSpec& spec);
 // Gazebo's ground plane is a floor only when there is no other.
 std::vector<FloorLevel> building_floors(const GazeboScene& scene);
 
-// A world YAML with an `sdf` key (docs/buildings.md#world-yaml): sdf, model_path, geometry,
+// A world YAML with an `sdf` key (docs/buildings.md#world-yaml): sdf, model_path, resource_path, geometry,
 // missing_models, collada_up_axis, floor_z, step_height, name, start, flight_volume.
 WorldDescription building_from_yaml(const YamlView& v);
 // The files such a YAML's world depends on (for fingerprints): see gazebo_world_files().

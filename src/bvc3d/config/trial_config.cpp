@@ -32,7 +32,7 @@ std::uint64_t text_hash(const std::string& s) {
 WorldDescription WorldSpec::resolve() const {
     if (is_none()) throw InputError("this trial has no world (its returns are recorded data)");
     if (in_memory) throw InputError("world '" + source + "' was built in code: give its preset or file to rebuild it");
-    return config::resolve_world(source, tilt_deg, lean);
+    return config::resolve_world(source, tilt_deg, lean, missing_models);
 }
 
 std::string WorldSpec::label() const {
@@ -62,6 +62,7 @@ std::string WorldSpec::fingerprint() const {
     };
     std::string fp = "file " + std::filesystem::path(source).filename().string() + " " + file_hash(source);
     for (const auto& mesh : config::world_file_meshes(source)) fp += " mesh " + file_hash(mesh);
+    if (missing_models == config::MissingModels::skip) fp += " missing-models skip";  // absent at the default
     return fp;
 }
 

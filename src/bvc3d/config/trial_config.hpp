@@ -12,24 +12,28 @@
 #include "bvc3d/agent/agent.hpp"
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
+#include "bvc3d/config/building.hpp"
 #include "bvc3d/config/model_spec.hpp"
 #include "bvc3d/config/returns_spec.hpp"
 #include "bvc3d/core/params.hpp"
 
 namespace bvc3d {
 
-// A world by name: a preset (with tilt and lean for `cross`) or a YAML file; or none (an empty
-// source: a replay of recorded data).
+// A world by name: a preset (with tilt and lean for `cross`), a YAML file or a Gazebo world file (with
+// what becomes of its missing models); or none (an empty source: a replay of recorded data).
 struct WorldSpec {
     std::string source = "cross";
     std::optional<double> tilt_deg;
     std::string lean = "+x+y";
+    config::MissingModels missing_models = config::MissingModels::error;
 
     // A world built in code (a Python World): its name labels it; it cannot be found again from the spec.
     bool in_memory = false;
 
     static WorldSpec none() { return WorldSpec{"", std::nullopt, "+x+y"}; }
-    static WorldSpec built(const std::string& name) { return WorldSpec{name, std::nullopt, "+x+y", true}; }
+    static WorldSpec built(const std::string& name) {
+        return WorldSpec{name, std::nullopt, "+x+y", config::MissingModels::error, true};
+    }
     bool is_none() const { return source.empty(); }
     WorldDescription resolve() const;  // InputError for none
     // "cross-45", "two-rooms", ...: used in file names and tables.

@@ -18,10 +18,17 @@ WorldSpec world_from(const YamlView& v) {
     if (v.is_scalar()) {
         w.source = path_in_file(v, v.as_string());
     } else {
-        v.expect_map({"source", "tilt_deg", "lean"});
+        v.expect_map({"source", "tilt_deg", "lean", "missing_models"});
         w.source = path_in_file(v, v.get("source", w.source));
         if (v.has("tilt_deg")) w.tilt_deg = v["tilt_deg"].as_double();
         w.lean = v.get("lean", w.lean);
+        if (v.has("missing_models")) try {
+                w.missing_models = parse_missing_models(v["missing_models"].as_string());
+            } catch (const ConfigError&) {
+                throw;
+            } catch (const InputError& e) {
+                v["missing_models"].fail(e.what());
+            }
     }
     try {
         w.resolve();  // check now, with the key in the message
@@ -169,12 +176,15 @@ std::string trial_to_commented_yaml(const TrialConfig& t) {
     const bool preset_world = std::find(presets.begin(), presets.end(), t.world.source) != presets.end();
     out.section("", "world");
     out.line("  ", "source", preset_world ? t.world.source : file_text(t.world.source),
-             "a world preset (" + list(presets) + ") or a world YAML file");
+             "a world preset (" + list(presets) + "), a world YAML file or a Gazebo world (.world, .sdf)");
     if (world_preset_takes_tilt(t.world.source) || t.world.tilt_deg)
         out.line("  ", "tilt_deg", format_number(t.world.tilt_deg.value_or(0.0)),
                  "cross and cross-webots only: degrees the central walls lean");
     if (preset_world && t.world.source.rfind("cross", 0) == 0)
         out.line("  ", "lean", params::CommentedYaml::scalar(t.world.lean), "the corner they lean toward");
+    if (t.world.missing_models != MissingModels::error)
+        out.line("  ", "missing_models", missing_models_names()[static_cast<std::size_t>(t.world.missing_models)],
+                 "a Gazebo world file's models that are not found: error or skip (left out)");
     if (const std::string preset = preset_name_of(t.model); !preset.empty()) {
         out.line("", "model", preset,
                  "a preset (" + list(model_preset_names()) +

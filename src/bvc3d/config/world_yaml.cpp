@@ -331,8 +331,8 @@ bool world_preset_takes_tilt(const std::string& name) {
 WorldDescription world_from_yaml(const YamlView& v) {
     const bool sdf = v.has("sdf");  // a Gazebo building (config/building.hpp)
     if (sdf)
-        v.expect_map({"name", "sdf", "model_path", "geometry", "missing_models", "collada_up_axis", "floor_z",
-                      "step_height", "walkable", "start", "flight_volume"});
+        v.expect_map({"name", "sdf", "model_path", "resource_path", "geometry", "missing_models", "collada_up_axis",
+                      "floor_z", "step_height", "walkable", "start", "flight_volume"});
     else v.expect_map({"name", "objects", "walkable", "start", "flight_volume"});
     WorldDescription w;
     std::optional<WorldDescription> arena;
@@ -418,7 +418,11 @@ std::vector<std::string> world_file_meshes(const std::string& path) {
     return files;
 }
 
-WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean) {
+WorldDescription resolve_world(const std::string& name, std::optional<double> tilt_deg, const std::string& lean,
+                               MissingModels missing) {
+    if (missing == MissingModels::skip && !is_gazebo_file(name))
+        throw InputError("missing models: 'skip' applies to Gazebo world files (.world, .sdf), not to '" + name +
+                         "' (a world YAML with `sdf:` says it with its key missing_models: skip)");
     if (const WorldPreset* preset = find_world_preset(name)) {
         if (preset->fixed_world) {
             if (tilt_deg)
@@ -445,6 +449,7 @@ WorldDescription resolve_world(const std::string& name, std::optional<double> ti
     if (is_gazebo_file(name)) {
         BuildingSpec spec;
         spec.file = name;
+        spec.gazebo.skip_missing_models = missing == MissingModels::skip;
         return building_world(spec);
     }
     return load_world_file(name);
@@ -480,6 +485,14 @@ std::string lidar_model_list(bool quoted = false) {
     return list;
 }
 
+// The paper's scanners: "horizontal, spherical, ..." (quoted: "'horizontal', 'spherical', ...").
+std::string scanner_list(bool quoted = false) {
+    std::string list;
+    for (const auto& [name, spec] : builtin_sensors())
+        if (!find_lidar_model(name)) list += (list.empty() ? "" : ", ") + (quoted ? "'" + name + "'" : name);
+    return list;
+}
+
 // The rows an upper-half model keeps of a beam table: elevations >= 0 (as `keep_rows: upper` of the
 // spherical scanner).
 LidarSpec upper_rows(LidarSpec s) {
@@ -489,12 +502,17 @@ LidarSpec upper_rows(LidarSpec s) {
 
 }  // namespace
 
+std::vector<std::string> sensor_preset_names() {
+    std::vector<std::string> names;
+    for (const auto& [name, spec] : builtin_sensors()) names.push_back(name);
+    return names;
+}
+
 LidarSpec sensor_from_yaml(const YamlView& v) {
     if (v.is_scalar()) {
         const std::string name = v.as_string();
         if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
-        v.fail("expected horizontal, spherical, spherical-full, spherical-authors, a LiDAR model (" +
-               lidar_model_list() + "), or a sensor mapping");
+        v.fail("expected " + scanner_list() + ", a LiDAR model (" + lidar_model_list() + "), or a sensor mapping");
     }
     if (!v.is_map()) v.fail("expected horizontal, spherical, or a sensor mapping (or a LiDAR model's name)");
     const std::string preset = v.get("preset", "");
@@ -549,10 +567,8 @@ LidarSpec resolve_sensor(const std::string& name) {
     if (const LidarSpec* s = find_builtin_sensor(name)) return *s;
     std::error_code ec;
     if (!std::filesystem::exists(name, ec))
-        throw InputError(
-            "sensor '" + name +
-            "' is neither 'horizontal', 'spherical', 'spherical-full', 'spherical-authors', a LiDAR model (" +
-            lidar_model_list(true) + ") nor an existing YAML file");
+        throw InputError("sensor '" + name + "' is neither " + scanner_list(true) + ", a LiDAR model (" +
+                         lidar_model_list(true) + ") nor an existing YAML file");
     const YamlView v = YamlView::load_file(name);
     return sensor_from_yaml(v.has("sensor") ? v["sensor"] : v);
 }

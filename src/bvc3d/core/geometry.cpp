@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "bvc3d/core/format.hpp"
+
 namespace bvc3d {
 
 Pose Pose::from_rotation(const Vec3& p, const Eigen::Matrix3d& R) {
@@ -21,6 +23,14 @@ Eigen::Matrix3d Pose::rotation() const {
     return (Eigen::AngleAxisd(heading, Vec3::UnitZ()) * Eigen::AngleAxisd(-pitch, Vec3::UnitY()) *
             Eigen::AngleAxisd(roll, Vec3::UnitX()))
         .toRotationMatrix();
+}
+
+std::string point_text(const Vec2& p) {
+    std::string text = "(";  // appended, not "(" + ...: g++ 12 warns falsely on that (-Wrestrict, GCC bug 105329)
+    text += format_number(p.x());
+    text += ", ";
+    text += format_number(p.y());
+    return text + ")";
 }
 
 }  // namespace bvc3d

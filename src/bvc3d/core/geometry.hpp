@@ -3,6 +3,7 @@
 // (x east, y north, z up; docs/model-reference.md#conventions).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <string>
 
 namespace bvc3d {
 
@@ -26,5 +27,8 @@ struct Pose {
     bool finite() const;
     Eigen::Matrix3d rotation() const;
 };
+
+// "(x, y)" with each number as format_number writes it, for messages that name a point.
+std::string point_text(const Vec2& p);
 
 }  // namespace bvc3d

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -12,8 +11,10 @@
 
 #include "bvc3d/agent/trajectory.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/parallel.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 
@@ -235,7 +236,8 @@ std::vector<CandidateScore> score_elevation_sets(const World* world, const Model
                                                  const std::vector<std::vector<double>>& sets, int budget,
                                                  std::uint64_t seed, const analysis::AnalysisParams& analysis, int jobs,
                                                  const SourceFactory& sources, const std::atomic<bool>* stop) {
-    if (jobs < 0) throw InputError("jobs must be >= 0");
+    // Slice k holds sets k, k + slices, ...: one group each, sharing its scans between its sets.
+    const std::size_t slices = std::clamp<std::size_t>(thread_count(jobs), 1, std::max<std::size_t>(sets.size(), 1));
     if (walk.steps.size() < 2) throw InputError("the exploratory walk needs at least 2 steps");
     std::vector<TrialConfig> trials;
     const auto agent = two_passes(walk.steps, walk.dims);
@@ -251,39 +253,22 @@ std::vector<CandidateScore> score_elevation_sets(const World* world, const Model
         trials.push_back(std::move(t));
     }
     const std::uint64_t noise_seed = hash_u64(seed, static_cast<std::uint64_t>(Stream::sensor_noise), 0);
-    const std::size_t threads = std::clamp<std::size_t>(
-        static_cast<std::size_t>(jobs > 0 ? jobs : std::max(1u, std::thread::hardware_concurrency())), 1,
-        std::max<std::size_t>(sets.size(), 1));
     std::vector<CandidateScore> out(sets.size());
-    std::vector<std::exception_ptr> errors(threads);
-    // Thread k runs sets k, k + threads, ...: one group each, sharing its scans between its sets.
-    auto work = [&](std::size_t k) {
-        try {
-            std::vector<TrialConfig> mine;
-            std::vector<std::size_t> index;
-            for (std::size_t i = k; i < trials.size(); i += threads) {
-                mine.push_back(trials[i]);
-                index.push_back(i);
-            }
-            if (mine.empty()) return;
-            RunControl control;
-            control.stop = stop;
-            const GroupResult r =
-                run_trial_group(world, mine, control, replay_factory(sources, walk.steps.size(), noise_seed));
-            for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(world, r, m, mine[m]);
-        } catch (...) {
-            errors[k] = std::current_exception();
+    const CancelScope scope(stop ? stop : cancel_flag());
+    parallel_for(slices, static_cast<int>(slices), [&](std::size_t k) {
+        std::vector<TrialConfig> mine;
+        std::vector<std::size_t> index;
+        for (std::size_t i = k; i < trials.size(); i += slices) {
+            mine.push_back(trials[i]);
+            index.push_back(i);
         }
-    };
-    if (threads == 1) {
-        work(0);
-    } else {
-        std::vector<std::thread> pool;
-        for (std::size_t k = 0; k < threads; ++k) pool.emplace_back(work, k);
-        for (auto& th : pool) th.join();
-    }
-    for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
+        if (mine.empty()) return;
+        RunControl control;
+        control.stop = cancel_flag();  // the pool's: Ctrl-C, or another slice's error
+        const GroupResult r =
+            run_trial_group(world, mine, control, replay_factory(sources, walk.steps.size(), noise_seed));
+        for (std::size_t m = 0; m < mine.size(); ++m) out[index[m]] = score(world, r, m, mine[m]);
+    });
     return out;
 }
 

@@ -8,10 +8,11 @@
 #include <map>
 #include <mutex>
 #include <set>
-#include <thread>
 
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/parallel.hpp"
 #include "bvc3d/experiment/pipeline.hpp"
 
 namespace bvc3d {
@@ -65,7 +66,7 @@ public:
         trials_.fetch_add(1);
         if (style_ == ProgressStyle::lines) line(name);
     }
-    // From the watcher thread, every fraction of a second.
+    // From the thread that waits for the workers, every fraction of a second.
     void tick() {
         if (style_ == ProgressStyle::terminal) {
             terminal(false);
@@ -127,7 +128,7 @@ private:
     std::atomic<double> seconds_{0};
     std::atomic<std::int64_t> steps_{0}, model_steps_{0}, live_model_steps_{0};
     std::atomic<int> trials_{0};
-    int printed_tenth_ = 0;  // the watcher's
+    int printed_tenth_ = 0;  // the waiting thread's
     std::mutex mutex_;
 };
 
@@ -206,7 +207,7 @@ double estimate_memory(const std::vector<TrialConfig>& trials, int jobs) {
     std::vector<double> sizes;
     for (const auto& [key, group] : groups) sizes.push_back(group_memory(group));
     std::sort(sizes.begin(), sizes.end(), std::greater<>());
-    const auto threads = static_cast<std::size_t>(jobs > 0 ? jobs : std::max(1u, std::thread::hardware_concurrency()));
+    const std::size_t threads = thread_count(jobs);
     double total = 0;
     for (std::size_t i = 0; i < std::min(threads, sizes.size()); ++i) total += sizes[i];
     return total;
@@ -242,7 +243,7 @@ private:
     void check_trials() const;
     bool complete(std::size_t i) const { return trial_file_complete(files_[i], trials_[i]); }
     std::vector<std::size_t> unfinished_groups(int& complete_before) const;
-    void run_group(const Group& g);
+    void run_group(const Group& g, const std::atomic<bool>* stop);
     void work();
 
     const std::vector<TrialConfig>& trials_;
@@ -253,10 +254,7 @@ private:
     std::vector<Group> groups_;
     std::vector<std::size_t> pending_;  // indices into groups_, as the root dealt them
     std::unique_ptr<Progress> progress_;
-    std::atomic<bool> interrupted_{false}, failed_{false}, stop_all_{false};
     std::atomic<int> ran_{0};
-    std::exception_ptr error_;
-    std::mutex error_mutex_;
 };
 
 void ExperimentRun::check_trials() const {
@@ -282,7 +280,7 @@ std::vector<std::size_t> ExperimentRun::unfinished_groups(int& complete_before) 
     return pending;
 }
 
-void ExperimentRun::run_group(const Group& g) {
+void ExperimentRun::run_group(const Group& g, const std::atomic<bool>* stop) {
     // Only the members whose files are missing run; they still share the agent.
     std::vector<TrialConfig> members;
     std::vector<std::filesystem::path> paths;
@@ -293,7 +291,7 @@ void ExperimentRun::run_group(const Group& g) {
         }
     if (members.empty()) return;
     RunControl control;
-    control.stop = &stop_all_;
+    control.stop = stop;
     control.checkpoint = ckpt_dir_ / (g.key + ".h5");
     control.checkpoint_minutes = options_.checkpoint_minutes;
     double last = 0;
@@ -313,22 +311,18 @@ void ExperimentRun::run_group(const Group& g) {
     progress_->add_steps(done.result.stats.explore_steps + done.result.stats.sample_steps, n_models);
 }
 
-// A worker thread: groups from the coordinator until none is left, or until a stop or an error.
+// A worker: groups from the coordinator until none is left, or until the pool is cancelled (Ctrl-C or
+// another worker's error). Only the trial runner stops a group, checkpointing first: an analysis under
+// way finishes and its file is written.
 void ExperimentRun::work() {
-    while (!stop_all_.load()) {
+    const std::atomic<bool>* stop = cancel_flag();  // the pool's
+    for (;;) {
+        if (stop->load()) throw Interrupted();
         const auto g = coord_.next();
         if (!g) return;
-        try {
-            run_group(groups_[pending_[*g]]);
-        } catch (const Interrupted&) {
-            interrupted_ = true;
-        } catch (...) {
-            std::lock_guard lock(error_mutex_);
-            if (!error_) error_ = std::current_exception();
-            failed_ = true;
-        }
+        const CancelScope only_the_runner(nullptr);
+        run_group(groups_[pending_[*g]], stop);
     }
-    if (stop_all_.load()) interrupted_ = true;
 }
 
 ExperimentOutcome ExperimentRun::run() {
@@ -355,26 +349,20 @@ ExperimentOutcome ExperimentRun::run() {
     progress_ = std::make_unique<Progress>(coord_.is_root() ? options_.progress : ProgressStyle::none, todo_trials,
                                            total_seconds);
     {
-        // Stop everything on Ctrl-C or on the first error.
-        std::jthread watcher([&](std::stop_token st) {
-            while (!st.stop_requested()) {
-                if ((options_.stop && options_.stop->load()) || failed_.load()) stop_all_ = true;
-                progress_->tick();
-                std::this_thread::sleep_for(std::chrono::milliseconds(200));
-            }
-        });
-        // More threads than groups would only wait.
-        const int jobs = static_cast<int>(
-            std::min<std::size_t>(options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency()),
-                                  std::max<std::size_t>(pending_.size(), 1)));
-        {
-            std::vector<std::jthread> workers;
-            for (int j = 0; j < jobs; ++j) workers.emplace_back([this] { work(); });
+        // Ctrl-C (options_.stop) or the first error stops every worker; more threads than groups would only wait.
+        const CancelScope scope(options_.stop ? options_.stop : cancel_flag());
+        ParallelOptions parallel;
+        parallel.tick = [this] { progress_->tick(); };
+        const std::size_t threads = std::min(thread_count(options_.jobs), std::max<std::size_t>(pending_.size(), 1));
+        try {
+            run_workers(
+                threads, [this](std::size_t) { work(); }, parallel);
+        } catch (...) {
+            coord_.finish();
+            throw;
         }
         coord_.finish();
     }
-    if (error_) std::rethrow_exception(error_);
-    if (interrupted_ && !failed_) throw Interrupted();
     progress_->finish();
     std::error_code ec;
     std::filesystem::remove(ckpt_dir_, ec);  // only if empty

@@ -4,16 +4,15 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <mutex>
 #include <numeric>
-#include <thread>
 
 #include "bvc3d/config/model_yaml.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/parallel.hpp"
 #include "bvc3d/core/random.hpp"
 #include "bvc3d/place/place_cell_network.hpp"
 
@@ -172,28 +171,6 @@ Descriptions descriptions_for(const std::vector<DescriptorSpec>& descriptors) {
     return d;
 }
 
-// Runs `work(thread)` on `n` threads; rethrows the first exception (the others stop at their next scan).
-template <class F>
-void on_threads(std::size_t n, F work) {
-    const auto* flag = cancel_flag();
-    std::exception_ptr error;
-    std::mutex m;
-    auto guarded = [&](std::size_t t) {
-        const CancelScope scope(flag);
-        try {
-            work(t);
-        } catch (...) {
-            std::lock_guard lock(m);
-            if (!error) error = std::current_exception();
-        }
-    };
-    std::vector<std::thread> pool;
-    for (std::size_t t = 1; t < n; ++t) pool.emplace_back(guarded, t);
-    guarded(0);
-    for (auto& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
-}
-
 }  // namespace
 
 std::vector<double> scan_times(const ScanSequence& seq) {
@@ -237,7 +214,7 @@ void describe_scans(const ScanSequence& seq, const std::vector<double>& heading,
     d.context_seconds.assign(threads, 0.0);
     std::atomic<std::size_t> next{0}, done{0};
     std::mutex progress_lock;
-    on_threads(threads, [&](std::size_t t) {
+    run_workers(threads, [&](std::size_t t) {
         std::vector<BoundaryVectorLayer> layers;
         for (const auto& s : d.streams) layers.emplace_back(s.model.bvc);
         Scan returns;
@@ -322,8 +299,7 @@ PlaceRecognitionOutcome run_place_recognition(const ScanSequence& seq, const std
     out.drift = heading_drift(out.times, deg_to_rad(o.drift_deg_per_sqrt_min), o.seed);
 
     Descriptions d = descriptions_for(descriptors);
-    const std::size_t cores = o.threads > 0 ? static_cast<std::size_t>(o.threads)
-                                            : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+    const std::size_t cores = thread_count(o.threads);
     const auto start = Clock::now();
     describe_scans(seq, out.heading, out.drift, o, std::max<std::size_t>(1, std::min(n, cores)), d);
     out.describe_wall_seconds = since(start);

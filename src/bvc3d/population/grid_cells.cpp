@@ -2,15 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/random.hpp"
 
 namespace bvc3d {
 
 namespace {
-constexpr double pi = std::numbers::pi;
 constexpr std::uint64_t phase_tag = 0x6772696470686173;  // the phases' shift: hash(seed, tag, 0)
 constexpr std::uint64_t noise_tag = 0x677269646e6f6973;  // path noise: hash(seed ^ tag, step, axis·2 + draw)
 }  // namespace

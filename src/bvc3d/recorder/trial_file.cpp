@@ -181,6 +181,17 @@ std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path) {
     return stamp;
 }
 
+bool is_trial_file(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return false;
+    try {
+        auto lock = h5::hdf5_lock();
+        return h5::read_attr_string(h5::open_file(path.string()), "format") == "bvc3d-trial";
+    } catch (const InputError&) {
+        return false;
+    }
+}
+
 namespace {
 
 // Reading a trial file: every error names the file and the dataset or attribute.

@@ -79,6 +79,8 @@ struct TrialStamp {
     bool navigation = false;  // it holds /navigation (a navigation trial's episodes)
 };
 std::optional<TrialStamp> read_trial_stamp(const std::filesystem::path& path);
+// Whether `path` is a trial file (an HDF5 file whose root says format bvc3d-trial), whole or not.
+bool is_trial_file(const std::filesystem::path& path);
 
 // What `bvc3d analyze` reads back. Reading checks what it reads: errors (InputError) name the file
 // and the dataset or attribute — missing, of the wrong type or shape, non-finite positions or rates,

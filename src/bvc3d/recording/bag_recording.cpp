@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string secs(double t) {
+std::string stamp_text(double t) {
     char s[40];
     std::snprintf(s, sizeof s, "%.9f s", t);
     return s;
@@ -97,8 +97,8 @@ std::vector<PoseRecord> topic_poses(const BagReader& bag, const std::string& top
             throw InputError(bag.where(t, k) + ": " + e.what());
         }
         if (k > 0 && !(s.stamp > *poses[k - 1].time))
-            throw InputError(bag.where(t, k) + ": its stamp " + secs(s.stamp) + " does not follow the previous " +
-                             secs(*poses[k - 1].time) + " (stamps out of order)");
+            throw InputError(bag.where(t, k) + ": its stamp " + stamp_text(s.stamp) + " does not follow the previous " +
+                             stamp_text(*poses[k - 1].time) + " (stamps out of order)");
     }
     if (poses.empty()) throw InputError(quoted_path(bag.path()) + ", topic '" + topic + "' has no messages");
     return poses;
@@ -192,8 +192,8 @@ Recording open_bag_recording(std::shared_ptr<const BagReader> bag, const BagSour
         headers.push_back(message_header(*bag, t, k));
         const double stamp = headers.back().stamp;
         if (k > 0 && !(stamp > headers[k - 1].stamp))
-            throw InputError(bag->where(t, k) + ": its stamp " + secs(stamp) +
-                             " does not follow the previous cloud's " + secs(headers[k - 1].stamp) +
+            throw InputError(bag->where(t, k) + ": its stamp " + stamp_text(stamp) +
+                             " does not follow the previous cloud's " + stamp_text(headers[k - 1].stamp) +
                              " (stamps out of order)");
         r.scans.push_back({source.bag, stamp});
     }
@@ -213,7 +213,7 @@ Recording open_bag_recording(std::shared_ptr<const BagReader> bag, const BagSour
                 p.time = headers[k].stamp;
                 poses.push_back(p);
             } catch (const InputError& e) {
-                throw InputError(bag->where(t, k) + " (stamp " + secs(headers[k].stamp) + "): " + e.what());
+                throw InputError(bag->where(t, k) + " (stamp " + stamp_text(headers[k].stamp) + "): " + e.what());
             }
         }
         if (options.base_from_sensor) apply_extrinsics(poses, *options.base_from_sensor);

@@ -228,7 +228,7 @@ PcdData parse_data(const fs::path& file, const HeaderEntry& data) {
                       "unknown DATA encoding " + quote_token(value) + ": expected ascii, binary or binary_compressed");
 }
 
-PcdHeader parse_header(const fs::path& file, std::string_view bytes) {
+PcdHeader parse_pcd_header(const fs::path& file, std::string_view bytes) {
     const RawHeader raw = read_raw_header(file, bytes);
     required(file, raw.fields, "FIELDS");
     required(file, raw.size, "SIZE");
@@ -426,7 +426,7 @@ void append_points(const fs::path& file, std::string& out, const PointCloud& clo
 
 PointCloud read_pcd(const fs::path& file) {
     const std::string bytes = read_file(file);
-    const PcdHeader header = parse_header(file, bytes);
+    const PcdHeader header = parse_pcd_header(file, bytes);
     switch (header.data) {
         case PcdData::ascii:
             return read_ascii(file, bytes, header);

@@ -202,7 +202,7 @@ void find_vertices(const fs::path& file, PlyHeader& header) {
         header.xyz[axis] = find_coordinate(file, header.elements[*vertex], std::string_view("xyz").substr(axis, 1));
 }
 
-PlyHeader parse_header(const fs::path& file, std::string_view bytes) {
+PlyHeader parse_ply_header(const fs::path& file, std::string_view bytes) {
     LineCursor lines(bytes);
     std::string_view line;
     if (!lines.next(line) || trim(line) != "ply")
@@ -413,7 +413,7 @@ std::string header_text(std::size_t vertices, PlyEncoding encoding, PlyPrecision
 
 PointCloud read_ply(const fs::path& file) {
     const std::string bytes = read_file(file);
-    const PlyHeader header = parse_header(file, bytes);
+    const PlyHeader header = parse_ply_header(file, bytes);
     return header.encoding == PlyEncoding::ascii ? read_ascii(file, bytes, header) : read_binary(file, bytes, header);
 }
 

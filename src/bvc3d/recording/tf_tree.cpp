@@ -10,7 +10,7 @@ namespace bvc3d::recording {
 
 namespace {
 
-std::string secs(double t) {
+std::string time_text(double t) {
     char s[40];
     std::snprintf(s, sizeof s, "%.9g s", t);
     return s;
@@ -21,11 +21,11 @@ std::string secs(double t) {
 void TfTree::add(const StampedTransform& t, bool is_static) {
     const std::string child(bare_frame(t.child)), parent(bare_frame(t.parent));
     if (child.empty() || parent.empty())
-        throw InputError("a tf transform at " + secs(t.stamp) + " has an empty frame name (parent '" + parent +
+        throw InputError("a tf transform at " + time_text(t.stamp) + " has an empty frame name (parent '" + parent +
                          "', child '" + child + "')");
     if (child == parent) throw InputError("a tf transform links frame '" + child + "' to itself");
     if (!std::isfinite(t.stamp) || !t.translation.allFinite())
-        throw InputError("the tf transform " + parent + " → " + child + " at " + secs(t.stamp) +
+        throw InputError("the tf transform " + parent + " → " + child + " at " + time_text(t.stamp) +
                          " has a non-finite value");
     Sample s{t.stamp, t.translation, checked_rotation(t.rotation)};
     auto [it, fresh] = links_.try_emplace(child);
@@ -68,22 +68,23 @@ Eigen::Isometry3d TfTree::at(const std::string& child, const Link& link, double 
     if (after != v.end() && after->stamp == time) return make(after->translation, after->rotation);
     if (after == v.begin()) {
         if (after->stamp - time > tolerance)
-            throw InputError(name + " starts at " + secs(after->stamp) + ", " + secs(after->stamp - time) +
-                             " after the time " + secs(time) + " (tf tolerance " + secs(tolerance) + ")");
+            throw InputError(name + " starts at " + time_text(after->stamp) + ", " + time_text(after->stamp - time) +
+                             " after the time " + time_text(time) + " (tf tolerance " + time_text(tolerance) + ")");
         return make(after->translation, after->rotation);
     }
     const Sample& a = *(after - 1);
     if (after == v.end()) {
         if (time - a.stamp > tolerance || !hold_ends)
-            throw InputError(name + " ends at " + secs(a.stamp) + ", " + secs(time - a.stamp) + " before the time " +
-                             secs(time) + " (tf tolerance " + secs(tolerance) + ")");
+            throw InputError(name + " ends at " + time_text(a.stamp) + ", " + time_text(time - a.stamp) +
+                             " before the time " + time_text(time) + " (tf tolerance " + time_text(tolerance) + ")");
         return make(a.translation, a.rotation);
     }
     const Sample& b = *after;
     const double gap = b.stamp - a.stamp;
     if (gap > tolerance)
-        throw InputError(name + " has a gap of " + secs(gap) + " (from " + secs(a.stamp) + " to " + secs(b.stamp) +
-                         ") around the time " + secs(time) + ", more than the tf tolerance " + secs(tolerance));
+        throw InputError(name + " has a gap of " + time_text(gap) + " (from " + time_text(a.stamp) + " to " +
+                         time_text(b.stamp) + ") around the time " + time_text(time) + ", more than the tf tolerance " +
+                         time_text(tolerance));
     const double s = (time - a.stamp) / gap;
     return make(a.translation + s * (b.translation - a.translation), a.rotation.slerp(s, b.rotation));
 }

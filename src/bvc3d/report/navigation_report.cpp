@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/error.hpp"
-#include "bvc3d/core/format.hpp"
 #include "bvc3d/navigation/failure_class.hpp"
 
 namespace bvc3d {
@@ -22,16 +22,9 @@ double quantile(std::vector<double> v, double q) {
 
 namespace {
 
-std::string num(double v) { return format_number(v); }
-
-// "x,y" or "x,y,z" of point i of `v` (points of `dims` numbers).
-std::string point(const std::vector<double>& v, std::size_t i, int dims) {
-    std::string s;
-    for (int d = 0; d < dims; ++d) {
-        if (d) s += ',';
-        s += num(v[i * std::size_t(dims) + std::size_t(d)]);
-    }
-    return s;
+// The fields x, y (and z when `dims` is 3) of point i of `v` (points of `dims` numbers).
+void point(CsvWriter& w, const std::vector<double>& v, std::size_t i, int dims) {
+    for (int d = 0; d < dims; ++d) w.field(v[i * std::size_t(dims) + std::size_t(d)]);
 }
 
 }  // namespace
@@ -59,13 +52,23 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
                                    r.goals.begin() + std::ptrdiff_t(g + 1) * r.dims);
     };
 
-    AtomicFile starts(folder / "starts.csv"), paths(folder / "paths.csv"), maps(folder / "reward_map.csv"),
-        learning(folder / "learning.csv");
-    starts.stream() << "world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s"
-                    << (flying ? ",goal_z,start_z" : "") << ",failure\n";
-    paths.stream() << "model,seed,start,x,y" << (flying ? ",z\n" : "\n");
-    maps.stream() << "model,seed,goal,x,y,reward\n";
-    learning.stream() << "model,seed,learn_s,coverage,goal,visits,goal_cell\n";
+    AtomicFile starts_file(folder / "starts.csv"), paths_file(folder / "paths.csv"),
+        maps_file(folder / "reward_map.csv"), learning_file(folder / "learning.csv");
+    CsvWriter starts(starts_file.stream()), paths(paths_file.stream()), maps(maps_file.stream()),
+        learning(learning_file.stream());
+    // A flying run (goals x,y,z) adds goal_z,start_z (before failure) to starts.csv, z to paths.csv and goal_z to
+    // summary.csv.
+    if (flying) {
+        starts.row("world", "model", "seed", "goal_x", "goal_y", "start_x", "start_y", "success", "path_m",
+                   "shortest_m", "path_ratio", "time_s", "goal_z", "start_z", "failure");
+        paths.row("model", "seed", "start", "x", "y", "z");
+    } else {
+        starts.row("world", "model", "seed", "goal_x", "goal_y", "start_x", "start_y", "success", "path_m",
+                   "shortest_m", "path_ratio", "time_s", "failure");
+        paths.row("model", "seed", "start", "x", "y");
+    }
+    maps.row("model", "seed", "goal", "x", "y", "reward");
+    learning.row("model", "seed", "learn_s", "coverage", "goal", "visits", "goal_cell");
 
     // A row of the summary per world, model and goal, in the order they first appear.
     struct Cell {
@@ -83,43 +86,49 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
     };
     for (const NavigationTrial& t : trials) {
         const NavigationRecord& r = t.record;
-        const std::string who = t.model + ',' + std::to_string(t.seed);
         for (std::size_t g = 0; g < r.n_goals(); ++g) {
-            learning.stream() << who << ',' << num(r.learn_s) << ',' << num(r.coverage) << ',' << g << ','
-                              << r.visits[g] << ',' << r.goal_cells[g] << '\n';
+            learning.row(t.model, t.seed, r.learn_s, r.coverage, g, r.visits[g], r.goal_cells[g]);
             Cell& c = cell_of(t, g);
             c.learn_s.push_back(r.learn_s);
             ++c.seeds;
             const std::size_t n_points = r.map_points.size() / 2;
-            for (std::size_t k = 0; k < n_points; ++k)
-                maps.stream() << who << ',' << g << ',' << point(r.map_points, k, 2) << ','
-                              << num(r.map_reward[g * n_points + k]) << '\n';
+            for (std::size_t k = 0; k < n_points; ++k) {
+                maps.field(t.model).field(t.seed).field(g);
+                point(maps, r.map_points, k, 2);
+                maps.field(r.map_reward[g * n_points + k]).end_row();
+            }
         }
         for (std::size_t i = 0; i < r.n_starts(); ++i) {
             const auto g = std::size_t(r.start_goal[i]);
             const auto goal = goal_of(r, g);
             const double ratio = r.path_m[i] / r.shortest_m[i];
-            starts.stream() << t.world << ',' << who << ',' << num(goal[0]) << ',' << num(goal[1]) << ','
-                            << num(r.start[i * std::size_t(dims)]) << ',' << num(r.start[i * std::size_t(dims) + 1])
-                            << ',' << r.success[i] << ',' << num(r.path_m[i]) << ',' << num(r.shortest_m[i]) << ','
-                            << num(ratio) << ',' << num(r.time_s[i]);
-            if (flying) starts.stream() << ',' << num(goal[2]) << ',' << num(r.start[i * 3 + 2]);
+            starts.field(t.world).field(t.model).field(t.seed).field(goal[0]).field(goal[1]);
+            starts.field(r.start[i * std::size_t(dims)]).field(r.start[i * std::size_t(dims) + 1]).field(r.success[i]);
+            starts.field(r.path_m[i]).field(r.shortest_m[i]).field(ratio).field(r.time_s[i]);
+            if (flying) starts.field(goal[2]).field(r.start[i * 3 + 2]);
             // Why it failed: empty when it arrived, and in files written before the classes existed.
-            starts.stream() << ',' << (i < r.failure.size() ? to_string(FailureClass(r.failure[i])) : "") << '\n';
-            for (std::uint64_t k = r.path_start[i]; k < r.path_start[i + 1]; ++k)
-                paths.stream() << who << ',' << i << ',' << point(r.path, k, dims) << '\n';
+            starts.field(i < r.failure.size() ? to_string(FailureClass(r.failure[i])) : std::string());
+            starts.end_row();
+            for (std::uint64_t k = r.path_start[i]; k < r.path_start[i + 1]; ++k) {
+                paths.field(t.model).field(t.seed).field(i);
+                point(paths, r.path, k, dims);
+                paths.end_row();
+            }
             Cell& c = cell_of(t, g);
             ++c.tried;
             if (r.success[i]) ++c.reached, c.ratios.push_back(ratio);
         }
     }
 
-    AtomicFile csv(folder / "summary.csv"), md(folder / "summary.md");
+    AtomicFile csv_file(folder / "summary.csv"), md(folder / "summary.md");
+    CsvWriter csv(csv_file.stream());
     int n_seeds = 0;
     for (const Cell& c : cells) n_seeds = std::max(n_seeds, c.seeds);
-    csv.stream() << "world,model,goal_x,goal_y,seeds,starts,success_rate,path_ratio_median,path_ratio_q25,"
-                    "path_ratio_q75,learn_h_mean"
-                 << (flying ? ",goal_z\n" : "\n");
+    for (const char* name : {"world", "model", "goal_x", "goal_y", "seeds", "starts", "success_rate",
+                             "path_ratio_median", "path_ratio_q25", "path_ratio_q75", "learn_h_mean"})
+        csv.field(name);
+    if (flying) csv.field("goal_z");
+    csv.end_row();
     md.stream()
         << "# Navigation: " << trials.front().world << ", " << n_seeds << " learning run(s) per model\n\n"
         << "| model | goal | starts | success | path ratio median [q25, q75] (successes) | learning h (mean) |\n"
@@ -129,11 +138,10 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
         for (double s : c.learn_s) mean_learn += s / 3600 / double(c.learn_s.size());
         const double rate = c.tried ? double(c.reached) / c.tried : 0.0;
         const double med = quantile(c.ratios, 0.5), q25 = quantile(c.ratios, 0.25), q75 = quantile(c.ratios, 0.75);
-        csv.stream() << c.world << ',' << c.model << ',' << num(c.goal[0]) << ',' << num(c.goal[1]) << ',' << c.seeds
-                     << ',' << c.tried << ',' << num(rate) << ',' << num(med) << ',' << num(q25) << ',' << num(q75)
-                     << ',' << num(mean_learn);
-        if (flying) csv.stream() << ',' << num(c.goal[2]);
-        csv.stream() << '\n';
+        csv.field(c.world).field(c.model).field(c.goal[0]).field(c.goal[1]).field(c.seeds).field(c.tried);
+        csv.field(rate).field(med).field(q25).field(q75).field(mean_learn);
+        if (flying) csv.field(c.goal[2]);
+        csv.end_row();
         char where[96], line[256];
         if (flying) std::snprintf(where, sizeof where, "(%g, %g, %g)", c.goal[0], c.goal[1], c.goal[2]);
         else std::snprintf(where, sizeof where, "(%g, %g)", c.goal[0], c.goal[1]);
@@ -141,7 +149,7 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
                       100 * rate, med, q25, q75, mean_learn);
         md.stream() << "| " << c.model << (cells.front().world == c.world ? "" : " (" + c.world + ")") << " " << line;
     }
-    for (AtomicFile* f : {&starts, &paths, &maps, &learning, &csv, &md}) f->commit();
+    for (AtomicFile* f : {&starts_file, &paths_file, &maps_file, &learning_file, &csv_file, &md}) f->commit();
 }
 
 }  // namespace bvc3d

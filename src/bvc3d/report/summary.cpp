@@ -10,6 +10,7 @@
 #include "bvc3d/analysis/metrics.hpp"
 #include "bvc3d/analysis/trial_metrics.hpp"
 #include "bvc3d/core/atomic_file.hpp"
+#include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/format.hpp"
 
 namespace bvc3d {
@@ -40,14 +41,6 @@ std::string swept_value(const Row& r, const std::string& key) {
     for (const auto& [k, v] : r.swept)
         if (k == key) return v;
     return "";
-}
-
-// CSV fields with commas or quotes are quoted.
-std::string csv(const std::string& s) {
-    if (s.find_first_of(",\"\n") == std::string::npos) return s;
-    std::string q = "\"";
-    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
 }
 
 }  // namespace
@@ -170,20 +163,20 @@ std::vector<SummaryRow> summarize(const std::vector<TrialSummaryRow>& trials) {
 
 void write_summary_csv(const std::filesystem::path& path, const std::vector<SummaryRow>& rows) {
     AtomicFile f(path);
-    auto& os = f.stream();
+    CsvWriter csv(f.stream());
     const auto keys = swept_keys(rows);
-    os << "condition,model,world,tilt_deg";
-    for (const auto& k : keys) os << ',' << csv("swept:" + k);
-    os << ",n_seeds";
+    csv.field("condition").field("model").field("world").field("tilt_deg");
+    for (const auto& k : keys) csv.field("swept:" + k);
+    csv.field("n_seeds");
     if (!rows.empty())
-        for (const auto& m : rows.front().metric_names) os << ',' << m << "_mean," << m << "_sd";
-    os << '\n';
+        for (const auto& m : rows.front().metric_names) csv.field(m + "_mean").field(m + "_sd");
+    csv.end_row();
     for (const auto& r : rows) {
-        os << csv(r.condition) << ',' << csv(r.model) << ',' << csv(r.world) << ',' << num(r.tilt_deg);
-        for (const auto& k : keys) os << ',' << csv(swept_value(r, k));
-        os << ',' << r.n_seeds;
-        for (std::size_t m = 0; m < r.mean.size(); ++m) os << ',' << num(r.mean[m]) << ',' << num(r.sd[m]);
-        os << '\n';
+        csv.field(r.condition).field(r.model).field(r.world).field(r.tilt_deg);
+        for (const auto& k : keys) csv.field(swept_value(r, k));
+        csv.field(r.n_seeds);
+        for (std::size_t m = 0; m < r.mean.size(); ++m) csv.field(r.mean[m]).field(r.sd[m]);
+        csv.end_row();
     }
     f.commit();
 }
@@ -239,21 +232,20 @@ void write_summary_markdown(const std::filesystem::path& path, const std::vector
 
 void write_trials_csv(const std::filesystem::path& path, const std::vector<TrialSummaryRow>& trials) {
     AtomicFile f(path);
-    auto& os = f.stream();
+    CsvWriter csv(f.stream());
     const auto keys = swept_keys(trials);
-    os << "name,condition,model,world,tilt_deg";
-    for (const auto& k : keys) os << ',' << csv("swept:" + k);
-    os << ",seed,protocol,explore_hours,sample_hours";
+    csv.field("name").field("condition").field("model").field("world").field("tilt_deg");
+    for (const auto& k : keys) csv.field("swept:" + k);
+    csv.field("seed").field("protocol").field("explore_hours").field("sample_hours");
     if (!trials.empty())
-        for (const auto& [name, v] : trials.front().metrics) os << ',' << name;
-    os << '\n';
+        for (const auto& [name, v] : trials.front().metrics) csv.field(name);
+    csv.end_row();
     for (const auto& t : trials) {
-        os << csv(t.name) << ',' << csv(t.condition) << ',' << csv(t.model) << ',' << csv(t.world) << ','
-           << num(t.tilt_deg);
-        for (const auto& k : keys) os << ',' << csv(swept_value(t, k));
-        os << ',' << t.seed << ',' << csv(t.protocol) << ',' << num(t.explore_hours) << ',' << num(t.sample_hours);
-        for (const auto& [name, v] : t.metrics) os << ',' << num(v);
-        os << '\n';
+        csv.field(t.name).field(t.condition).field(t.model).field(t.world).field(t.tilt_deg);
+        for (const auto& k : keys) csv.field(swept_value(t, k));
+        csv.field(t.seed).field(t.protocol).field(t.explore_hours).field(t.sample_hours);
+        for (const auto& [name, v] : t.metrics) csv.field(v);
+        csv.end_row();
     }
     f.commit();
 }

@@ -274,7 +274,7 @@ public:
     Loader(const Loader&) = delete;  // its callbacks hold `this`
     Loader& operator=(const Loader&) = delete;
     Loader(const std::string& file, const GazeboOptions& options)
-        : file_(file), options_(options), model_path_(gazebo_model_path(file, options)) {
+        : file_(file), options_(options), resolver_(file, options) {
         find_ = [this](const std::string& uri) { return find(uri); };
         parser_ = [this](const sdf::NestedInclude& include, sdf::Errors&) { return intercept(include); };
         config_.SetFindCallback(find_);
@@ -290,17 +290,9 @@ private:
         const std::string scheme = "model://";
         if (uri.rfind(scheme, 0) != 0) return "";
         const std::string name = uri.substr(scheme.size());
-        const std::string folder = model_folder(name);
+        const std::string folder = resolver_.model_folder(name);
         if (!folder.empty()) return (fs::path(folder) / "model.config").string();
         if (name == "ground_plane" || name == "sun") return builtin_marker + name;
-        return "";
-    }
-
-    std::string model_folder(const std::string& name) const {
-        if (name.empty() || name.find('/') != std::string::npos) return "";
-        std::error_code ec;
-        for (const auto& dir : model_path_)
-            if (fs::exists(fs::path(dir) / name / "model.config", ec)) return (fs::path(dir) / name).string();
         return "";
     }
 
@@ -323,7 +315,7 @@ private:
 
     std::string file_;
     GazeboOptions options_;
-    std::vector<std::string> model_path_;
+    GazeboResolver resolver_;
     sdf::ParserConfig config_;
     std::function<std::string(const std::string&)> find_;
     sdf::CustomModelParser parser_;
@@ -397,9 +389,9 @@ void Loader::check_errors(const sdf::Errors& errors, const std::vector<std::stri
                 scene_.missing_models.push_back(uri.substr(8) + " at " + at.path);
                 continue;
             }
-            fail(at, "model '" + uri + "' was not found on the model path (" + join(model_path_, ", ") +
+            fail(at, "model '" + uri + "' was not found on the model path (" + join(resolver_.model_path(), ", ") +
                          "): add its folder to model_path or GAZEBO_MODEL_PATH, or leave missing models out "
-                         "(missing_models: skip)");
+                         "(missing_models: skip; on the command line --missing-models skip)");
         }
         fatal.push_back(&e);
     }
@@ -474,28 +466,9 @@ void Loader::read_geometry(const sdf::Geometry& g, const sdf::ElementPtr& e, con
                                    format_number(p.scale.z()) + ") is absurd: each factor must be finite, with " +
                                    format_number(min_mesh_scale) +
                                    " <= |factor| <= " + format_number(1.0 / min_mesh_scale));
-            const std::string uri = m.Uri();
-            std::string file;
-            if (uri.rfind("model://", 0) == 0) {
-                const std::string rest = uri.substr(8);
-                const auto slash = rest.find('/');
-                const std::string folder = model_folder(rest.substr(0, slash));
-                if (folder.empty() || slash == std::string::npos)
-                    fail(p.at, "mesh '" + uri + "': model '" + rest.substr(0, slash) +
-                                   "' was not found on the model path (" + join(model_path_, ", ") + ")");
-                file = (fs::path(folder) / rest.substr(slash + 1)).string();
-            } else if (uri.rfind("file://", 0) == 0) {
-                file = uri.substr(7);
-            } else if (uri.find("://") != std::string::npos) {
-                fail(p.at, "mesh '" + uri + "': only model://, file:// and file paths can be read");
-            } else {
-                const fs::path rel(uri);
-                file = rel.is_absolute() ? uri : (fs::path(m.FilePath()).parent_path() / rel).string();
-            }
-            std::error_code ec;
-            if (uri.empty()) fail(p.at, "mesh has no <uri>");
-            if (!fs::exists(file, ec)) fail(p.at, "mesh file '" + file + "' (from '" + uri + "') does not exist");
-            p.mesh_file = file;
+            const GazeboResolver::Found found = resolver_.mesh_file(m.Uri(), m.FilePath());
+            if (found.file.empty()) fail(p.at, found.error);
+            p.mesh_file = found.file;
             break;
         }
         case sdf::GeometryType::HEIGHTMAP:
@@ -811,16 +784,87 @@ GazeboScene Loader::load() {
 
 }  // namespace
 
+namespace {
+
+// The folders of a colon-separated environment variable, in order.
+std::vector<std::string> env_folders(const char* name) {
+    std::vector<std::string> out;
+    if (const char* env = std::getenv(name)) {
+        std::istringstream in(env);
+        for (std::string dir; std::getline(in, dir, ':');)
+            if (!dir.empty()) out.push_back(dir);
+    }
+    return out;
+}
+
+bool is_file(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec);
+}
+
+}  // namespace
+
 std::vector<std::string> gazebo_model_path(const std::string& world_file, const GazeboOptions& options) {
     std::vector<std::string> path = options.model_path;
     const fs::path beside = fs::absolute(world_file).parent_path().parent_path() / "models";
     path.push_back(beside.lexically_normal().string());
-    if (const char* env = std::getenv("GAZEBO_MODEL_PATH")) {
-        std::istringstream in(env);
-        for (std::string dir; std::getline(in, dir, ':');)
-            if (!dir.empty()) path.push_back(dir);
-    }
+    for (auto& dir : env_folders("GAZEBO_MODEL_PATH")) path.push_back(std::move(dir));
     return path;
+}
+
+std::vector<std::string> gazebo_resource_path(const GazeboOptions& options) {
+    std::vector<std::string> path = options.resource_path;
+    for (auto& dir : env_folders("GAZEBO_RESOURCE_PATH")) path.push_back(std::move(dir));
+    return path;
+}
+
+GazeboResolver::GazeboResolver(const std::string& world_file, const GazeboOptions& options)
+    : model_path_(gazebo_model_path(world_file, options)), resource_path_(gazebo_resource_path(options)) {}
+
+std::string GazeboResolver::model_folder(const std::string& name) const {
+    if (name.empty() || name.find('/') != std::string::npos) return "";
+    for (const auto& dir : model_path_)
+        if (is_file(fs::path(dir) / name / "model.config")) return (fs::path(dir) / name).string();
+    return "";
+}
+
+GazeboResolver::Found GazeboResolver::mesh_file(const std::string& uri, const std::string& sdf_file) const {
+    const auto missing = [&](const std::string& why) { return Found{"", "mesh '" + uri + "': " + why}; };
+    if (uri.empty()) return Found{"", "mesh has no <uri>"};
+    const std::string model = "model://", file = "file://";
+    if (uri.rfind(model, 0) == 0) {
+        const std::string rest = uri.substr(model.size());
+        const auto slash = rest.find('/');
+        const std::string folder = model_folder(rest.substr(0, slash));
+        if (folder.empty() || slash == std::string::npos)
+            return missing("model '" + rest.substr(0, slash) + "' was not found on the model path (" +
+                           join(model_path_, ", ") + ")");
+        const fs::path path = fs::path(folder) / rest.substr(slash + 1);
+        if (!is_file(path)) return missing("file '" + path.string() + "' does not exist");
+        return Found{path.string(), ""};
+    }
+    const bool file_uri = uri.rfind(file, 0) == 0;
+    if (!file_uri && uri.find("://") != std::string::npos)
+        return missing("only model://, file:// and file paths can be read");
+    const fs::path named = file_uri ? uri.substr(file.size()) : uri;
+    if (named.is_absolute()) {
+        if (!is_file(named)) return missing("file '" + named.string() + "' does not exist");
+        return Found{named.string(), ""};
+    }
+    // Relative: beside the SDF file (a plain path only), then on the resource path.
+    std::vector<std::string> places;
+    if (!file_uri)
+        places.push_back(fs::path(sdf_file).has_parent_path() ? fs::path(sdf_file).parent_path().string() : ".");
+    places.insert(places.end(), resource_path_.begin(), resource_path_.end());
+    for (const auto& dir : places)
+        if (is_file(fs::path(dir) / named)) return Found{(fs::path(dir) / named).string(), ""};
+    const std::string how =
+        "relative file:// URIs are searched on the resource path: a world YAML's resource_path, then the folders "
+        "of GAZEBO_RESOURCE_PATH";
+    if (places.empty())
+        return missing("'" + named.string() + "' is relative and the resource path is empty (" + how + ")");
+    return missing("'" + named.string() + "' was not found in '" + join(places, "', '") + "' (" +
+                   (file_uri ? "" : "a plain path is looked for beside its SDF file first; ") + how + ")");
 }
 
 GazeboScene load_gazebo_world(const std::string& file, const GazeboOptions& options) {
@@ -833,31 +877,64 @@ GazeboScene load_gazebo_world(const std::string& file, const GazeboOptions& opti
     }
 }
 
+namespace {
+
+// The texts of every <mesh>'s <uri> in an SDF file's text (comments included: a superset does no harm).
+std::vector<std::string> mesh_uris(const std::string& text) {
+    std::vector<std::string> uris;
+    for (std::size_t at = text.find("<mesh"); at != std::string::npos; at = text.find("<mesh", at + 5)) {
+        if (at + 5 < text.size() && !std::strchr(" \t\r\n>", text[at + 5])) continue;  // <meshes>, <mesh_x>
+        const std::size_t end = text.find("</mesh>", at), open = text.find("<uri>", at);
+        if (end == std::string::npos || open == std::string::npos || open > end) continue;
+        const std::size_t close = text.find("</uri>", open);
+        if (close == std::string::npos || close > end) continue;
+        std::string uri = text.substr(open + 5, close - open - 5);
+        const auto first = uri.find_first_not_of(" \t\r\n"), last = uri.find_last_not_of(" \t\r\n");
+        if (first != std::string::npos) uris.push_back(uri.substr(first, last - first + 1));
+    }
+    return uris;
+}
+
+}  // namespace
+
 std::vector<std::string> gazebo_world_files(const std::string& file, const GazeboOptions& options) {
-    const auto model_path = gazebo_model_path(file, options);
+    const GazeboResolver resolver(file, options);
     std::set<std::string> files{file}, folders;
-    std::vector<std::string> to_scan{file};
+    std::vector<std::string> to_scan{file}, scanned;
     while (!to_scan.empty()) {
-        std::ifstream in(to_scan.back(), std::ios::binary);
+        scanned.push_back(to_scan.back());
         to_scan.pop_back();
+        std::ifstream in(scanned.back(), std::ios::binary);
         const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         for (std::size_t at = text.find("model://"); at != std::string::npos; at = text.find("model://", at + 8)) {
             std::size_t end = at + 8;
             while (end < text.size() && !std::strchr("/<\"' \t\r\n", text[end])) ++end;
-            const std::string name = text.substr(at + 8, end - at - 8);
+            const std::string folder = resolver.model_folder(text.substr(at + 8, end - at - 8));
+            if (folder.empty() || !folders.insert(folder).second) continue;
             std::error_code ec;
-            for (const auto& dir : model_path) {
-                const fs::path folder = fs::path(dir) / name;
-                if (name.empty() || !fs::exists(folder / "model.config", ec)) continue;
-                if (!folders.insert(folder.string()).second) break;
-                for (const auto& e : fs::recursive_directory_iterator(folder, ec)) {
-                    if (!e.is_regular_file(ec)) continue;
-                    files.insert(e.path().string());
-                    const auto ext = e.path().extension().string();
-                    if (ext == ".sdf" || ext == ".world") to_scan.push_back(e.path().string());
-                }
-                break;
+            for (const auto& e : fs::recursive_directory_iterator(folder, ec)) {
+                if (!e.is_regular_file(ec)) continue;
+                files.insert(e.path().string());
+                const auto ext = e.path().extension().string();
+                if (ext == ".sdf" || ext == ".world") to_scan.push_back(e.path().string());
             }
+        }
+    }
+    // Then the meshes found as the loader finds them (file:// URIs, paths), those not listed yet (by
+    // another spelling of their path) added.
+    const auto canonical = [](const std::string& f) {
+        std::error_code ec;
+        const fs::path c = fs::weakly_canonical(f, ec);
+        return ec ? f : c.string();
+    };
+    std::set<std::string> listed;
+    for (const auto& f : files) listed.insert(canonical(f));
+    for (const auto& sdf_file : scanned) {
+        std::ifstream in(sdf_file, std::ios::binary);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        for (const auto& uri : mesh_uris(text)) {
+            const auto found = resolver.mesh_file(uri, sdf_file);
+            if (!found.file.empty() && listed.insert(canonical(found.file)).second) files.insert(found.file);
         }
     }
     return {files.begin(), files.end()};

@@ -17,14 +17,20 @@ void require(bool ok, const std::string& what) {
 
 // Signs of the corner named by `lean`, e.g. "+x-y" -> (+1, -1).
 std::pair<double, double> lean_signs(const std::string& lean) {
-    if (lean == "+x+y") return {1.0, 1.0};
-    if (lean == "+x-y") return {1.0, -1.0};
-    if (lean == "-x+y") return {-1.0, 1.0};
-    if (lean == "-x-y") return {-1.0, -1.0};
-    throw InputError("cross arena: lean '" + lean + "' is not one of +x+y, +x-y, -x+y, -x-y");
+    if (lean.size() == 4 && (lean[0] == '+' || lean[0] == '-') && lean[1] == 'x' &&
+        (lean[2] == '+' || lean[2] == '-') && lean[3] == 'y')
+        return {lean[0] == '+' ? 1.0 : -1.0, lean[2] == '+' ? 1.0 : -1.0};
+    std::string list;
+    for (const auto& l : cross_arena_leans()) list += (list.empty() ? "" : ", ") + l;
+    throw InputError("cross arena: lean '" + lean + "' is not one of " + list);
 }
 
 }  // namespace
+
+const std::vector<std::string>& cross_arena_leans() {
+    static const std::vector<std::string> leans{"+x+y", "+x-y", "-x+y", "-x-y"};
+    return leans;
+}
 
 CrossArenaParams CrossArenaParams::webots(double tilt_deg) {
     constexpr double outer_wall_center = 5.0, outer_wall_thickness = 0.3;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bvc3d/world/mesh.hpp"
 
@@ -89,6 +90,9 @@ struct CrossArenaParams {
     // floor to ceiling). Only the inner faces and the ceiling's underside can be reached or seen.
     static CrossArenaParams webots(double tilt_deg = 0.0);
 };
+
+// The corners the central walls may lean toward (CrossArenaParams::lean): "+x+y", "+x-y", "-x+y", "-x-y".
+const std::vector<std::string>& cross_arena_leans();
 
 // Checks the parameters (throws InputError naming the parameter) and builds the arena.
 WorldDescription cross_arena(const CrossArenaParams& p);
