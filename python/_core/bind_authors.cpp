@@ -69,8 +69,12 @@ pyb::dict mix_dict(const ScaleMix& m) {
     pyb::dict d;
     d["P_ds"] = to_numpy(m.P_ds.data(), {S, D});
     d["P"] = to_numpy(m.P.data(), {S, D});
-    for (const auto& [key, v] : {std::pair{"M", &m.M}, {"H", &m.H}, {"H_smoothed", &m.H_smoothed}, {"iota", &m.iota},
-                                 {"q", &m.q}, {"P_s", &m.P_s}})
+    for (const auto& [key, v] : {std::pair{"M", &m.M},
+                                 {"H", &m.H},
+                                 {"H_smoothed", &m.H_smoothed},
+                                 {"iota", &m.iota},
+                                 {"q", &m.q},
+                                 {"P_s", &m.P_s}})
         d[key] = to_numpy(v->data(), {S});
     return d;
 }
@@ -97,16 +101,16 @@ std::vector<Vec2> pairs_of(const pyb::handle& obj, std::size_t count) {
 }  // namespace
 
 void bind_authors(pyb::module_& m) {
-    const std::string params = "Keywords: the authors policy's parameters:\n" +
-                               describe(AuthorsParams::table(), AuthorsParams{});
+    const std::string params =
+        "Keywords: the authors policy's parameters:\n" + describe(AuthorsParams::table(), AuthorsParams{});
     m.def(
         "authors_rollouts",
         [](const pyb::object& w_rec, const pyb::object& a0, const pyb::object& w_reward, const pyb::object& uniforms,
            const pyb::kwargs& kwargs) {
             const HandMade h = hand_made(w_rec);
-            const auto r = turning_rollouts(*h.copy, h.column_sums, rates_of(w_reward, "w_reward", h.n),
-                                            rates_of(a0, "a0", h.n), values_of(uniforms, "uniforms"),
-                                            authors_of(kwargs));
+            const auto r =
+                turning_rollouts(*h.copy, h.column_sums, rates_of(w_reward, "w_reward", h.n), rates_of(a0, "a0", h.n),
+                                 values_of(uniforms, "uniforms"), authors_of(kwargs));
             return rollouts_dict(r);
         },
         pyb::arg("w_rec"), pyb::arg("a0"), pyb::arg("w_reward"), pyb::arg("uniforms"),

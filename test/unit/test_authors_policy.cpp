@@ -162,9 +162,9 @@ TEST(AuthorsPolicy, TurnsThatCannotBeCompletedTurnRandomlyAndFeedTheLoopPenalty)
     Rig rig(world_of(dir.path(), 10.0), 8.0);
     AuthorsParams p = no_learning();
     // The 90°–135° turns the choice asks for cannot be completed; the failed turn's own (within ±45°) can.
-    auto controller = rig.controller(p, std::make_unique<StubbornBody>(
-                                            floor_body(rig.world, rig.spec.robot, rig.sensor, p.contact),
-                                            deg_to_rad(50), true));
+    auto controller =
+        rig.controller(p, std::make_unique<StubbornBody>(floor_body(rig.world, rig.spec.robot, rig.sensor, p.contact),
+                                                         deg_to_rad(50), true));
     Rng rng(3, Stream::walk);
     const StartRun run = controller.run(Pose::on_floor(0, 0, 0), far_goal(12.0), rng);
     const AuthorsStats& s = controller.stats();
@@ -205,8 +205,8 @@ TEST(AuthorsPolicy, ABodyThatNeverMovesDrivesReliabilityDownAndForcesExploration
     test::TempDir dir;
     Rig rig(world_of(dir.path(), 10.0), 8.0);
     AuthorsParams p = no_learning();
-    auto controller = rig.controller(p, std::make_unique<StubbornBody>(
-                                            floor_body(rig.world, rig.spec.robot, rig.sensor, p.contact), 10.0, false));
+    auto controller = rig.controller(
+        p, std::make_unique<StubbornBody>(floor_body(rig.world, rig.spec.robot, rig.sensor, p.contact), 10.0, false));
     Rng rng(9, Stream::walk);
     StartTask task = far_goal(1e9);
     task.max_s = 600;

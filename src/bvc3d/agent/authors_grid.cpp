@@ -117,7 +117,8 @@ std::optional<AuthorsGrid::Path> AuthorsGrid::shortest(const Vec2& from, const V
         if (std::hypot(at.x() - goal.x(), at.y() - goal.y()) <= radius) {
             Path path{d, {}};
             for (std::int64_t k = std::int64_t(i); k >= 0; k = parent[std::size_t(k)])
-                path.cells.emplace_back(int(std::size_t(k) % std::size_t(cols_)), int(std::size_t(k) / std::size_t(cols_)));
+                path.cells.emplace_back(int(std::size_t(k) % std::size_t(cols_)),
+                                        int(std::size_t(k) / std::size_t(cols_)));
             std::reverse(path.cells.begin(), path.cells.end());
             return path;
         }
@@ -138,8 +139,8 @@ std::optional<AuthorsGrid::Path> AuthorsGrid::shortest(const Vec2& from, const V
     return std::nullopt;
 }
 
-Vec2 AuthorsGrid::draw_start(Rng& rng, const BodyCollider& body, const Vec2& goal, double min_distance,
-                             double margin, double radius) const {
+Vec2 AuthorsGrid::draw_start(Rng& rng, const BodyCollider& body, const Vec2& goal, double min_distance, double margin,
+                             double radius) const {
     for (int tries = 0; tries < 100000; ++tries) {
         const double x = rng.uniform(west_ + margin, east_ - margin);
         const double y = rng.uniform(south_ + margin, north_ - margin);

@@ -184,7 +184,8 @@ ScaleMix mix_scales(std::span<const double> R, std::span<const double> Var, std:
     m.dirs = dirs;
     m.scales = dirs ? R.size() / dirs : 0;
     const std::size_t S = m.scales;
-    if (R.size() != S * dirs || Var.size() != R.size() || reliability.size() != S || (!H_prev.empty() && H_prev.size() != S))
+    if (R.size() != S * dirs || Var.size() != R.size() || reliability.size() != S ||
+        (!H_prev.empty() && H_prev.size() != S))
         throw InputError("mix_scales: returns, variances, reliabilities and entropies of different sizes");
     m.P_ds.assign(S * dirs, 0.0);
     m.M.assign(S, 0.0), m.H.assign(S, 0.0), m.H_smoothed.assign(S, 0.0);
@@ -211,8 +212,8 @@ ScaleMix mix_scales(std::span<const double> R, std::span<const double> Var, std:
     double q_sum = 0;
     for (std::size_t s = 0; s < S; ++s) {
         m.iota[s] = inv[s] / std::max(inv_sum, 1e-9);
-        q_sum += m.q[s] = m.M[s] * std::pow(m.iota[s], p.entropy_exponent) *
-                          std::pow(reliability[s], p.reliability_exponent);
+        q_sum += m.q[s] =
+            m.M[s] * std::pow(m.iota[s], p.entropy_exponent) * std::pow(reliability[s], p.reliability_exponent);
     }
     for (double& q : m.q) q /= std::max(q_sum, 1e-9);
     const double top = S ? *std::max_element(m.q.begin(), m.q.end()) : 0.0;
@@ -227,15 +228,18 @@ ScaleMix mix_scales(std::span<const double> R, std::span<const double> Var, std:
 
 std::string to_string(HeadingRule r) {
     switch (r) {
-        case HeadingRule::mix: return "mix";
-        case HeadingRule::opposed: return "opposed";
-        case HeadingRule::fallback: return "fallback";
+        case HeadingRule::mix:
+            return "mix";
+        case HeadingRule::opposed:
+            return "opposed";
+        case HeadingRule::fallback:
+            return "fallback";
     }
     return "?";
 }
 
-std::optional<HeadingChoice> heading_rule(std::span<const double> P, std::span<const double> R,
-                                          std::span<const Vec2> V, std::span<const char> safe) {
+std::optional<HeadingChoice> heading_rule(std::span<const double> P, std::span<const double> R, std::span<const Vec2> V,
+                                          std::span<const char> safe) {
     const std::size_t D = safe.size(), S = D ? P.size() / D : 0;
     if (P.size() != S * D || R.size() != P.size() || V.size() != P.size())
         throw InputError("heading_rule: P, R and V must each hold scales × directions values");

@@ -16,7 +16,8 @@
 // took the same directions share their states (the same products): a decision computes each distinct path once.
 // Mix:   P(d|s) = e^{β(R − max R)} / max(Σ, 10⁻⁹),  M_s = Σ_d P·R,
 //        H_s = −Σ_d P ln max(P, 10⁻⁹) + w·ln(1 + Σ_d P·Var),  H̃ = f·H + (1 − f)·H̃_prev (H at a start's first),
-//        ι = (1/(H̃ + 10⁻⁹)) / max(Σ, 10⁻⁹),  q = M·ι^a·ρ^b / max(Σ, 10⁻⁹),  P(s) = softmax(β_s·q),  P(s,d) = P(s)·P(d|s)
+//        ι = (1/(H̃ + 10⁻⁹)) / max(Σ, 10⁻⁹),  q = M·ι^a·ρ^b / max(Σ, 10⁻⁹),  P(s) = softmax(β_s·q),
+//        P(s,d) = P(s)·P(d|s)
 // Heading: P′ = P over the safe pairs (s, d), / max(Σ, 10⁻⁹); c = Σ P′·V; if the two safe pairs of largest R have V's
 //        at cos < −0.75: c = V of the best; if |c| < 10⁻⁶: c = V of the best; heading = atan2(c).
 #include <optional>
@@ -49,7 +50,7 @@ double clamped_readout(std::span<const double> w, std::span<const double> a);
 
 struct ScaleMix {
     std::size_t scales = 0, dirs = 0;
-    std::vector<double> P_ds, P;  // scales × dirs
+    std::vector<double> P_ds, P;                         // scales × dirs
     std::vector<double> M, H, H_smoothed, iota, q, P_s;  // per scale
 };
 // R, Var: scales × dirs; `reliability`: ρ per scale; `H_prev`: H̃ of the decision before (empty: a start's first).
@@ -67,8 +68,8 @@ struct HeadingChoice {
     std::vector<double> scale_weights;  // Σ_d P′(s, d): what the reliability update credits
 };
 // None when no direction is safe (an exploration block). P, R: scales × dirs; V: scales × dirs; safe: dirs.
-std::optional<HeadingChoice> heading_rule(std::span<const double> P, std::span<const double> R,
-                                          std::span<const Vec2> V, std::span<const char> safe);
+std::optional<HeadingChoice> heading_rule(std::span<const double> P, std::span<const double> R, std::span<const Vec2> V,
+                                          std::span<const char> safe);
 
 // The least range per direction's sector (+∞ for a sector without a return); azimuths allocentric, rad.
 std::vector<double> sector_minima(std::span<const double> ranges, std::span<const double> azimuths, int n_dir,

@@ -40,12 +40,12 @@ std::unique_ptr<AuthorsBody> floor_body(const World& world, const RobotParams& r
 
 // What a start did, beyond its path.
 struct AuthorsStats {
-    int decisions = 0;       // decisions that took a heading
-    int forced = 0;          // exploration blocks the low reliability forced
-    int unsafe = 0;          // exploration blocks for want of a safe direction
-    int failed_turns = 0;    // turns that could not be completed
-    int full_turns = 0;      // loops seen: the accumulated heading change passed 360°
-    int loop_penalties = 0;  // loops that cost the scales reliability
+    int decisions = 0;         // decisions that took a heading
+    int forced = 0;            // exploration blocks the low reliability forced
+    int unsafe = 0;            // exploration blocks for want of a safe direction
+    int failed_turns = 0;      // turns that could not be completed
+    int full_turns = 0;        // loops seen: the accumulated heading change passed 360°
+    int loop_penalties = 0;    // loops that cost the scales reliability
     std::size_t products = 0;  // distinct rollout states computed
 };
 
