@@ -31,7 +31,7 @@ namespace bvc3d::cli {
 namespace {
 
 struct NavigateOptions {
-    std::string config, goals, model = "2d";
+    std::string config, goals, model = "2d", policy = default_policy_kind().name;
     WorldOptions world;
     int seeds = 1;
     std::uint64_t first_seed = 0;
@@ -53,6 +53,7 @@ struct NavigatePlan {
     AdjacencyParams adjacency;
     RewardParams reward;
     FlightParams flight;
+    std::shared_ptr<const PolicySpec> policy = default_policy();
 };
 
 // A goal of 2 numbers (on the floor) or 3 (in the air, the flying agent); else nothing.
@@ -91,16 +92,20 @@ NavigatePlan plan_of_options(const NavigateOptions& o) {
     p.seeds = o.seeds, p.first_seed = o.first_seed;
     o.nav.apply(p.nav);
     p.nav.validate();
+    p.policy = config::policy_named(o.policy);
     return p;
 }
 
 // The sweep-friendly YAML (docs/navigation.md#a-yaml-file): world (a preset or a file, relative to the YAML's
-// folder), tilt, lean, missing_models, goals ([[x, y], ...]), models (a name or a list), seeds, first_seed, and
-// the parameter tables navigation:, adjacency:, reward:, flight:. Any other key: InputError naming it.
+// folder), tilt, lean, missing_models, goals ([[x, y], ...]), models (a name or a list), seeds, first_seed, the
+// parameter tables navigation:, adjacency:, reward:, flight:, and policy: with its parameters' section
+// (config/policy_kinds.hpp). Any other key: InputError naming it.
 NavigatePlan plan_of_yaml(const std::string& file) {
     const auto v = config::YamlView::load_file(file);
-    v.expect_map({"world", "tilt", "lean", "missing_models", "goals", "models", "seeds", "first_seed", "navigation",
-                  "adjacency", "reward", "flight"});
+    std::vector<std::string> keys{"world", "tilt",       "lean",       "missing_models", "goals",  "models",
+                                  "seeds", "first_seed", "navigation", "adjacency",      "reward", "flight"};
+    for (const auto& key : config::policy_yaml_keys()) keys.push_back(key);
+    v.expect_map(keys);
     NavigatePlan p;
     p.world = config::path_in_file(v, v["world"].as_string());
     if (v.has("tilt")) p.tilt = v["tilt"].as_double();
@@ -138,6 +143,7 @@ NavigatePlan plan_of_yaml(const std::string& file) {
     if (v.has("adjacency")) config::read_table(v["adjacency"], p.adjacency, AdjacencyParams::table());
     if (v.has("reward")) config::read_table(v["reward"], p.reward, RewardParams::table());
     if (v.has("flight")) config::read_table(v["flight"], p.flight, FlightParams::table());
+    p.policy = config::policy_from_yaml(v);
     return p;
 }
 
@@ -157,6 +163,7 @@ void navigate_command(const NavigateOptions& o) {
     nav->space.n_hd = plan.adjacency.n_hd;
     nav->adjacency = plan.adjacency;
     nav->reward = plan.reward;
+    nav->policy = plan.policy;
     const std::string world_name = label_of(plan.world) + (plan.tilt ? "-" + format_number(*plan.tilt) : "");
     std::vector<TrialConfig> trials;
     try {  // before anything is written; a YAML file's errors name it
@@ -206,6 +213,7 @@ void add_navigate_command(CLI::App& app) {
                                     "Goals on the floor, x,y[;x,y...], or in the air for the flying agent, "
                                     "x,y,z[;x,y,z...] (m)"));
     given.push_back(add_model_option(*cmd, o->model, ModelCount::list));
+    given.push_back(add_policy_option(*cmd, o->policy));
     given.push_back(cmd->add_option("--seeds", o->seeds, "Learning runs (seeds first-seed, first-seed+1, ...)")
                         ->capture_default_str());
     given.push_back(

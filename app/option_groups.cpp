@@ -5,6 +5,7 @@
 
 #include "bvc3d/config/building.hpp"
 #include "bvc3d/config/model_spec.hpp"
+#include "bvc3d/config/policy_kinds.hpp"
 #include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
@@ -119,6 +120,16 @@ std::vector<std::string> model_list(const std::string& text, const std::string& 
     auto models = split_commas(text);
     if (models.empty()) throw InputError(flag + " lists no model");
     return models;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Navigation policy
+
+CLI::Option* add_policy_option(CLI::App& cmd, std::string& policy) {
+    return cmd
+        .add_option("--policy", policy,
+                    "The controller of the starts (docs/navigation.md#policies): " + policy_names_text())
+        ->capture_default_str();
 }
 
 // ---------------------------------------------------------------------------------------------

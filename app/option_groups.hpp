@@ -1,9 +1,10 @@
 #pragma once
 // The option groups every command builds its options from, each added by one call with its help
 // written once here: the world (--world, --tilt, --lean, --missing-models), the sensor (--sensor),
-// the model (--model or --models), parallelism (--jobs), figures (--no-figures) and outputs (--out and
-// its kin, with --force and the one rule for outputs that exist). Help texts list what is accepted
-// from the library's own lists (world presets, sensor presets and LiDAR models, model presets).
+// the model (--model or --models), navigation's policy (--policy), parallelism (--jobs), figures
+// (--no-figures) and outputs (--out and its kin, with --force and the one rule for outputs that
+// exist). Help texts list what is accepted from the library's own lists (world presets, sensor
+// presets and LiDAR models, model presets, navigation policies).
 // Options made from a parameter table are in table_options.hpp.
 // Takes: a command (CLI::App). Gives: its options, their values checked, and what they name built.
 #include <CLI/CLI.hpp>
@@ -67,6 +68,13 @@ CLI::Option* add_model_option(CLI::App& cmd, std::string& model, ModelCount coun
                               const std::string& role = "");
 // The items of a --model list, or InputError "FLAG lists no model".
 std::vector<std::string> model_list(const std::string& text, const std::string& flag = "--model");
+
+// ---------------------------------------------------------------------------------------------
+// Navigation policy: --policy.
+
+// Adds --policy (the controller of navigation's starts, named in its help from the library's list,
+// config/policy_kinds.hpp) to `cmd`, bound to `policy` (shown as the default).
+CLI::Option* add_policy_option(CLI::App& cmd, std::string& policy);
 
 // ---------------------------------------------------------------------------------------------
 // Parallelism: --jobs (and --threads, a hidden alias).

@@ -7,7 +7,9 @@
 #include "bvc3d/agent/body_collider.hpp"
 #include "bvc3d/agent/shortest_path.hpp"
 #include "bvc3d/config/model_yaml.hpp"
+#include "bvc3d/config/world_yaml.hpp"
 #include "bvc3d/experiment/navigation.hpp"
+#include "bvc3d/navigation/failure_class.hpp"
 #include "bvc3d/navigation/replay.hpp"
 #include "bvc3d/navigation/rollouts.hpp"
 #include "bvc3d/navigation/scale_mix.hpp"
@@ -36,15 +38,31 @@ RewardParams reward_of(const pyb::kwargs& kwargs) {
     return p;
 }
 
-// Keywords to whichever table names them: navigation, reward, adjacency.
+// A dict keyword (a YAML file's section: navigation=, adjacency=, reward=, flight=) as the keywords of its table.
+pyb::kwargs section_of(const std::string& key, const pyb::handle& v) {
+    if (!pyb::isinstance<pyb::dict>(v))
+        throw InputError(key + " must be a dict of the parameters of a navigation YAML's `" + key + ":` section");
+    return pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v));
+}
+
+// Keywords as a navigation YAML has them (docs/navigation.md#a-yaml-file): its sections as dicts (navigation=,
+// adjacency=, reward=, flight=), policy= and the policy's own section (e.g. authors=dict(...)); and, flat, the keys
+// of the navigation, reward and adjacency tables, each to whichever table names it.
 void apply_navigation(NavigationSpec& s, const pyb::kwargs& kwargs) {
     pyb::kwargs a, b, c;
+    std::string policy = default_policy_kind().name;
+    std::optional<std::pair<std::string, std::string>> policy_section;  // its key and the dict as JSON (YAML)
+    const auto sections = config::policy_yaml_keys();
     for (const auto& [k, v] : kwargs) {
         const std::string key = pyb::str(k);
-        if (key == "flight") {  // the flying agent's parameters, as a YAML file's `flight:` section
-            if (!pyb::isinstance<pyb::dict>(v))
-                throw InputError("flight must be a dict of the flying agent's parameters");
-            apply_kwargs(s.space.flight, FlightParams::table(), pyb::kwargs(pyb::reinterpret_borrow<pyb::dict>(v)));
+        if (key == "flight") apply_kwargs(s.space.flight, FlightParams::table(), section_of(key, v));
+        else if (key == "navigation") apply_kwargs(s.space.nav, NavigationParams::table(), section_of(key, v));
+        else if (key == "adjacency") apply_kwargs(s.adjacency, AdjacencyParams::table(), section_of(key, v));
+        else if (key == "reward") apply_kwargs(s.reward, RewardParams::table(), section_of(key, v));
+        else if (key == "policy") policy = pyb::str(v);
+        else if (std::find(sections.begin(), sections.end(), key) != sections.end()) {
+            section_of(key, v);
+            policy_section = {key, pyb::str(pyb::module_::import("json").attr("dumps")(v))};
         } else if (RewardParams::table().find(key)) b[k] = v;
         else if (AdjacencyParams::table().find(key) && !NavigationParams::table().find(key)) c[k] = v;
         else a[k] = v;
@@ -53,6 +71,15 @@ void apply_navigation(NavigationSpec& s, const pyb::kwargs& kwargs) {
     apply_kwargs(s.reward, RewardParams::table(), b);
     apply_kwargs(s.adjacency, AdjacencyParams::table(), c);
     s.space.n_hd = s.adjacency.n_hd;
+    if (policy_section) {
+        const auto& [key, json] = *policy_section;
+        if (policy_kind(policy).section != key)
+            throw InputError(key + "= gives the parameters of another policy than policy='" + policy + "'");
+        const auto view = config::YamlView::load_string(json, key + "=");
+        s.policy = config::policy_named(policy, &view);
+    } else {
+        s.policy = config::policy_named(policy);
+    }
 }
 
 }  // namespace
@@ -215,6 +242,9 @@ HdAdjacency(n_place, **params); params and their defaults:
             d["path_m"] = to_numpy(run.path_m.data(), {n});
             d["shortest_m"] = to_numpy(run.shortest_m.data(), {n});
             d["time_s"] = to_numpy(run.time_s.data(), {n});
+            pyb::list failure;  // why each start failed: "" when it arrived (docs/navigation.md#why-a-start-fails)
+            for (const int c : run.failure) failure.append(to_string(FailureClass(c)));
+            d["failure"] = failure;
             d["paths"] = paths;
             d["learn_s"] = run.learn_s;
             d["coverage"] = run.coverage;
@@ -224,11 +254,16 @@ HdAdjacency(n_place, **params); params and their defaults:
             return d;
         },
         pyb::arg("world"), pyb::arg("goals"), pyb::arg("model") = "2d", pyb::arg("seed") = 0,
-        ("One navigation run (docs/navigation.md): learning, then starts per goal. goals: (N, 2) on the floor or "
-         "(N, 3) for the flying agent (docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per "
-         "start (goal, goal_x, goal_y, start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, "
-         "time_s, paths of (M, 2) or (M, 3)), and learn_s, coverage, visits, goal_cells. Keywords (navigation, reward "
-         "and adjacency parameters; flight=dict of the flying agent's, below them):\n" +
+        ("One navigation run (docs/navigation.md): learning, then starts per goal. world: a bvc3d.World, or a preset "
+         "name or world file as navigate's --world. goals: (N, 2) on the floor or (N, 3) for the flying agent "
+         "(docs/navigation.md#flying-to-goals-in-3-d). dict of arrays, one entry per start (goal, goal_x, goal_y, "
+         "start_x, start_y, and goal_z, start_z in 3-D, success, path_m, shortest_m, time_s, failure (why it failed, "
+         "\"\" when it arrived), paths of (M, 2) or "
+         "(M, 3)), and learn_s, coverage, visits, goal_cells. Keywords as a navigation YAML's keys: the sections "
+         "navigation=, adjacency=, reward=, flight= as dicts; policy= (" +
+         policy_names_text() +
+         ") and the policy's own section as a dict (e.g. authors=dict(...)); or flat, the navigation, reward and "
+         "adjacency parameters (below; flight's after them):\n" +
          describe(NavigationParams::table(), NavigationParams{}) + describe(RewardParams::table(), RewardParams{}) +
          "flight:\n" + describe(FlightParams::table(), FlightParams{}))
             .c_str());

@@ -191,6 +191,7 @@ void bind_recording(pyb::module_& m);
 void bind_place_recognition(pyb::module_& m);
 void bind_buildings(pyb::module_& m);  // after bind_simulator: it adds to World
 void bind_navigation(pyb::module_& m);
+void bind_authors(pyb::module_& m);
 void bind_populations(pyb::module_& m);
 void bind_growing(pyb::module_& m);
 

@@ -149,6 +149,7 @@ PYBIND11_MODULE(_core, m) {
     bvc3d::py::bind_place_recognition(m);  // after bind_analysis: it adds to bvc3d.analysis
     bvc3d::py::bind_buildings(m);
     bvc3d::py::bind_navigation(m);
+    bvc3d::py::bind_authors(m);
     bvc3d::py::bind_populations(m);
     bvc3d::py::bind_growing(m);
 }

@@ -202,6 +202,16 @@ def test_navigate_refuses_bad_goals(tmp_path, goals, named):
     assert not (tmp_path / "out").exists()
 
 
+def test_navigate_refuses_an_unknown_policy_naming_the_list(tmp_path):
+    r = run("navigate", "--world", "cross", "--goals", "3,3", "--policy", "nonesuch", "--out", str(tmp_path / "out"))
+    assert r.returncode == 2 and "policy 'nonesuch' is not one of rollout8" in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+    config = tmp_path / "nav.yaml"
+    config.write_text("world: cross\ngoals: [[3, 3]]\npolicy: nonesuch\n")
+    r = run("navigate", "--config", str(config), "--out", str(tmp_path / "out"))
+    assert r.returncode == 2 and "nav.yaml" in r.stderr and "policy" in r.stderr, r.stderr
+
+
 def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path():
     world = bvc3d.World.cross()
     kw = dict(max_learn_hours=0.2, starts=2, min_start_distance=3.0, goal_visits=1, reward_map_cell=0)
@@ -218,6 +228,20 @@ def test_navigate_from_python_is_seeded_and_measures_against_the_shortest_path()
         assert np.all(steps <= 0.25 + 1e-9) and a["path_m"][i] == pytest.approx(steps.sum())
     with pytest.raises(ValueError, match="goal 1"):
         bvc3d.navigate(world, [[30.0, 0.0]])
+    # The world by name (as navigate's --world), the YAML's sections as dicts, the policy by name: the same run.
+    c = bvc3d.navigate("cross", [[3.5, 3.5]], seed=1, policy="rollout8", navigation=kw)
+    for key in ("start_x", "path_m", "time_s"):
+        np.testing.assert_array_equal(a[key], c[key])
+    pruned = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, adjacency=dict(prune=0.01), reward=dict(rollout_steps=3),
+                            **kw)
+    flat = bvc3d.navigate(world, [[3.5, 3.5]], seed=1, prune=0.01, **kw)
+    np.testing.assert_array_equal(pruned["path_m"], flat["path_m"])
+    with pytest.raises(ValueError, match="policy 'nonesuch' is not one of rollout8"):
+        bvc3d.navigate(world, [[3.5, 3.5]], policy="nonesuch", **kw)
+    with pytest.raises(ValueError, match="adjacency must be a dict"):
+        bvc3d.navigate(world, [[3.5, 3.5]], adjacency=0.01, **kw)
+    with pytest.raises(ValueError, match="unknown argument 'prun'"):
+        bvc3d.navigate(world, [[3.5, 3.5]], adjacency=dict(prun=0.01), **kw)
 
 
 def six_digits(text):
@@ -231,6 +255,19 @@ def six_digits(text):
     return "".join(",".join(field(f) for f in line.split(",")) + "\n" for line in text.splitlines())
 
 
+FAILURE_CLASSES = {"", "blocked", "closing-in", "plateau", "wrong-basin", "loop", "wander"}
+
+
+def without_failure_column(text):
+    """starts.csv without its last column, `failure`, and each row's failure class with the row (a dict)."""
+    lines = text.splitlines()
+    header = lines[0].split(",")
+    assert header[-1] == "failure", header
+    rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
+    assert {row["failure"] for row in rows} <= FAILURE_CLASSES, rows
+    return "".join(line.rsplit(",", 1)[0] + "\n" for line in lines), [(row["failure"], row) for row in rows]
+
+
 def test_navigate_on_the_floor_keeps_the_numbers_it_wrote_before(tmp_path):
     """A small run's starts.csv and paths.csv: the digests the code wrote before navigation became trials of the
     engine (issue 41; before that, the digests of the code before goals in 3-D, issue 30), from today's exact numbers
@@ -240,6 +277,17 @@ def test_navigate_on_the_floor_keeps_the_numbers_it_wrote_before(tmp_path):
             "0.2", "--starts", "3", "--seeds", "2", "--out", str(out), "--no-report")
     assert r.returncode == 0, r.stderr
     texts = {name: (out / name).read_text() for name in ("starts.csv", "paths.csv")}
+    # The failure class (issue 46) is a column after the ones pinned: the pinned bytes are those before it.
+    texts["starts.csv"], failures = without_failure_column(texts["starts.csv"])
+    assert all((f == "") == (row["success"] == "1") for f, row in failures), failures
+    # ... written from the trial files' /navigation/failure (0: reached, then the classes in the order above).
+    names = ["", "blocked", "closing-in", "plateau", "wrong-basin", "loop", "wander"]
+    written = []
+    for seed in (0, 1):
+        with h5py.File(next(out.glob(f"*seed{seed}.h5")), "r") as f:
+            written += [names[c] for c in f["navigation/failure"][()]]
+            assert f["navigation/walls"].shape[1] == 4 and len(f["navigation/walls"]) > 4  # the cross and the room
+    assert written == [f for f, _ in failures]
     digest = lambda text: hashlib.sha256(text.encode()).hexdigest()
     assert {name: digest(six_digits(t)) for name, t in texts.items()} == {
         "starts.csv": "e600565f279eff431d74855ac1dffb396389c3d8aeb0576f6799413a55a27b71",
@@ -294,7 +342,7 @@ def test_navigate_in_3d_writes_z_and_resumes_its_runs_to_the_same_bytes(tmp_path
     starts, paths = ((out / n).read_text() for n in ("starts.csv", "paths.csv"))
     header = starts.splitlines()[0].split(",")
     assert header == ("world,model,seed,goal_x,goal_y,start_x,start_y,success,path_m,shortest_m,path_ratio,time_s,"
-                      "goal_z,start_z").split(",")
+                      "goal_z,start_z,failure").split(",")
     assert paths.splitlines()[0] == "model,seed,start,x,y,z"
     row = dict(zip(header, starts.splitlines()[1].split(",")))
     assert float(row["goal_z"]) == 0.8 and 0.4 < float(row["start_z"]) < 5.6

@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 
+#include "bvc3d/agent/authors_grid.hpp"
 #include "bvc3d/agent/body_collider.hpp"
 #include "bvc3d/agent/free_space_grid.hpp"
 #include "bvc3d/agent/goal_seeking_flight.hpp"
@@ -42,7 +43,12 @@ const params::Table<NavigationParams>& NavigationParams::table() {
          real("path_cell", &P::path_cell, closed(0.01, 10), "m, the shortest path's grid (voxels in 3-D)"),
          real("path_inflate", &P::path_inflate, closed(0, 100),
               "m, obstacles (in 3-D all geometry) inflated for the shortest path"),
-         real("reward_map_cell", &P::reward_map_cell, closed(0, 100), "m between reward-map points; 0: no map")});
+         real("reward_map_cell", &P::reward_map_cell, closed(0, 100), "m between reward-map points; 0: no map"),
+         choice("protocol", &P::protocol,
+                {{NavigationProtocol::bvc3d, "bvc3d"}, {NavigationProtocol::authors, "authors"}},
+                "starts and yardstick: bvc3d's, or the authors' (SPEC §17.3: their starts, the same for every "
+                "learning run, and their optimal path to the goal's disc; on the floor only)")
+             .quiet_at_default()});
     return t;
 }
 
@@ -78,6 +84,8 @@ public:
         cover_parts_ = cover_grid_.parts(s.robot.radius, n);
         cover_main_ = largest_part(cover_parts_, n);
         for (int l : cover_parts_) cover_free_ += l == cover_main_;
+        if (s.nav.protocol == NavigationProtocol::authors)
+            authors_.emplace(*body_, s.nav.path_cell, s.nav.path_inflate);
     }
     void check_goal(std::size_t i, const NavigationGoal& goal) const override {
         const Vec2 g = xy(goal.p);
@@ -103,6 +111,11 @@ public:
     }
     Vec3 draw_start(Rng& rng, std::size_t g, const NavigationGoal& goal, double min_distance) const override {
         const Vec2 at = xy(goal.p);
+        if (authors_) {
+            const Vec2 p =
+                authors_->draw_start(rng, *body_, at, min_distance, s_.nav.path_inflate, s_.nav.success_radius);
+            return {p.x(), p.y(), 0.0};
+        }
         const int goal_part = parts_[path_grid_.index(*nearest_usable_cell(path_grid_, at, s_.robot.radius))];
         const auto bounds = body_->walkable().bounds();
         for (int tries = 0; tries <= 100000; ++tries) {
@@ -119,7 +132,19 @@ public:
         return Pose::on_floor(p.x(), p.y(), rng.uniform(-pi, pi));
     }
     double shortest(const Vec3& from, const Vec3& to) const override {
+        if (authors_) {
+            const auto path = authors_->shortest(xy(from), xy(to), s_.nav.success_radius);
+            return path ? path->length : 0.0;
+        }
+        return geodesic(from, to);
+    }
+    double geodesic(const Vec3& from, const Vec3& to) const override {
         return shortest_path(path_grid_, xy(from), xy(to), s_.nav.path_inflate).length;
+    }
+    std::vector<std::array<Vec2, 2>> walls() const override {
+        std::vector<std::array<Vec2, 2>> out;
+        for (const Segment2& seg : body_->segments()) out.push_back({seg.a, seg.b});
+        return out;
     }
     std::unique_ptr<GoalSeeker> seeker(DirectionPolicy& policy, const Pose& start) const override {
         return std::make_unique<GoalSeekingWalk>(
@@ -144,6 +169,7 @@ private:
     std::vector<int> parts_, cover_parts_;
     int main_ = -1, cover_main_ = -1;
     std::size_t cover_free_ = 0;
+    std::optional<AuthorsGrid> authors_;  // protocol authors
 };
 
 // Flying (SPEC §12 and §17 in 3-D): the sphere, its walk, the 20 flying HD cells, voxels.
@@ -207,7 +233,8 @@ public:
     Pose start_pose(const Vec3& p, Rng& rng) const override {
         return Pose{p.x(), p.y(), p.z(), rng.uniform(-pi, pi), 0.0, 0.0};
     }
-    double shortest(const Vec3& from, const Vec3& to) const override {
+    double shortest(const Vec3& from, const Vec3& to) const override { return geodesic(from, to); }
+    double geodesic(const Vec3& from, const Vec3& to) const override {
         return voxel_path_between(occupancy_, from, to).value_or(0.0);
     }
     std::unique_ptr<GoalSeeker> seeker(DirectionPolicy& policy, const Pose& start) const override {
@@ -217,6 +244,7 @@ public:
             start);
     }
     std::vector<Vec2> map_points(double) const override { return {}; }
+    std::vector<std::array<Vec2, 2>> walls() const override { return {}; }
 
 private:
     int part_of_voxel(const Vec3& p) const {

@@ -8,6 +8,7 @@
 // The space is picked by the goals' dimension: x, y on the floor (the paper's robot, its random walk, n_hd directions
 // of the heading, the floor's 0.1 m grid) or x, y, z flying (SPEC §12's body and walk, the 20 directions of the
 // flying HD cells, voxels). Nothing above this asks which one it has.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -22,6 +23,11 @@
 #include "bvc3d/world/world.hpp"
 
 namespace bvc3d {
+
+// How a start is posed and scored: bvc3d's (starts uniform on the goal's part of the floor, one stream per learning
+// run and goal for the starts and the choices; the shortest path of agent/shortest_path.hpp) or the authors' (SPEC
+// §17.3: starts as theirs, the same for every learning run; their optimal path, agent/authors_grid.hpp).
+enum class NavigationProtocol { bvc3d, authors };
 
 struct NavigationParams {
     // learning
@@ -43,6 +49,7 @@ struct NavigationParams {
     double path_cell = 0.1;        // m
     double path_inflate = 0.5;     // m
     double reward_map_cell = 0.5;  // m between the points of the reward maps; 0: none
+    NavigationProtocol protocol = NavigationProtocol::bvc3d;
     static const params::Table<NavigationParams>& table();
     void validate() const { table().check(*this); }
 };
@@ -88,10 +95,18 @@ public:
     virtual std::size_t coverage_cells() const = 0;
     virtual std::size_t coverage_size() const = 0;
     virtual std::optional<std::size_t> coverage_cell(const Vec3& p) const = 0;
-    // A random start at least `min_distance` from goal g, in its part of the space; then the pose there.
+    // A random start at least `min_distance` from goal g, in its part of the space (under protocol authors, as SPEC
+    // §17.3 draws it); then the pose there.
     virtual Vec3 draw_start(Rng& rng, std::size_t g, const NavigationGoal& goal, double min_distance) const = 0;
     virtual Pose start_pose(const Vec3& p, Rng& rng) const = 0;
+    // The yardstick: the shortest path from `from` to the goal `to` (protocol authors: their optimal path to the
+    // goal's disc of the success radius).
     virtual double shortest(const Vec3& from, const Vec3& to) const = 0;
+    // The distance to walk from `from` to `to` round the geometry (bvc3d's shortest path, whatever the protocol):
+    // how far a failed start still was from its goal.
+    virtual double geodesic(const Vec3& from, const Vec3& to) const = 0;
+    // The geometry the agent meets, as segments of the floor plane (the walls a figure draws); none in flight.
+    virtual std::vector<std::array<Vec2, 2>> walls() const = 0;
     virtual std::unique_ptr<GoalSeeker> seeker(DirectionPolicy& policy, const Pose& start) const = 0;
     // Points of the floor for the reward maps (none in flight).
     virtual std::vector<Vec2> map_points(double cell) const = 0;

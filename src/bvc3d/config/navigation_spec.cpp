@@ -16,6 +16,11 @@ void NavigationSpec::validate() const {
     adjacency.validate();
     reward.validate();
     space.check_goals_shape();
+    policy->validate();
+    policy->check_dims(space.dims());
+    if (space.nav.protocol == NavigationProtocol::authors && space.dims() != 2)
+        NavigationParams::table().fail("protocol", "authors poses and scores starts on the floor; goals of " +
+                                                       std::to_string(space.dims()) + " coordinates fly");
 }
 
 std::string NavigationSpec::adjacency_name(const ModelSpec& model, std::size_t scale) {
@@ -96,8 +101,14 @@ std::string NavigationSpec::canonical() const {
     for (const NavigationGoal& g : space.goals)
         goals += " [" + format_number(g.x()) + ", " + format_number(g.y()) +
                  (g.dims == 3 ? ", " + format_number(g.z()) : "") + "]";
+    std::string policy_text;
+    const std::string policy_params = policy->canonical("    ");
+    if (policy->name() != default_policy_kind().name || !policy_params.empty()) {
+        policy_text = "  policy: " + policy->name() + "\n";
+        if (!policy_params.empty()) policy_text += "  " + policy_kind(policy->name()).section + ":\n" + policy_params;
+    }
     return "navigation:\n  goals:" + goals + "\n" + params::yaml_lines(NavigationParams::table(), space.nav, "  ") +
-           "reward:\n" + params::yaml_lines(RewardParams::table(), reward, "  ") + "adjacency:\n" +
+           policy_text + "reward:\n" + params::yaml_lines(RewardParams::table(), reward, "  ") + "adjacency:\n" +
            params::yaml_lines(AdjacencyParams::table(), adjacency_params(), "  ");
 }
 

@@ -75,10 +75,13 @@ void analysis_from(const YamlView& v, TrialConfig& t) {
 }
 
 // `navigation:` (docs/navigation.md#as-a-trial): goals ([[x, y], ...] or [[x, y, z], ...]), the navigation table's
-// keys, and adjacency: and reward: tables; the bodies from the trial's robot: or flight: section.
+// keys, adjacency: and reward: tables, and policy: with its parameters' section; the bodies from the trial's robot:
+// or flight: section.
 std::shared_ptr<NavigationSpec> navigation_from(const YamlView& v, const YamlView& trial) {
     auto nav = std::make_shared<NavigationSpec>();
-    read_table(v, nav->space.nav, NavigationParams::table(), {"goals", "adjacency", "reward"});
+    std::vector<std::string> also{"goals", "adjacency", "reward"};
+    for (const auto& key : policy_yaml_keys()) also.push_back(key);
+    read_table(v, nav->space.nav, NavigationParams::table(), also);
     if (!v.has("goals")) v.fail("needs goals: a list of [x, y] (on the floor) or [x, y, z] (flying)");
     const YamlView goals = v["goals"];
     if (!goals.is_sequence() || goals.size() == 0) goals.fail("must be a list of [x, y] or of [x, y, z]");
@@ -90,6 +93,7 @@ std::shared_ptr<NavigationSpec> navigation_from(const YamlView& v, const YamlVie
     }
     if (v.has("adjacency")) read_table(v["adjacency"], nav->adjacency, AdjacencyParams::table());
     if (v.has("reward")) read_table(v["reward"], nav->reward, RewardParams::table());
+    nav->policy = policy_from_yaml(v);
     if (trial.has("robot")) read_table(trial["robot"], nav->space.robot, RobotParams::table());
     if (trial.has("flight")) read_table(trial["flight"], nav->space.flight, FlightParams::table());
     nav->space.n_hd = nav->adjacency.n_hd;

@@ -3,13 +3,13 @@
 // learning run. Takes: the world, the trial (TrialConfig::navigation set) and every population's state at the end of
 // learning. Gives: the trial's NavigationRecord (recorder/trial_record.hpp) and the reward cells' state after replay.
 //
-// Per scale of place cells, the learned adjacency's frozen copies (navigation/rollout_policy.hpp) and, per goal,
+// Per scale of place cells, the learned adjacency's frozen copies (navigation/scale_memory.hpp) and, per goal,
 // replay from the reward cell the learning bound (navigation/replay.hpp). Then the model, its state as learned (the
-// reward cells' weights set by replay), is stepped through its populations one model step at a time with learning
-// off: at points of the floor for the first scale's reward map, and from `starts` random starts per goal (at least
-// `min_start_distance` from it, in its part of the space) where the agent (agent/navigation_space.hpp) goes where the
-// policy chooses, until it is within `success_radius` of the goal, or its path reaches `max_path_ratio` × the
-// shortest path, or `max_hours` pass. Every population is set back to rest at each start and map point.
+// reward cells' weights set by replay), is stepped through its populations one model step at a time: at points of
+// the floor for the first scale's reward map (at rest, learning off), and from `starts` random starts per goal (at
+// least `min_start_distance` from it, in its part of the space) where the trial's policy (navigation/policy.hpp: the
+// NavigationSpec's) runs each start — it steps the model and moves the agent (agent/navigation_space.hpp) until it is
+// within `success_radius` of the goal, or its path reaches `max_path_ratio` × the shortest path, or `max_hours` pass.
 #include <atomic>
 #include <functional>
 #include <vector>

@@ -1,18 +1,11 @@
 #include "bvc3d/navigation/rollout_policy.hpp"
 
+#include <algorithm>
+
 #include "bvc3d/navigation/rollouts.hpp"
 #include "bvc3d/navigation/scale_mix.hpp"
 
 namespace bvc3d {
-
-ScaleMemory scale_memory(const HdAdjacency& adj, const AdjacencyParams& params, const RewardParams& reward) {
-    ScaleMemory m;
-    m.sparse = std::make_shared<const SparseAdjacency>(adj, params.prune);
-    if (params.rollout_weights == RolloutWeights::float32) m.rollouts = m.sparse;
-    else m.rollouts = make_rollout_product(adj, params);
-    m.reward = reward;
-    return m;
-}
 
 RolloutPolicy::RolloutPolicy(const std::vector<ScaleMemory>& scales, std::size_t goal,
                              const std::vector<std::vector<double>>& rates, const RewardParams& params, Rng& rng)
@@ -33,6 +26,52 @@ int RolloutPolicy::choose(const Pose&, std::span<const char> allowed) {
         if (u < (sum += prob[d])) return last;
     }
     return last;
+}
+
+namespace {
+
+class RolloutController : public EpisodeController {
+public:
+    explicit RolloutController(const PolicyContext& c) : c_(c) {}
+    StartRun run(const Pose& start, const StartTask& task, Rng& rng) override {
+        const NavigationParams& p = c_.spec.nav;
+        c_.senses.reset();
+        for (int k = 0; k < std::max(1, p.settle_steps); ++k) c_.senses.step(start, false, 0.0);
+        RolloutPolicy policy(c_.memory, task.goal, c_.senses.rates(), c_.reward, rng);
+        const auto agent = c_.space.seeker(policy, start);
+        StartRun out;
+        out.path.push_back(start.position());
+        while (true) {
+            if (c_.space.distance(agent->pose().position(), task.at) <= task.success_radius) {
+                out.end = StartEnd::reached;
+                break;
+            }
+            if (agent->travelled() >= task.max_path_m) {
+                out.end = StartEnd::path_cap;
+                break;
+            }
+            const auto step = agent->next(task.max_s);
+            if (!step) {
+                out.end = agent->time() >= task.max_s ? StartEnd::time_cap : StartEnd::wedged;
+                break;
+            }
+            c_.senses.step(step->pose, step->bumped, step->t);
+            out.path.push_back(step->pose.position());
+            out.bumped.push_back(step->bumped ? 1 : 0);
+        }
+        out.path_m = agent->travelled();
+        out.time_s = agent->time();
+        return out;
+    }
+
+private:
+    PolicyContext c_;
+};
+
+}  // namespace
+
+std::unique_ptr<EpisodeController> RolloutPolicySpec::make(const PolicyContext& context) const {
+    return std::make_unique<RolloutController>(context);
 }
 
 }  // namespace bvc3d

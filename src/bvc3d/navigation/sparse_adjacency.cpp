@@ -60,6 +60,16 @@ void SparseAdjacency::apply(int k, std::span<const double> x, std::span<double> 
     }
 }
 
+std::vector<double> SparseAdjacency::column_sums() const {
+    std::vector<double> c(rows_.size() * std::size_t(n_), 0.0);
+    for (std::size_t k = 0; k < rows_.size(); ++k) {
+        double* ck = &c[k * std::size_t(n_)];
+        for (std::size_t e = 0; e < rows_[k].col.size(); ++e) ck[rows_[k].col[e]] += double(rows_[k].w[e]);
+        for (int j = 0; j < n_; ++j) ck[j] *= scale_;
+    }
+    return c;
+}
+
 std::size_t SparseAdjacency::entries() const {
     std::size_t e = 0;
     for (const Rows& r : rows_) e += r.col.size();

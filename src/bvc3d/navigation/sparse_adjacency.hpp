@@ -34,6 +34,8 @@ public:
     using AdjacencyProduct::apply;
     std::size_t entries() const override;
     double bytes() const override;
+    // Each matrix's column sums of the kept weights, Σ_i W[k][i][j] (n_dir × n, row k): Σ_i (W[k]·x)_i = c_k·x.
+    std::vector<double> column_sums() const;
 
 protected:
     void apply_one(int k, std::span<const double> x, std::span<double> y) const override { apply(k, x, y); }

@@ -93,6 +93,7 @@ class AdjacencyPopulation : public Population {
 public:
     AdjacencyPopulation(int n_place, const AdjacencyParams& params = {});
     HdAdjacency& adjacency() { return adj_; }
+    const HdAdjacency& adjacency() const { return adj_; }
     std::size_t size() const override { return 0; }
     void step(const StepBlock& block, std::span<const std::span<const double>> inputs, std::span<double> out) override;
     std::vector<StateArray> state() const override { return adj_.state(); }

@@ -7,6 +7,7 @@
 
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/navigation/failure_class.hpp"
 #include "bvc3d/recorder/hdf5_io.hpp"
 
 namespace bvc3d {
@@ -95,6 +96,8 @@ void write_navigation(hid_t f, const NavigationRecord& r) {
     h5::write(g, "path", r.path, {r.path.size() / d, d});
     h5::write(g, "map_points", r.map_points, {r.map_points.size() / 2, 2});
     h5::write(g, "map_reward", r.map_reward, {G, r.map_points.size() / 2});
+    h5::write(g, "failure", ints(r.failure), {r.failure.size()});
+    h5::write(g, "walls", r.walls, {r.walls.size() / 4, 4});
 }
 
 }  // namespace
@@ -426,6 +429,10 @@ TrialNavigation read_trial_navigation(const std::filesystem::path& path) {
     n.path_start.assign(starts.begin(), starts.end());
     n.map_points = reals("map_points", {0, 2});
     n.map_reward = reals("map_reward", {G, n.map_points.size() / 2});
+    // Written since the failure classes and walls existed (issue 46); files before them have neither.
+    if (h5::exists(g, "failure"))
+        n.failure = as_int(integers("failure", {N}, 0, std::int64_t(failure_class_names().size()) - 1));
+    if (h5::exists(g, "walls")) n.walls = reals("walls", {0, 4});
     return out;
 }
 

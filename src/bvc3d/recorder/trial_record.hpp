@@ -38,6 +38,11 @@ struct NavigationRecord {
     std::vector<double> path_m, shortest_m, time_s;
     std::vector<std::uint64_t> path_start;  // starts + 1 offsets into `path`
     std::vector<double> path;               // points × dims: each start's positions, its start first
+    // Why each start failed (navigation/failure_class.hpp: 0 reached, then blocked, closing-in, plateau, wrong-basin,
+    // loop, wander); empty in files written before the classes existed.
+    std::vector<int> failure;
+    // The floor's geometry in the body's slab as segments (x0, y0, x1, y1), for figures; none in flight.
+    std::vector<double> walls;
     // The first scale's reward read-out at points of the floor (none in flight): points × 2, and goals × points.
     std::vector<double> map_points, map_reward;
     std::size_t n_goals() const { return dims > 0 ? goals.size() / std::size_t(dims) : 0; }

@@ -7,6 +7,7 @@
 #include "bvc3d/core/atomic_file.hpp"
 #include "bvc3d/core/csv.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/navigation/failure_class.hpp"
 
 namespace bvc3d {
 
@@ -55,14 +56,15 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
         maps_file(folder / "reward_map.csv"), learning_file(folder / "learning.csv");
     CsvWriter starts(starts_file.stream()), paths(paths_file.stream()), maps(maps_file.stream()),
         learning(learning_file.stream());
-    // A flying run (goals x,y,z) appends goal_z,start_z to starts.csv and z to paths.csv and summary.csv (goal_z).
+    // A flying run (goals x,y,z) adds goal_z,start_z (before failure) to starts.csv, z to paths.csv and goal_z to
+    // summary.csv.
     if (flying) {
         starts.row("world", "model", "seed", "goal_x", "goal_y", "start_x", "start_y", "success", "path_m",
-                   "shortest_m", "path_ratio", "time_s", "goal_z", "start_z");
+                   "shortest_m", "path_ratio", "time_s", "goal_z", "start_z", "failure");
         paths.row("model", "seed", "start", "x", "y", "z");
     } else {
         starts.row("world", "model", "seed", "goal_x", "goal_y", "start_x", "start_y", "success", "path_m",
-                   "shortest_m", "path_ratio", "time_s");
+                   "shortest_m", "path_ratio", "time_s", "failure");
         paths.row("model", "seed", "start", "x", "y");
     }
     maps.row("model", "seed", "goal", "x", "y", "reward");
@@ -104,6 +106,8 @@ void write_navigation_report(const std::filesystem::path& folder, const std::vec
             starts.field(r.start[i * std::size_t(dims)]).field(r.start[i * std::size_t(dims) + 1]).field(r.success[i]);
             starts.field(r.path_m[i]).field(r.shortest_m[i]).field(ratio).field(r.time_s[i]);
             if (flying) starts.field(goal[2]).field(r.start[i * 3 + 2]);
+            // Why it failed: empty when it arrived, and in files written before the classes existed.
+            starts.field(i < r.failure.size() ? to_string(FailureClass(r.failure[i])) : std::string());
             starts.end_row();
             for (std::uint64_t k = r.path_start[i]; k < r.path_start[i + 1]; ++k) {
                 paths.field(t.model).field(t.seed).field(i);
