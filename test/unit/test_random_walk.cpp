@@ -10,6 +10,7 @@
 #include "bvc3d/agent/random_walk.hpp"
 #include "bvc3d/core/angles.hpp"
 #include "bvc3d/core/error.hpp"
+#include "bvc3d/core/uniform_point.hpp"
 
 using namespace bvc3d;
 
@@ -93,6 +94,18 @@ TEST_P(PaperWorldWalk, FourHoursCoverEveryReachableHalfMetreCell) {
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperTilts, PaperWorldWalk, ::testing::Values(0.0, 30.0, 45.0, 60.0));
+
+TEST(UniformPoint, DrawsTheLastAxisFirstWhateverTheCompiler) {
+    // The same stream drawn by hand: z, then y, then x (y, then x in the plane), each scaled to its side.
+    const Eigen::AlignedBox3d box(Vec3(-1, 2, 0.5), Vec3(3, 4, 2.5));
+    Rng drawn(7, Stream::walk), by_hand(7, Stream::walk);
+    const Vec3 p = uniform_point(box, drawn);
+    const double z = by_hand.uniform(), y = by_hand.uniform(), x = by_hand.uniform();
+    EXPECT_EQ(p, Vec3(-1 + 4 * x, 2 + 2 * y, 0.5 + 2 * z));
+    const Vec2 q = uniform_point(Eigen::AlignedBox2d(Vec2(0, 0), Vec2(1, 1)), drawn);
+    const double qy = by_hand.uniform(), qx = by_hand.uniform();
+    EXPECT_EQ(q, Vec2(qx, qy));
+}
 
 TEST(RandomWalk, TurnsFollowTheirDistributions) {
     const World world = World::cross({.tilt_deg = 45});

@@ -6,6 +6,7 @@
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/uniform_point.hpp"
 
 namespace bvc3d {
 
@@ -43,8 +44,7 @@ FlightState FlyingWalk::draw_start(const SphereCollider& body, const FlightParam
     const auto& box = body.center_box();
     bool found = false;
     for (int attempt = 0; attempt < 100000 && !found; ++attempt) {
-        const Vec3 p(rng.uniform(box.min().x(), box.max().x()), rng.uniform(box.min().y(), box.max().y()),
-                     rng.uniform(box.min().z(), box.max().z()));
+        const Vec3 p = uniform_point(box, rng);
         if (body.can_start_at(p)) {
             s.position = p;
             found = true;

@@ -16,6 +16,7 @@
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
 #include "bvc3d/core/icosahedron.hpp"
+#include "bvc3d/core/uniform_point.hpp"
 
 namespace bvc3d {
 
@@ -221,8 +222,7 @@ public:
         const int goal_part = part_of_voxel(goal.p);
         const auto& box = body_->center_box();
         for (int tries = 0; tries <= 100000; ++tries) {
-            const Vec3 p(rng.uniform(box.min().x(), box.max().x()), rng.uniform(box.min().y(), box.max().y()),
-                         rng.uniform(box.min().z(), box.max().z()));
+            const Vec3 p = uniform_point(box, rng);
             if ((p - goal.p).norm() >= min_distance && body_->is_free(p) && body_->clearance(p) >= 0.05 &&
                 body_->can_start_at(p) && part_of_voxel(p) == goal_part)
                 return p;

@@ -6,6 +6,7 @@
 #include "bvc3d/core/cancel.hpp"
 #include "bvc3d/core/error.hpp"
 #include "bvc3d/core/format.hpp"
+#include "bvc3d/core/uniform_point.hpp"
 
 namespace bvc3d {
 
@@ -82,7 +83,7 @@ Pose RandomWalk::draw_start(const WorldDescription& world, const BodyCollider& b
         const auto box = region.bounds();
         bool found = false;
         for (int attempt = 0; attempt < 100000 && !found; ++attempt) {
-            const Vec2 p(rng.uniform(box.min().x(), box.max().x()), rng.uniform(box.min().y(), box.max().y()));
+            const Vec2 p = uniform_point(box, rng);
             if (region.contains(p) && body.can_start_at(p)) {
                 pose.x = p.x();
                 pose.y = p.y();
