@@ -58,6 +58,18 @@ void write_tables(const fs::path& dir, const PlaceRecognitionOutcome& r) {
     for (AtomicFile* f : {&queries_file, &summary_file, &details_file, &pr_file, &scans_file}) f->commit();
 }
 
+// The figure module's arguments: the folder, and a simulated route's world as `route --figure` passes it
+// (--world and whichever of --tilt, --lean, --missing-models were given), drawn under the route.
+std::vector<std::string> figure_arguments(const std::string& out, const WorldOptions& world) {
+    std::vector<std::string> args{out};
+    if (world.world.empty()) return args;  // a recording: no world to draw
+    args.insert(args.end(), {"--world", world.world});
+    if (world.tilt) args.insert(args.end(), {"--tilt", num(*world.tilt)});
+    if (world.lean) args.insert(args.end(), {"--lean", *world.lean});
+    if (world.missing_models) args.insert(args.end(), {"--missing-models", *world.missing_models});
+    return args;
+}
+
 std::string descriptor_help() {
     std::string text = "Descriptors (--descriptors, comma-separated):\n";
     for (const auto& k : descriptor_kinds()) {
@@ -177,9 +189,11 @@ void add_place_recognition_command(CLI::App& app) {
                 "no query has a revisit (an older scan outside the exclusion window within --revisit-m %s m): "
                 "recall, F1max and AUC are undefined (nan) and the curve is empty\n",
                 num(o->run.loop.revisit_m).c_str());
-        if (!o->no_figures && run_python_module("bvc3d.place_recognition_figure", {o->out}).status != 0)
+        // A simulated route is drawn over its world's floor plan; a recording has no world to draw.
+        const std::vector<std::string> figure_args = figure_arguments(o->out, o->world);
+        if (!o->no_figures && run_python_module("bvc3d.place_recognition_figure", figure_args).status != 0)
             throw InputError("the figure failed; the tables are in '" + o->out + "'; rerun it with:\n  " +
-                             python_command().shell_line("bvc3d.place_recognition_figure", {o->out}));
+                             python_command().shell_line("bvc3d.place_recognition_figure", figure_args));
         std::printf("tables: %s/summary.csv, queries.csv, details.csv, pr.csv, scans.csv%s\n", o->out.c_str(),
                     o->no_figures ? "" : ", figure: place-recognition.png");
     });

@@ -1,10 +1,13 @@
 """The figure of `bvc3d place-recognition`: every descriptor's precision-recall curve, and the route seen
-from above with the queries that have a revisit.
+from above with the queries that have a revisit, over its world's floor plan when it has a world.
 
-    /usr/bin/python3 -m bvc3d.place_recognition_figure DIR
+    /usr/bin/python3 -m bvc3d.place_recognition_figure DIR [--world WORLD --tilt DEG --lean CORNER \
+        --missing-models skip]
 
 DIR holds details.csv, pr.csv, queries.csv and scans.csv (as `bvc3d place-recognition` writes them);
-the figure is DIR/place-recognition.png.
+the figure is DIR/place-recognition.png. A simulated route's world (the command passes its --world and
+the options given with it) is drawn as `route --figure` draws it: the floor plan at the robot's body
+height (bvc3d.route_figure.draw_plan). A recording has no world: its route is drawn alone.
 """
 import argparse
 import math
@@ -17,6 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from .report import num, read_csv  # noqa: E402
+from .route_figure import BODY_HEIGHT, add_world_arguments, draw_plan, open_world  # noqa: E402
 
 DPI = 120
 
@@ -25,8 +29,9 @@ def _pct(v):
     return "n/a" if math.isnan(v) else f"{100 * v:.1f}%"
 
 
-def draw(directory):
-    """The figure of a folder as a matplotlib Figure (figure() writes it)."""
+def draw(directory, world=None, body_height=BODY_HEIGHT):
+    """The figure of a folder as a matplotlib Figure (figure() writes it). `world` (a World, or a preset or
+    world file's name; None for a recording) is the route's: its floor plan is drawn under the route."""
     details = read_csv(os.path.join(directory, "details.csv"))
     pr = read_csv(os.path.join(directory, "pr.csv"))
     scans = read_csv(os.path.join(directory, "scans.csv"))
@@ -56,6 +61,11 @@ def draw(directory):
     left.legend(fontsize=7, loc="lower left")
     x = [num(s["x"]) for s in scans]
     y = [num(s["y"]) for s in scans]
+    if world is not None:
+        world = open_world(world)
+        draw_plan(right, world, body_height)
+        right.set_title(f"{world.name}: the route over the floor plan at the body's height\n"
+                        f"(0–{body_height:g} m; red: where the floor ends)", fontsize=9)
     right.plot(x, y, "-", c="0.6", lw=0.8, label="route")
     first = details[0]["descriptor"] if details else None
     revisit = {int(q["query"]) for q in queries if q["descriptor"] == first and q["has_revisit"] == "1"}
@@ -71,8 +81,8 @@ def draw(directory):
     return fig
 
 
-def figure(directory, out=None):
-    fig = draw(directory)
+def figure(directory, out=None, world=None, body_height=BODY_HEIGHT):
+    fig = draw(directory, world, body_height)
     path = out or os.path.join(directory, "place-recognition.png")
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
@@ -82,9 +92,11 @@ def figure(directory, out=None):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("directory")
+    add_world_arguments(parser, required=False)
     args = parser.parse_args(argv)
     try:
-        print("figure:", figure(args.directory))
+        world = None if args.world is None else open_world(args.world, args.tilt, args.lean, args.missing_models)
+        print("figure:", figure(args.directory, world=world))
     except (OSError, KeyError, ValueError, IndexError) as e:
         print(f"bvc3d.place_recognition_figure: error: {e}", file=sys.stderr)
         return 2

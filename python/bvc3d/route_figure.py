@@ -40,6 +40,23 @@ def draw_plan(ax, world, body_height=BODY_HEIGHT):
     return segments
 
 
+def open_world(world, tilt_deg=None, lean="+x+y", missing_models="error"):
+    """`world` itself when it is a World, else the world its source names (a preset, a world YAML or a Gazebo
+    world) with the options given."""
+    if isinstance(world, _core.World):
+        return world
+    return _core.World.preset(str(world), tilt_deg, lean, missing_models)
+
+
+def add_world_arguments(parser, required):
+    """--world, --tilt, --lean and --missing-models, as the command that calls the figure passes them."""
+    parser.add_argument("--world", required=required, help="a world preset, world YAML or Gazebo world")
+    parser.add_argument("--tilt", type=float, default=None, help="degrees the cross arena's central walls lean")
+    parser.add_argument("--lean", default="+x+y", help="the corner they lean toward (default +x+y)")
+    parser.add_argument("--missing-models", default="error",
+                        help="a Gazebo world's models that are not found: 'skip' or 'error' (default)")
+
+
 def draw_path(ax, fig, t, x, y, heading):
     """The path coloured by time (minutes when it is long), its start as a black triangle."""
     minutes = t[-1] > 300
@@ -55,7 +72,7 @@ def draw_path(ax, fig, t, x, y, heading):
 
 def figure(world_source, trajectory, out, body_height=BODY_HEIGHT, tilt_deg=None, lean="+x+y",
            missing_models="error"):
-    world = _core.World.preset(str(world_source), tilt_deg, lean, missing_models)
+    world = open_world(world_source, tilt_deg, lean, missing_models)
     path = _core.read_trajectory(str(trajectory))
     t, x, y, heading = path["t"], path["x"], path["y"], path["heading"]
     if len(t) < 2:
@@ -86,11 +103,7 @@ def figure(world_source, trajectory, out, body_height=BODY_HEIGHT, tilt_deg=None
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--world", required=True, help="a world preset, world YAML or Gazebo world")
-    parser.add_argument("--tilt", type=float, default=None, help="degrees the cross arena's central walls lean")
-    parser.add_argument("--lean", default="+x+y", help="the corner they lean toward (default +x+y)")
-    parser.add_argument("--missing-models", default="error",
-                        help="a Gazebo world's models that are not found: 'skip' or 'error' (default)")
+    add_world_arguments(parser, required=True)
     parser.add_argument("--trajectory", required=True, help="the route: a trajectory file (t, x, y, [z], heading)")
     parser.add_argument("--out", required=True, help="the figure to write (.png)")
     parser.add_argument("--body-height", type=float, default=BODY_HEIGHT, help="m: the plan's cut (default 0.1)")

@@ -483,3 +483,81 @@ def test_the_hall_has_no_revisit_in_the_sequential_sense():
     assert all(math.isnan(v) for v in r["summary"]["recall_at_1"])
     np.testing.assert_array_equal(r["queries"]["query"][:9], np.arange(51, 60))
     assert np.all(r["queries"]["match_m"] > 5)
+
+
+# ------------------------------------------------------------------- the figure's floor plan
+
+ROOM_YAML = """name: room
+objects:
+  - box: {center: [0, -6.1, 1.5], size: [12.4, 0.2, 3]}
+  - box: {center: [0, 6.1, 1.5], size: [12.4, 0.2, 3]}
+  - box: {center: [-6.1, 0, 1.5], size: [0.2, 12.4, 3]}
+  - box: {center: [6.1, 0, 1.5], size: [0.2, 12.4, 3]}
+  - box: {center: [0, 0, 1.5], size: [4, 4, 3]}
+walkable: {rect: [-6, -6, 6, 6]}
+"""
+
+
+def plan_segments(ax):
+    """The segments of every line collection on `ax` (the route and the queries are lines and points)."""
+    from matplotlib.collections import LineCollection
+    parts = [np.asarray(c.get_segments()).reshape(-1, 2, 2) for c in ax.collections if isinstance(c, LineCollection)]
+    return np.concatenate(parts) if parts else np.empty((0, 2, 2))
+
+
+def rectangle_edges(x0, y0, x1, y1):
+    return np.array([[[x0, y0], [x1, y0]], [[x1, y0], [x1, y1]], [[x1, y1], [x0, y1]], [[x0, y1], [x0, y0]]], float)
+
+
+def on_an_edge(points, edges, tol=1e-6):
+    """Whether each point lies on one of the axis-parallel edges (S, 2, 2)."""
+    lo, hi = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
+    inside = np.all((points[:, None] >= lo[None] - tol) & (points[:, None] <= hi[None] + tol), axis=2)
+    return inside.any(axis=1)
+
+
+def test_the_figure_draws_a_simulated_route_over_its_floor_plan(tmp_path):
+    """Issue 43, finding 10: a route through a world is drawn over the world's floor plan at the body's height
+    (as route --figure draws it): here a 12 m room with a 4 m block, every box taller than the body. The plan's
+    segments are the boxes' outlines (walls from the YAML, computed here), and the block's four edges are whole
+    in it. A recording of the same route has no world: its figure is the route alone, and nothing says so."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from bvc3d import place_recognition_figure
+    world = tmp_path / "room.yaml"
+    world.write_text(ROOM_YAML)
+    route, _ = two_laps(tmp_path)
+    out = tmp_path / "sim"
+    run_cli("place-recognition", "--world", world, "--route", route, "--sensor", "horizontal", "--descriptors",
+            "scan-context", "--exclude-seconds", 10, "--out", out, check=True)
+    # The boxes' outlines at the body's height, from the YAML: the walls' and the block's rectangles.
+    boxes = [(-6.2, -6.2, 6.2, -6.0), (-6.2, 6.0, 6.2, 6.2), (-6.2, -6.2, -6.0, 6.2), (6.0, -6.2, 6.2, 6.2),
+             (-2, -2, 2, 2), (-6, -6, 6, 6)]
+    edges = np.concatenate([rectangle_edges(*b) for b in boxes])
+    fig = place_recognition_figure.draw(out, world=world)
+    drawn = plan_segments(fig.axes[1])
+    assert len(drawn) >= 4
+    assert on_an_edge(drawn.reshape(-1, 2), edges).all(), drawn
+    for edge in rectangle_edges(-2, -2, 2, 2):
+        assert any(np.allclose(s, edge) or np.allclose(s, edge[::-1]) for s in drawn), edge
+    # Drawn as route --figure draws it: the world's own floor plan at the body's height, whole.
+    np.testing.assert_array_equal(drawn, bvc3d.World.from_yaml(world).floor_plan(height=0.1)["segments"])
+    assert "room" in fig.axes[1].get_title() and "floor plan" in fig.axes[1].get_title()
+    # The command drew the same figure: it passes its world to the figure.
+    again, bare = tmp_path / "again.png", tmp_path / "bare.png"
+    place_recognition_figure.figure(out, again, world=bvc3d.World.from_yaml(world))
+    place_recognition_figure.figure(out, bare)
+    png = (out / "place-recognition.png").read_bytes()
+    assert png == again.read_bytes() and png != bare.read_bytes()
+    # The same route as a recording: no world, the route alone, and no word of a missing plan.
+    run_cli("export-scans", "--world", world, "--trajectory", route, "--sensor", "horizontal", "--format",
+            "pcd-f8", "--out", tmp_path / "rec", check=True)
+    rec = tmp_path / "rec-out"
+    proc = run_cli("place-recognition", "--scans", tmp_path / "rec" / "scans.txt", "--poses",
+                   tmp_path / "rec" / "poses.txt", "--descriptors", "scan-context", "--exclude-seconds", 10,
+                   "--out", rec, check=True)
+    assert "plan" not in proc.stdout + proc.stderr and "world" not in proc.stdout + proc.stderr, proc
+    fig = place_recognition_figure.draw(rec)
+    assert len(plan_segments(fig.axes[1])) == 0 and fig.axes[1].get_title() == ""
+    place_recognition_figure.figure(rec, bare)
+    assert (rec / "place-recognition.png").read_bytes() == bare.read_bytes()
