@@ -24,11 +24,8 @@ __all__ += ["place_recognition", "scan_context", "scan_context_distance"]
 __all__ += ["lidar_models", "route", "tour", "write_trajectory"]
 from ._core import HdAdjacency, combine_scales, navigate, reward_readout, shortest_path
 __all__ += ["HdAdjacency", "combine_scales", "navigate", "reward_readout", "shortest_path"]
-from ._core import AuthorsReliability, authors_decide, authors_heading, authors_mix, authors_rollouts, sector_minima
-__all__ += ["AuthorsReliability", "authors_decide", "authors_heading", "authors_mix", "authors_rollouts",
-            "sector_minima"]
-from ._core import authors_grid, authors_path
-__all__ += ["authors_grid", "authors_path"]
+from . import authors  # the authors' controller piece by piece
+__all__ += ["authors"]
 __all__ += ["GridCells", "HeadDirectionCells"]
 from ._core import GrowingPlaceCells
 __all__ += ["GrowingPlaceCells"]

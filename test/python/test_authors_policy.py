@@ -31,7 +31,7 @@ def test_rollouts_on_the_hand_made_chain_match_the_oracle_draw_for_draw():
     rng = np.random.default_rng(3)
     for _ in range(5):
         u = rng.random((2, 8, 10))
-        mine = bvc3d.authors_rollouts(w, a0, wr, u.ravel())
+        mine = bvc3d.authors.authors_rollouts(w, a0, wr, u.ravel())
         oracle = ao.sample_rollouts(w, a0, wr, u)
         np.testing.assert_allclose(mine["R"], oracle["R"], rtol=0, atol=1e-14)
         np.testing.assert_allclose(mine["V"], oracle["V"], rtol=0, atol=1e-14)
@@ -47,7 +47,7 @@ def test_rollouts_on_random_adjacencies_match_the_oracle_and_share_paths(antisym
         a0 = rng.random(n) * (rng.random(n) < 0.6)
         wr = rng.normal(0, 1, n)
         u = rng.random((2, 8, 10))
-        mine = bvc3d.authors_rollouts(w, a0, wr, u.ravel())
+        mine = bvc3d.authors.authors_rollouts(w, a0, wr, u.ravel())
         oracle = ao.sample_rollouts(w, a0, wr, u)
         np.testing.assert_allclose(mine["R"], oracle["R"], rtol=1e-12, atol=1e-13)
         np.testing.assert_allclose(mine["V"], oracle["V"], rtol=0, atol=1e-13)
@@ -59,11 +59,11 @@ def test_rollouts_on_random_adjacencies_match_the_oracle_and_share_paths(antisym
     w = float32_adjacency(rng, 8, n)
     a0, wr = rng.random(n), rng.normal(0, 1, n)
     u = rng.random((4, 8, 3))
-    mine = bvc3d.authors_rollouts(w, a0, wr, u.ravel(), samples=3, steps=5, discount=0.5, temperature=2.0)
+    mine = bvc3d.authors.authors_rollouts(w, a0, wr, u.ravel(), samples=3, steps=5, discount=0.5, temperature=2.0)
     oracle = ao.sample_rollouts(w, a0, wr, u, samples=3, steps=5, discount=0.5, temperature=2.0)
     np.testing.assert_allclose(mine["R"], oracle["R"], rtol=1e-12, atol=1e-13)
     with pytest.raises(ValueError, match="uniforms"):
-        bvc3d.authors_rollouts(w, a0, wr, u.ravel()[:-1], samples=3, steps=5)
+        bvc3d.authors.authors_rollouts(w, a0, wr, u.ravel()[:-1], samples=3, steps=5)
 
 
 def test_the_scale_mix_matches_the_oracle():
@@ -74,11 +74,11 @@ def test_the_scale_mix_matches_the_oracle():
         Var = rng.random((S, 8)) * 0.1
         rho = rng.uniform(0.1, 1.0, S)
         prev = None if trial % 2 else rng.random(S) * 3
-        mine = bvc3d.authors_mix(R, Var, rho, prev)
+        mine = bvc3d.authors.authors_mix(R, Var, rho, prev)
         oracle = ao.mix_scales(R, Var, rho, prev)
         for key in ("P_ds", "M", "H", "H_smoothed", "iota", "q", "P_s", "P"):
             np.testing.assert_allclose(mine[key], oracle[key], rtol=1e-12, atol=1e-300, err_msg=key)
-    silent = bvc3d.authors_mix(np.zeros((3, 8)), np.zeros((3, 8)), [1.0, 1.0, 1.0])
+    silent = bvc3d.authors.authors_mix(np.zeros((3, 8)), np.zeros((3, 8)), [1.0, 1.0, 1.0])
     np.testing.assert_allclose(silent["P_s"], [1 / 3] * 3)
 
 
@@ -99,7 +99,7 @@ def test_the_heading_rule_matches_the_oracle_in_every_case():
             V[0, 0] = [1.0, 0.0]
             V[0, 4] = [-1.0, 0.0]
         safe = rng.random(8) < 0.7
-        mine = bvc3d.authors_heading(P, R, V, safe.astype(float))
+        mine = bvc3d.authors.authors_heading(P, R, V, safe.astype(float))
         oracle = ao.heading_rule(P, R, V, safe)
         if oracle is None:
             assert mine is None
@@ -118,10 +118,10 @@ def test_sector_minima_match_the_oracle(sector):
     azimuths = np.arange(720) * 2 * math.pi / 720
     ranges = rng.uniform(0.2, 10, 720)
     ranges[rng.random(720) < 0.1] = np.inf
-    np.testing.assert_array_equal(bvc3d.sector_minima(ranges, azimuths, 8, sector),
+    np.testing.assert_array_equal(bvc3d.authors.sector_minima(ranges, azimuths, 8, sector),
                                   ao.sector_minima(ranges, azimuths, 8, sector))
     # One return at 10° guards direction 0 in both readings; at −10°, direction 7 (authors) or 0 (centred).
-    one = bvc3d.sector_minima([0.5], [math.radians(-10)], 8, sector)
+    one = bvc3d.authors.sector_minima([0.5], [math.radians(-10)], 8, sector)
     assert np.argmin(one) == (7 if sector == "authors" else 0)
 
 
@@ -129,7 +129,7 @@ def test_the_reliability_bookkeeping_matches_the_oracle_step_for_step():
     rng = np.random.default_rng(4)
     for trial in range(10):
         S = 1 + trial % 3
-        mine, oracle = bvc3d.AuthorsReliability(S), ao.Reliability(S)
+        mine, oracle = bvc3d.authors.AuthorsReliability(S), ao.Reliability(S)
         heading = 0.0
         phases = []
         for decision in range(120):
@@ -169,7 +169,7 @@ def test_a_whole_decision_matches_the_oracle():
         sector_min = rng.uniform(0.3, 4, 8)
         rho = rng.uniform(0.1, 1, 3)
         prev = None if trial == 0 else rng.random(3) * 2
-        mine = bvc3d.authors_decide(scales, flat, sector_min, rho, prev)
+        mine = bvc3d.authors.authors_decide(scales, flat, sector_min, rho, prev)
         oracle = ao.decide(scales, rho, ao.rollout_uniforms(flat, len(scales)), sector_min, prev)
         np.testing.assert_allclose(mine["H_smoothed"], oracle["H_smoothed"], rtol=1e-12, atol=1e-12)
         if oracle["choice"] is None:

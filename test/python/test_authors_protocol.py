@@ -26,7 +26,7 @@ CASES = {"authors-open": ([], ()), "authors-cross": (CROSS, ()), "authors-maze":
 @pytest.mark.parametrize("world", sorted(CASES))
 def test_the_grid_blocks_the_cells_their_planner_blocks(world):
     rects, oriented = CASES[world]
-    grid = bvc3d.authors_grid(WORLDS / f"{world}.yaml")
+    grid = bvc3d.authors.authors_grid(WORLDS / f"{world}.yaml")
     assert (grid["west"], grid["north"], grid["cell"]) == (-10.0, 10.0, 0.1)
     expected = authors_blocked_grid(rects, oriented=oriented)
     mismatch = np.argwhere(grid["blocked"] != expected)
@@ -44,7 +44,7 @@ def test_the_optimal_path_is_the_oracles_from_random_starts(world):
         for _ in range(4):
             start = rng.uniform(-9.5, 9.5, 2)
             c, r = authors_cell(start)
-            mine = bvc3d.authors_path(WORLDS / f"{world}.yaml", start, goal)
+            mine = bvc3d.authors.authors_path(WORLDS / f"{world}.yaml", start, goal)
             oracle = authors_optimal_path(rects, start, goal, oriented=oriented)
             assert mine["found"] == (oracle is not None) == (not blocked[r, c])
             if oracle is None:
