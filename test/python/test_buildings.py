@@ -102,24 +102,26 @@ def slab_segments(triangles, z_lo, z_hi):
 def distance_to_segments(points, segs, within=1.0):
     """Exact distance from each point to the nearest segment, for distances up to `within` (inf
     beyond): segments cut into pieces of at most 0.5 m, the pieces near each point checked."""
-    pieces = []
-    for a, b in segs:
-        n = max(1, int(np.ceil(np.linalg.norm(b - a) / 0.5)))
-        t = np.linspace(0, 1, n + 1)[:, None]
-        p = a + t * (b - a)
-        pieces.append(np.stack([p[:-1], p[1:]], axis=1))
-    segs = np.concatenate(pieces)
+    counts = np.maximum(1, np.ceil(np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1) / 0.5).astype(int))
+    whole = np.repeat(np.arange(len(segs)), counts)
+    j = np.arange(len(whole)) - np.repeat(np.cumsum(counts) - counts, counts)  # piece's index in its segment
+    a, ab, n = segs[whole, 0], segs[whole, 1] - segs[whole, 0], counts[whole][:, None]
+    segs = np.stack([a + (j[:, None] / n) * ab, a + ((j[:, None] + 1) / n) * ab], axis=1)
     tree = KDTree(segs.mean(axis=1))
-    out = np.empty(len(points))
-    for i, idx in enumerate(tree.query_radius(points, r=within + 0.25)):
-        if len(idx) == 0:
-            out[i] = np.inf
+    out = np.full(len(points), np.inf)
+    for start in range(0, len(points), 20000):  # every (point, nearby piece) pair at once, in chunks
+        chunk = points[start : start + 20000]
+        near = tree.query_radius(chunk, r=within + 0.25)
+        owner = np.repeat(np.arange(len(chunk)), [len(idx) for idx in near])
+        if len(owner) == 0:
             continue
-        a, b = segs[idx, 0], segs[idx, 1]
-        ab = b - a
-        t = np.clip(np.einsum("ij,ij->i", points[i] - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0, 1)
-        d = np.min(np.linalg.norm(points[i] - (a + t[:, None] * ab), axis=1))
-        out[i] = d if d <= within else np.inf
+        piece = np.concatenate(near)
+        a, ab, p = segs[piece, 0], segs[piece, 1] - segs[piece, 0], chunk[owner]
+        t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0, 1)
+        d = np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
+        first = np.r_[0, np.flatnonzero(np.diff(owner)) + 1]  # owner is sorted: each point's pairs in a row
+        out[start + owner[first]] = np.minimum.reduceat(d, first)
+    out[out > within] = np.inf
     return out
 
 
