@@ -23,7 +23,7 @@ template <int N, class V>
 
 // One job's blocks, added to the rows of its record's directions: C of them (C = 0: `count`, read at
 // run time). With the count known at compile time the direction loop is unrolled: no branch inside a
-// block whose outcome changes from job to job (measured 0.93-0.97 of the BVC layer's time).
+// block whose outcome changes from job to job (docs/performance.md#kernel-choices-and-the-measurements-behind-them).
 template <int N, int C>
 [[gnu::always_inline]] inline void add_blocks(std::array<typename simd::doubles<N>::type, 8 / N> pw, double b8, int W,
                                               int count, const std::uint16_t* dir, const double* factor,

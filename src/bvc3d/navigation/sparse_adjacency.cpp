@@ -31,8 +31,8 @@ SparseAdjacency::SparseAdjacency(const HdAdjacency& adj, double prune)
 void SparseAdjacency::apply(int k, std::span<const double> x, std::span<double> out) const {
     // Unpruned: the same two forms, in the same order, as HdAdjacency::apply (a left-out weight only adds ±0 there).
     // A pruned copy's bits are its own: the column form where it reads under a third of the entries (a rollout's
-    // first step, from the place cells' rates), else every row in 16 lanes (kernels::row_sums16: gathers, ~3× the
-    // entries per second of the column form's scattered updates; the state after a rollout step is ~all cells).
+    // first step, from the place cells' rates), else every row in 16 lanes (kernels::row_sums16, gathers: faster
+    // per entry than the column form's scattered updates, docs/performance.md; after a rollout step ~all cells are on).
     const Rows& r = rows_[std::size_t(k)];
     std::size_t active = 0, work = 0;
     for (std::size_t j = 0; j < x.size(); ++j)

@@ -108,7 +108,7 @@ template <int N, int PB, int T>
                                   out_stride);
     };
     // Fewer than a quarter of the blocks 0: every block, in the plain loop (the list's indirection would cost more
-    // than it saves; measured with callgrind on the paper's 2d, where few blocks are 0).
+    // than it saves: docs/performance.md#kernel-choices-and-the-measurements-behind-them).
     if (static_cast<std::size_t>(n_blocks) * 32 > 3 * n) row.template operator()<false>();
     else row.template operator()<true>();
 }
@@ -129,8 +129,8 @@ template <int N, int PS, int PB, int TB>
 }
 
 #if BVC3D_HAVE_DISPATCH
-// AVX-512: 32 registers, a block of 3 pairs × 8 steps takes 24 accumulators (measured on a Zen 4 core,
-// 250 × 960, against 2 × 8, 1 × 8, 4 × 4 and 2 × 4: 0.93, 0.79, 0.97, 0.89 of their time); AVX2: 16.
+// AVX-512: 32 registers, a block of 3 pairs × 8 steps takes 24 accumulators (the fastest tile measured,
+// docs/performance.md#kernel-choices-and-the-measurements-behind-them); AVX2: 16.
 BVC3D_TARGET_V4 void products_v4(const float* W, std::size_t pair_stride, const float* v, std::size_t v_stride,
                                  std::size_t n, int pairs, int steps, float* out, std::size_t out_stride,
                                  std::uint32_t* blocks) {
