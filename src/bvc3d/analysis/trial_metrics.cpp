@@ -88,7 +88,9 @@ std::shared_ptr<const Grid> fit_grid(const Eigen::Ref<const Points>& positions, 
     if (positions.cols() != 2)
         throw InputError("positions with " + std::to_string(positions.cols()) +
                          " coordinates: binning needs 2 (hexagons) or 3 (voxels)");
-    const Eigen::VectorXd x = positions.col(0), y = positions.col(1);
+    // No samples: no column taken (a column of an empty Ref with no data is an offset from a null pointer).
+    Eigen::VectorXd x(positions.rows()), y(positions.rows());
+    if (positions.rows() > 0) x = positions.col(0), y = positions.col(1);
     return std::make_shared<HexGrid>(HexGrid::fit({x.data(), static_cast<std::size_t>(x.size())},
                                                   {y.data(), static_cast<std::size_t>(y.size())}, params.gridsize,
                                                   params.extent));
