@@ -109,6 +109,10 @@ bool AuthorsController::over(Start& s) {
 
 bool AuthorsController::step(Start& s) {
     c_.senses.step(s.pose, s.contact, s.t);
+    return move(s);
+}
+
+bool AuthorsController::move(Start& s) {
     const double moved = body_->forward(s.pose, p_.step);
     s.contact = moved < p_.step;
     s.out.path_m += moved;
@@ -192,13 +196,7 @@ void AuthorsController::explore(Start& s) {
             turn(s, s.pose.heading - pi + two_pi * s.rng.uniform(), completed);
             break;
         }
-        const double moved = body_->forward(s.pose, p_.step);
-        s.contact = moved < p_.step;
-        s.out.path_m += moved;
-        s.t += p_.step / c_.spec.robot.speed;
-        s.out.path.push_back(s.pose.position());
-        s.out.bumped.push_back(s.contact ? 1 : 0);
-        if (over(s)) return;
+        if (move(s)) return;
     }
     turn(s, s.pose.heading + p_.explore_turn_sd * s.rng.normal(0.0, 1.0), completed);
 }

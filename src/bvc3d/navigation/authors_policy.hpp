@@ -63,6 +63,7 @@ private:
     void failed_turn(Start& s);
     void turn(Start& s, double heading, bool& completed);
     bool step(Start& s);  // a model update and a step forward; true when the start is over
+    bool move(Start& s);  // the step forward alone, recorded; true when the start is over
     bool over(Start& s);  // the goal reached or a cap: sets the run's end
 
     PolicyContext c_;
